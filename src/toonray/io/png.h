@@ -1,0 +1,41 @@
+#pragma once
+/// PNG encoding (libdeflate) and decoding (libpng).
+///
+/// Encoding is ours because libpng at its default level takes 20-28 ms for a 720p frame; flat
+/// toon images compress well with the Up filter and libdeflate's fast levels in a few ms
+/// (figures in docs/performance.md). Decoding uses libpng: it is only needed for validation and
+/// tests, where speed does not matter and a second, independent implementation is the point.
+
+#include <cstdint>
+#include <filesystem>
+#include <vector>
+
+#include "toonray/core/image.h"
+
+namespace toonray {
+
+struct PngOptions {
+    int level = 1;  ///< libdeflate level, 1 (fastest) to 12 (smallest)
+};
+
+/// Encodes 8-bit pixels (channels 1 = gray, 3 = RGB) as a complete PNG file in memory.
+std::vector<std::uint8_t> encode_png(int width, int height, int channels,
+                                     const std::uint8_t* pixels, const PngOptions& options = {});
+
+/// Encodes and writes atomically. Throws Error on failure.
+void write_png(const std::filesystem::path& path, const ImageRgb8& image, const PngOptions& options = {});
+void write_png(const std::filesystem::path& path, const ImageGray8& image, const PngOptions& options = {});
+
+/// A decoded PNG, converted to 8-bit RGB.
+struct DecodedPng {
+    int width = 0, height = 0;
+    ImageRgb8 rgb;
+};
+
+/// Decodes a PNG file with libpng. Throws Error when the file is missing, truncated or corrupt.
+DecodedPng read_png(const std::filesystem::path& path);
+
+/// True when `path` is a complete, decodable PNG (used by `batch --resume`).
+bool is_valid_png(const std::filesystem::path& path);
+
+}  // namespace toonray

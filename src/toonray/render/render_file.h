@@ -1,0 +1,52 @@
+#pragma once
+/// One frame from an OBJ file to PNG files: load, build the BVH, render, write atomically.
+/// Holds its scene, BVH and image buffers so that rendering many frames reuses memory.
+
+#include <filesystem>
+#include <optional>
+
+#include "toonray/accel/triangle_accel.h"
+#include "toonray/core/error.h"
+#include "toonray/io/png.h"
+#include "toonray/render/renderer.h"
+#include "toonray/scene/scene.h"
+
+namespace toonray {
+
+struct FileRenderOptions {
+    RenderSettings settings;
+    std::optional<CameraSpec> camera;  ///< overrides the file's camera block
+    std::optional<std::filesystem::path> aov_dir;  ///< write feature images here
+    Bvh::Config bvh;
+    PngOptions png;
+};
+
+/// The AOV file names for an output: `<dir>/<stem>_depth.png`, ... .
+struct AovPaths {
+    std::filesystem::path depth, normal, edges_depth, edges_normal, edges, cel;
+};
+AovPaths aov_paths(const std::filesystem::path& dir, const std::filesystem::path& output);
+
+class FileRenderer {
+public:
+    /// Renders `input` to `output` (and AOVs). Throws Error on bad input or a failed write;
+    /// no output is written for a scene that fails to load. Warnings are appended to `warnings`.
+    void render(const std::filesystem::path& input, const std::filesystem::path& output,
+                const FileRenderOptions& options, Warnings& warnings);
+
+    /// Renders an already loaded scene (the camera comes from options or the scene).
+    void render(const Scene& scene, const std::filesystem::path& output, const FileRenderOptions& options);
+
+    [[nodiscard]] const Renderer& renderer() const { return renderer_; }
+    [[nodiscard]] const Scene& scene() const { return scene_; }
+
+private:
+    Scene scene_;
+    TriangleAccel accel_;
+    Renderer renderer_;
+};
+
+/// The camera a frame uses: the override, else the file's camera block, else an automatic one.
+CameraSpec choose_camera(const Scene& scene, const FileRenderOptions& options);
+
+}  // namespace toonray

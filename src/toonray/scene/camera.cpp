@@ -1,0 +1,87 @@
+#include "toonray/scene/camera.h"
+
+#include <charconv>
+#include <cmath>
+#include <fmt/format.h>
+#include <vector>
+
+#include "toonray/core/error.h"
+
+namespace toonray {
+
+ViewPlane make_view_plane(const CameraSpec& camera, int width, int height) {
+    if (!is_finite(camera.eye) || !is_finite(camera.gaze) || !is_finite(camera.up))
+        throw Error("invalid camera: eye, gaze and up must be finite");
+    Vec3f view_dir = camera.gaze - camera.eye;
+    float view_len = length(view_dir);
+    if (!(view_len > 0)) throw Error("invalid camera: eye and gaze point are the same point");
+    float up_len = length(camera.up);
+    if (!(up_len > 0)) throw Error("invalid camera: up vector is zero");
+    Vec3f side = cross(view_dir, camera.up);
+    // sin of the angle between view direction and up; below ~0.06 degrees it is unusable.
+    if (!(length(side) > 1e-3f * view_len * up_len))
+        throw Error("invalid camera: up vector is parallel to the view direction");
+
+    const float ratio = static_cast<float>(height) / static_cast<float>(width);
+    Vec3f center = camera.eye + view_dir;
+    Vec3f right = normalize(side);
+    Vec3f up_vec = camera.up * ratio;
+    Vec3f ul = center + up_vec - right;
+    Vec3f ur = center + up_vec + right;
+    Vec3f ll = center - right - up_vec;
+
+    ViewPlane plane;
+    plane.eye = camera.eye;
+    plane.upper_left = ul;
+    plane.step_x = (ur - ul) / static_cast<float>(width);
+    plane.step_y = (ll - ul) / static_cast<float>(height);
+    plane.right = right;
+    plane.up = normalize(cross(right, view_dir));
+    return plane;
+}
+
+CameraSpec auto_camera(const BBox& bounds, int width, int height) {
+    Vec3f center = bounds.empty() ? Vec3f(0.0f) : bounds.center();
+    float radius = bounds.empty() ? 1.0f : 0.5f * length(bounds.extent());
+    if (!(radius > 0)) radius = 1.0f;
+    // 60 degrees horizontal: |viewDir| = 1 / tan(30 deg). The narrower half-angle must hold the
+    // bounding sphere.
+    const float view_len = 1.0f / std::tan(30.0f * 3.14159265f / 180.0f);
+    const float aspect = static_cast<float>(height) / static_cast<float>(width);
+    float half_fov = std::atan(std::min(1.0f, aspect) / view_len);
+    float distance = radius / std::sin(half_fov) * 1.05f;
+    Vec3f dir = normalize(Vec3f(0.55f, 0.45f, 1.0f));  // from the centre towards the eye
+    CameraSpec cam;
+    cam.eye = center + dir * distance;
+    Vec3f forward = -dir;
+    cam.gaze = cam.eye + forward * view_len;
+    Vec3f world_up(0.0f, 1.0f, 0.0f);
+    Vec3f right = normalize(cross(forward, world_up));
+    cam.up = normalize(cross(right, forward));
+    return cam;
+}
+
+CameraSpec parse_camera_spec(const std::string& text) {
+    std::vector<float> values;
+    const char* p = text.data();
+    const char* end = p + text.size();
+    while (p < end) {
+        float v;
+        auto [next, ec] = std::from_chars(p, end, v);
+        if (ec != std::errc() || !std::isfinite(v))
+            throw Error(fmt::format("--camera: malformed number in '{}'", text));
+        values.push_back(v);
+        p = next;
+        if (p < end) {
+            if (*p != ',') throw Error(fmt::format("--camera: expected ',' in '{}'", text));
+            ++p;
+        }
+    }
+    if (values.size() != 9)
+        throw Error(fmt::format("--camera: expected 9 numbers ex,ey,ez,gx,gy,gz,ux,uy,uz, got {}",
+                                values.size()));
+    return {{values[0], values[1], values[2]}, {values[3], values[4], values[5]},
+            {values[6], values[7], values[8]}};
+}
+
+}  // namespace toonray

@@ -1,0 +1,49 @@
+#pragma once
+/// The seed's camera: an eye, a gaze point and an up vector, and the view plane built from them.
+
+#include <string>
+
+#include "toonray/core/bbox.h"
+#include "toonray/core/math.h"
+
+namespace toonray {
+
+/// Camera as written in the OBJ camera block (`c eye gaze up`) or given with --camera.
+/// The distance from eye to gaze sets the field of view: horizontal fov = 2 atan(1 / |gaze - eye|).
+struct CameraSpec {
+    Vec3f eye;
+    Vec3f gaze;
+    Vec3f up;
+};
+
+/// The image plane in world space: pixel (x, y), y = 0 at the top, is sampled at
+/// `upper_left + (x + 0.5) * step_x + (y + 0.5) * step_y`.
+struct ViewPlane {
+    Vec3f eye;
+    Vec3f upper_left;
+    Vec3f step_x;  ///< (UR - UL) / width
+    Vec3f step_y;  ///< (LL - UL) / height
+    Vec3f right;   ///< unit vector to the right of the view
+    Vec3f up;      ///< unit vector up in the image (orthogonal to right and the view direction)
+
+    [[nodiscard]] Vec3f pixel_point(float x, float y) const {
+        return upper_left + step_x * x + step_y * y;
+    }
+};
+
+/// Builds the view plane exactly as the seed defines it:
+/// viewDir = gaze - eye; center = eye + viewDir; ratio = h / w; right = normalize(viewDir x up);
+/// upVec = ratio * up; UL = center + upVec - right, UR = center + upVec + right,
+/// LL = center - right - upVec. (As in the seed, `up` is used as given: it should be a unit
+/// vector orthogonal to the view direction, which is what exporters write.)
+/// Throws Error when eye == gaze, up is zero or parallel to the view direction, or a value is not finite.
+ViewPlane make_view_plane(const CameraSpec& camera, int width, int height);
+
+/// A camera that frames the whole box: looks at its centre from above and to the front-right,
+/// 60 degrees of horizontal field of view, the bounding sphere fitting the image.
+CameraSpec auto_camera(const BBox& bounds, int width, int height);
+
+/// Parses "ex,ey,ez,gx,gy,gz,ux,uy,uz" (as given to --camera). Throws Error when malformed.
+CameraSpec parse_camera_spec(const std::string& text);
+
+}  // namespace toonray

@@ -1,0 +1,396 @@
+#include "toonray/scene/obj_loader.h"
+
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <fmt/format.h>
+#include <string>
+#include <unordered_map>
+
+#include "toonray/io/file.h"
+
+namespace toonray {
+namespace {
+
+/// Splits text into logical lines: strips CR and comments' nothing (callers see '#'), joins
+/// lines ending in a backslash, and counts physical lines for messages.
+class LineReader {
+public:
+    explicit LineReader(std::string_view text) : text_(text) {
+        if (text_.size() >= 3 && std::memcmp(text_.data(), "\xEF\xBB\xBF", 3) == 0)
+            text_.remove_prefix(3);
+    }
+
+    /// Next logical line, or false at the end. `line_number` is the physical line it starts on.
+    bool next(std::string_view& line, std::size_t& line_number) {
+        if (pos_ >= text_.size()) return false;
+        line_number = ++physical_;
+        std::string_view piece = take_physical();
+        if (!ends_with_backslash(piece)) {
+            line = piece;
+            return true;
+        }
+        joined_.assign(piece.data(), piece.size() - 1);
+        while (pos_ < text_.size()) {
+            ++physical_;
+            piece = take_physical();
+            joined_.push_back(' ');
+            if (ends_with_backslash(piece)) {
+                joined_.append(piece.data(), piece.size() - 1);
+            } else {
+                joined_.append(piece.data(), piece.size());
+                break;
+            }
+        }
+        line = joined_;
+        return true;
+    }
+
+private:
+    static bool ends_with_backslash(std::string_view s) { return !s.empty() && s.back() == '\\'; }
+
+    std::string_view take_physical() {
+        const char* begin = text_.data() + pos_;
+        const void* nl = std::memchr(begin, '\n', text_.size() - pos_);
+        std::size_t len = nl ? static_cast<std::size_t>(static_cast<const char*>(nl) - begin)
+                             : text_.size() - pos_;
+        pos_ += len + (nl ? 1 : 0);
+        if (len > 0 && begin[len - 1] == '\r') --len;
+        return {begin, len};
+    }
+
+    std::string_view text_;
+    std::size_t pos_ = 0;
+    std::size_t physical_ = 0;
+    std::string joined_;
+};
+
+inline bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v'; }
+
+/// Cursor over one line's whitespace-separated tokens.
+struct Tokens {
+    const char* p;
+    const char* end;
+
+    explicit Tokens(std::string_view line) : p(line.data()), end(line.data() + line.size()) {}
+    void skip_space() {
+        while (p < end && is_space(*p)) ++p;
+    }
+    bool at_end() {
+        skip_space();
+        return p >= end || *p == '#';
+    }
+    std::string_view next() {
+        skip_space();
+        const char* begin = p;
+        while (p < end && !is_space(*p)) ++p;
+        return {begin, static_cast<std::size_t>(p - begin)};
+    }
+    /// The rest of the line, trimmed, with a trailing comment removed.
+    std::string_view rest() {
+        skip_space();
+        const char* e = end;
+        for (const char* q = p; q < end; ++q)
+            if (*q == '#') {
+                e = q;
+                break;
+            }
+        while (e > p && is_space(e[-1])) --e;
+        return {p, static_cast<std::size_t>(e - p)};
+    }
+};
+
+class Parser {
+public:
+    Parser(std::string_view file, std::size_t line) : file_(file), line_(line) {}
+
+    [[noreturn]] void fail(std::string_view message) const { throw_at(file_, line_, message); }
+
+    float number(Tokens& t, std::string_view what) const {
+        std::string_view tok = t.next();
+        if (tok.empty()) fail(fmt::format("missing number in '{}' statement", what));
+        const char* b = tok.data();
+        const char* e = b + tok.size();
+        if (*b == '+') ++b;
+        float v;
+        auto [ptr, ec] = std::from_chars(b, e, v);
+        if (ec == std::errc::result_out_of_range)
+            fail(fmt::format("number '{}' out of range in '{}' statement", tok, what));
+        if (ec != std::errc() || ptr != e)
+            fail(fmt::format("malformed number '{}' in '{}' statement", tok, what));
+        if (!std::isfinite(v))
+            fail(fmt::format("non-finite number '{}' in '{}' statement", tok, what));
+        return v;
+    }
+
+    Vec3f vec3(Tokens& t, std::string_view what) const {
+        Vec3f v;
+        v.x = number(t, what);
+        v.y = number(t, what);
+        v.z = number(t, what);
+        return v;
+    }
+
+private:
+    std::string_view file_;
+    std::size_t line_;
+};
+
+/// Resolves a 1-based or negative (relative) OBJ index against `count` defined so far.
+/// Returns false for 0 or out-of-range indices.
+inline bool resolve_index(long long idx, std::size_t count, std::uint32_t& out) {
+    if (idx > 0) {
+        if (static_cast<unsigned long long>(idx) > count) return false;
+        out = static_cast<std::uint32_t>(idx - 1);
+        return true;
+    }
+    if (idx < 0) {
+        if (static_cast<unsigned long long>(-idx) > count) return false;
+        out = static_cast<std::uint32_t>(static_cast<long long>(count) + idx);
+        return true;
+    }
+    return false;
+}
+
+struct Corner {
+    std::uint32_t v, t, n;
+};
+
+std::uint32_t intern(std::unordered_map<std::string, std::uint32_t>& ids,
+                     std::vector<std::string>& names, std::string_view name) {
+    auto [it, inserted] = ids.try_emplace(std::string(name), static_cast<std::uint32_t>(names.size()));
+    if (inserted) names.emplace_back(name);
+    return it->second;
+}
+
+void load_mtl_file(const std::filesystem::path& path, std::vector<Material>& materials,
+                   Warnings& warnings, std::string_view obj_file, std::size_t obj_line) {
+    std::string text;
+    try {
+        text = read_file(path);
+    } catch (const Error& e) {
+        warnings.push_back(located(obj_file, obj_line,
+                                   fmt::format("cannot read material library '{}' ({}); faces "
+                                               "using its materials get the default material",
+                                               path.string(), e.what())));
+        return;
+    }
+    parse_mtl(text, path, materials, warnings);
+}
+
+}  // namespace
+
+void parse_mtl(std::string_view text, const std::filesystem::path& path,
+               std::vector<Material>& materials, Warnings& /*warnings*/) {
+    const std::string file = path.string();
+    LineReader reader(text);
+    std::string_view line;
+    std::size_t line_number = 0;
+    Material* current = nullptr;
+    std::unordered_map<std::string, std::size_t> index;
+    for (std::size_t i = 0; i < materials.size(); ++i) index[materials[i].name] = i;
+
+    while (reader.next(line, line_number)) {
+        Tokens t(line);
+        if (t.at_end()) continue;
+        std::string_view kw = t.next();
+        Parser parse(file, line_number);
+        if (kw == "newmtl") {
+            std::string_view name = t.rest();
+            if (name.empty()) parse.fail("'newmtl' needs a material name");
+            std::string key(name);
+            auto it = index.find(key);
+            if (it != index.end()) {
+                materials[it->second] = Material{key};
+                current = &materials[it->second];
+            } else {
+                index.emplace(key, materials.size());
+                materials.push_back(Material{key});
+                current = &materials.back();
+            }
+            continue;
+        }
+        if (kw != "Kd" && kw != "Ka" && kw != "Ks" && kw != "Ns" && kw != "d" && kw != "Tr" &&
+            kw != "illum" && kw != "map_Kd")
+            continue;  // unknown statements are ignored by design
+        if (!current) parse.fail(fmt::format("'{}' before any 'newmtl'", kw));
+        if (kw == "Kd" || kw == "Ka" || kw == "Ks") {
+            Tokens probe = t;
+            std::string_view first = probe.next();
+            if (first == "spectral" || first == "xyz") continue;  // not supported; keep default
+            Vec3f c;
+            c.x = parse.number(t, kw);
+            // "Kd r" alone means r = g = b (MTL specification).
+            if (t.at_end()) {
+                c.y = c.z = c.x;
+            } else {
+                c.y = parse.number(t, kw);
+                c.z = parse.number(t, kw);
+            }
+            (kw == "Kd" ? current->kd : kw == "Ka" ? current->ka : current->ks) = c;
+        } else if (kw == "Ns") {
+            current->ns = parse.number(t, kw);
+        } else if (kw == "d") {
+            Tokens probe = t;
+            if (probe.next() == "-halo") t.next();
+            current->d = parse.number(t, kw);
+        } else if (kw == "Tr") {
+            current->d = 1.0f - parse.number(t, kw);
+        } else if (kw == "illum") {
+            current->illum = static_cast<int>(parse.number(t, kw));
+        } else if (kw == "map_Kd") {
+            // Options (-s 1 1 1, -clamp on, ...) come first; the file name is the last token.
+            std::string_view rest = t.rest();
+            std::size_t cut = rest.find_last_of(" \t");
+            std::string_view name = cut == std::string_view::npos ? rest : rest.substr(cut + 1);
+            if (name.empty()) parse.fail("'map_Kd' needs a file name");
+            current->map_kd = (path.parent_path() / std::string(name)).string();
+        }
+    }
+}
+
+void parse_obj(std::string_view text, const std::filesystem::path& path, Scene& scene,
+               Warnings& warnings, const ObjOptions& options) {
+    scene.clear();
+    const std::string file = path.string();
+    LineReader reader(text);
+    std::string_view line;
+    std::size_t line_number = 0;
+
+    std::unordered_map<std::string, std::uint32_t> object_ids{{"(default)", 0}};
+    std::unordered_map<std::string, std::uint32_t> warned_materials, warned_statements;
+    std::uint32_t material = 0, object = 0;
+    std::vector<Corner> corners;
+    corners.reserve(16);
+
+    while (reader.next(line, line_number)) {
+        Tokens t(line);
+        if (t.at_end()) continue;
+        std::string_view kw = t.next();
+        Parser parse(file, line_number);
+
+        if (kw == "v") {
+            scene.positions.push_back(parse.vec3(t, kw));
+            // Optional w (or vertex colour) values are accepted and ignored, but must be numbers.
+            while (!t.at_end()) parse.number(t, kw);
+        } else if (kw == "f") {
+            corners.clear();
+            while (!t.at_end()) {
+                std::string_view tok = t.next();
+                const char* p = tok.data();
+                const char* e = p + tok.size();
+                long long idx[3] = {0, 0, 0};
+                bool present[3] = {false, false, false};
+                for (int slot = 0; slot < 3; ++slot) {
+                    if (p < e && *p != '/') {
+                        auto [ptr, ec] = std::from_chars(p, e, idx[slot]);
+                        if (ec != std::errc() || (ptr != e && *ptr != '/'))
+                            parse.fail(fmt::format("malformed face corner '{}'", tok));
+                        present[slot] = true;
+                        p = ptr;
+                    }
+                    if (p < e) {
+                        if (*p != '/' || slot == 2)
+                            parse.fail(fmt::format("malformed face corner '{}'", tok));
+                        ++p;
+                    }
+                }
+                if (!present[0]) parse.fail(fmt::format("face corner '{}' has no vertex index", tok));
+                Corner c{0, kNoIndex, kNoIndex};
+                if (!resolve_index(idx[0], scene.positions.size(), c.v))
+                    parse.fail(idx[0] == 0 ? fmt::format("face vertex index 0 in '{}' (OBJ indices start at 1)", tok)
+                                           : fmt::format("face vertex index {} out of range ({} vertices defined so far)",
+                                                         idx[0], scene.positions.size()));
+                if (present[1] && !resolve_index(idx[1], scene.texcoords.size(), c.t))
+                    parse.fail(fmt::format("face texture index {} out of range ({} defined so far)",
+                                           idx[1], scene.texcoords.size()));
+                if (present[2] && !resolve_index(idx[2], scene.normals.size(), c.n))
+                    parse.fail(fmt::format("face normal index {} out of range ({} defined so far)",
+                                           idx[2], scene.normals.size()));
+                corners.push_back(c);
+            }
+            if (corners.size() < 3)
+                parse.fail(fmt::format("face needs at least 3 corners, has {}", corners.size()));
+            for (std::size_t i = 1; i + 1 < corners.size(); ++i) {
+                const Corner& a = corners[0];
+                const Corner& b = corners[i];
+                const Corner& c = corners[i + 1];
+                scene.add_triangle({a.v, b.v, c.v}, material, object, {a.n, b.n, c.n}, {a.t, b.t, c.t});
+            }
+        } else if (kw == "vn") {
+            scene.normals.push_back(parse.vec3(t, kw));
+        } else if (kw == "vt") {
+            Vec2f uv;
+            uv.x = parse.number(t, kw);
+            if (!t.at_end()) uv.y = parse.number(t, kw);
+            if (!t.at_end()) parse.number(t, kw);
+            scene.texcoords.push_back(uv);
+        } else if (kw == "usemtl") {
+            std::string_view name = t.rest();
+            material = 0;
+            for (std::size_t i = 1; i < scene.materials.size(); ++i)
+                if (scene.materials[i].name == name) material = static_cast<std::uint32_t>(i);
+            if (material == 0 && !name.empty() &&
+                warned_materials.emplace(std::string(name), 0).second)
+                warnings.push_back(located(file, line_number,
+                                           fmt::format("unknown material '{}'; using the default material", name)));
+        } else if (kw == "o" || kw == "g") {
+            std::string_view name = t.rest();
+            object = name.empty() ? 0 : intern(object_ids, scene.objects, name);
+        } else if (kw == "mtllib") {
+            if (!options.load_materials) continue;
+            while (!t.at_end()) {
+                std::string_view name = t.next();
+                load_mtl_file(path.parent_path() / std::string(name), scene.materials, warnings,
+                              file, line_number);
+            }
+        } else if (kw == "c") {
+            long long idx[3];
+            for (long long& i : idx) {
+                std::string_view tok = t.next();
+                auto [ptr, ec] = std::from_chars(tok.data(), tok.data() + tok.size(), i);
+                if (tok.empty() || ec != std::errc() || ptr != tok.data() + tok.size())
+                    parse.fail("camera statement needs three indices: c eye gaze up");
+            }
+            if (!t.at_end()) parse.fail("camera statement has more than three indices: c eye gaze up");
+            std::uint32_t eye, gaze, up;
+            if (!resolve_index(idx[0], scene.positions.size(), eye))
+                parse.fail(fmt::format("camera eye index {} out of range ({} vertices defined so far)",
+                                       idx[0], scene.positions.size()));
+            if (!resolve_index(idx[1], scene.positions.size(), gaze))
+                parse.fail(fmt::format("camera gaze index {} out of range ({} vertices defined so far)",
+                                       idx[1], scene.positions.size()));
+            if (!resolve_index(idx[2], scene.normals.size(), up))
+                parse.fail(fmt::format("camera up index {} out of range ({} normals defined so far)",
+                                       idx[2], scene.normals.size()));
+            CameraSpec cam{scene.positions[eye], scene.positions[gaze], scene.normals[up]};
+            if (cam.eye == cam.gaze) parse.fail("invalid camera: eye and gaze point are the same point");
+            if (!(length(cross(cam.gaze - cam.eye, cam.up)) > 0))
+                parse.fail("invalid camera: up vector is zero or parallel to the view direction");
+            scene.camera = cam;
+        } else if (kw == "s" || kw == "l" || kw == "p" || kw == "vp" || kw == "cstype" ||
+                   kw == "deg" || kw == "curv" || kw == "curv2" || kw == "surf" || kw == "parm" ||
+                   kw == "end" || kw == "mg" || kw == "lod" || kw == "usemap" || kw == "maplib" ||
+                   kw == "shadow_obj" || kw == "trace_obj" || kw == "bevel" || kw == "c_interp" ||
+                   kw == "d_interp" || kw == "ctech" || kw == "stech" || kw == "trim" ||
+                   kw == "hole" || kw == "scrv" || kw == "sp" || kw == "con" || kw == "bmat" ||
+                   kw == "step") {
+            // Accepted: smoothing groups are implied by vn; lines, points and free-form
+            // geometry are not rendered.
+        } else {
+            if (kw.find('\0') != std::string_view::npos)
+                parse.fail("binary data (NUL byte): not an OBJ text file");
+            if (warned_statements.emplace(std::string(kw), 0).second)
+                warnings.push_back(located(file, line_number,
+                                           fmt::format("unknown statement '{}' ignored", kw)));
+        }
+    }
+}
+
+void load_obj(const std::filesystem::path& path, Scene& scene, Warnings& warnings,
+              const ObjOptions& options) {
+    std::string text = read_file(path);
+    parse_obj(text, path, scene, warnings, options);
+}
+
+}  // namespace toonray

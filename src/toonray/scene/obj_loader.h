@@ -1,0 +1,40 @@
+#pragma once
+/// Wavefront OBJ and MTL reading, written for speed (one pass, no per-line allocation).
+///
+/// Reads: v (optional w or colour values ignored), vt, vn, f with 3 or more corners in all four
+/// index forms (v, v/vt, v//vn, v/vt/vn), negative (relative) indices, o, g, usemtl, mtllib
+/// (several files, paths relative to the OBJ), s (accepted, ignored: normals come from vn),
+/// comments, `\` line continuations, CRLF line endings, a UTF-8 byte-order mark, and the
+/// camera block statement `c eye gaze up`. Polygons are triangulated as a fan from their first
+/// corner, which is exact for convex polygons. Faces index only vertices defined before them.
+/// An object is the run of faces after an `o` or `g` statement, named by it.
+
+#include <cstddef>
+#include <filesystem>
+#include <string_view>
+#include <vector>
+
+#include "toonray/core/error.h"
+#include "toonray/scene/scene.h"
+
+namespace toonray {
+
+struct ObjOptions {
+    bool load_materials = true;  ///< follow mtllib statements
+};
+
+/// Loads an OBJ file and the MTL files it names. Clears `scene` first but keeps its
+/// allocations, so a batch of frames reuses memory. Throws Error("file:line: reason") on
+/// malformed input; a missing MTL file or unknown material is a warning.
+void load_obj(const std::filesystem::path& path, Scene& scene, Warnings& warnings,
+              const ObjOptions& options = {});
+
+/// Parses OBJ text already in memory; `path` names it in messages and anchors mtllib paths.
+void parse_obj(std::string_view text, const std::filesystem::path& path, Scene& scene,
+               Warnings& warnings, const ObjOptions& options = {});
+
+/// Parses MTL text, appending its materials (a name defined again replaces the earlier one).
+void parse_mtl(std::string_view text, const std::filesystem::path& path,
+               std::vector<Material>& materials, Warnings& warnings);
+
+}  // namespace toonray

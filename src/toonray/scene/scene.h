@@ -1,0 +1,67 @@
+#pragma once
+/// A triangle scene as loaded from OBJ/MTL or built in code.
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "toonray/core/bbox.h"
+#include "toonray/core/math.h"
+#include "toonray/scene/camera.h"
+
+namespace toonray {
+
+struct Material {
+    explicit Material(std::string name_ = {}) : name(std::move(name_)) {}
+
+    std::string name;
+    Vec3f kd{0.8f};  ///< diffuse colour; 0.8 grey for faces without a material
+    Vec3f ka{0.0f};
+    Vec3f ks{0.0f};
+    float ns = 0.0f;
+    float d = 1.0f;
+    int illum = 2;
+    std::string map_kd;  ///< texture path as written in the MTL, resolved relative to it
+};
+
+inline constexpr std::uint32_t kNoIndex = 0xffffffffu;
+
+/// Triangles with per-corner indices into shared attribute arrays. Material 0 is always the
+/// default material and object 0 the default object, so every triangle has both.
+struct Scene {
+    std::vector<Vec3f> positions;
+    std::vector<Vec3f> normals;
+    std::vector<Vec2f> texcoords;
+
+    std::vector<std::array<std::uint32_t, 3>> tri_positions;
+    std::vector<std::array<std::uint32_t, 3>> tri_normals;    ///< kNoIndex where a corner has none
+    std::vector<std::array<std::uint32_t, 3>> tri_texcoords;  ///< kNoIndex where a corner has none
+    std::vector<std::uint32_t> tri_material;
+    std::vector<std::uint32_t> tri_object;
+
+    std::vector<Material> materials{Material{"(default)"}};
+    std::vector<std::string> objects{"(default)"};
+
+    std::optional<CameraSpec> camera;  ///< from the OBJ camera block, if any
+
+    [[nodiscard]] std::size_t triangle_count() const { return tri_positions.size(); }
+    /// Bounds of the vertices that triangles use (camera vertices do not count).
+    [[nodiscard]] BBox bounds() const;
+
+    /// Appends a triangle; normals/texcoords default to none.
+    void add_triangle(std::array<std::uint32_t, 3> v, std::uint32_t material, std::uint32_t object,
+                      std::array<std::uint32_t, 3> n = {kNoIndex, kNoIndex, kNoIndex},
+                      std::array<std::uint32_t, 3> t = {kNoIndex, kNoIndex, kNoIndex}) {
+        tri_positions.push_back(v);
+        tri_normals.push_back(n);
+        tri_texcoords.push_back(t);
+        tri_material.push_back(material);
+        tri_object.push_back(object);
+    }
+    void clear();
+};
+
+}  // namespace toonray
