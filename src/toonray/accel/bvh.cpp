@@ -141,11 +141,11 @@ struct Builder {
 Bvh Bvh::build(std::span<const BBox> boxes, std::span<const Vec3f> centers, const Config& config) {
     Bvh bvh;
     const auto n = static_cast<std::uint32_t>(boxes.size());
+    if (n == 0) return bvh;  // no nodes at all: a zero-count node would read as an inner node
     bvh.prim_indices.resize(n);
     std::iota(bvh.prim_indices.begin(), bvh.prim_indices.end(), 0u);
-    bvh.nodes.reserve(n > 0 ? 2 * n : 1);
+    bvh.nodes.reserve(2 * n);
     bvh.nodes.push_back(BvhNode{BBox{}, 0, n});
-    if (n == 0) return bvh;  // an empty root leaf: traversal finds nothing
     Builder builder{boxes, centers, config, bvh};
     builder.build(0);
     bvh.nodes.shrink_to_fit();

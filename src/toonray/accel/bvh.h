@@ -29,7 +29,7 @@ struct Bvh {
         float intersection_cost = 1.0f;  ///< ...testing one primitive
     };
 
-    std::vector<BvhNode> nodes;             ///< nodes[0] is the root; children follow parents
+    std::vector<BvhNode> nodes;  ///< nodes[0] is the root; children follow parents; empty if no primitives
     std::vector<std::uint32_t> prim_indices;  ///< primitive ids in leaf order
 
     /// Builds with binned SAH. Deterministic: the same input gives the same tree.

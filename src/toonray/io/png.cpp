@@ -96,6 +96,11 @@ void write_png(const std::filesystem::path& path, const ImageGray8& image, const
 
 DecodedPng read_png(const std::filesystem::path& path) {
     std::string data = read_file(path);
+    // libpng's reader stops after the image data, so a file cut just before its IEND chunk
+    // would still decode: require the complete trailer.
+    static const char iend[12] = {0, 0, 0, 0, 'I', 'E', 'N', 'D', '\xAE', '\x42', '\x60', '\x82'};
+    if (data.size() < 12 || std::memcmp(data.data() + data.size() - 12, iend, 12) != 0)
+        throw Error(fmt::format("{}: truncated PNG (no IEND chunk at the end)", path.string()));
     png_image img;
     std::memset(&img, 0, sizeof img);
     img.version = PNG_IMAGE_VERSION;

@@ -14,7 +14,12 @@ AovPaths aov_paths(const std::filesystem::path& dir, const std::filesystem::path
 CameraSpec choose_camera(const Scene& scene, const FileRenderOptions& options) {
     if (options.camera) return *options.camera;
     if (scene.camera) return *scene.camera;
-    return auto_camera(scene.bounds(), options.settings.width, options.settings.height);
+    // Frame the vertices that triangles use.
+    std::vector<Vec3f> used;
+    used.reserve(scene.triangle_count() * 3);
+    for (const auto& tri : scene.tri_positions)
+        for (std::uint32_t v : tri) used.push_back(scene.positions[v]);
+    return auto_camera(used, options.settings.width, options.settings.height);
 }
 
 void FileRenderer::render(const std::filesystem::path& input, const std::filesystem::path& output,

@@ -40,24 +40,42 @@ ViewPlane make_view_plane(const CameraSpec& camera, int width, int height) {
     return plane;
 }
 
-CameraSpec auto_camera(const BBox& bounds, int width, int height) {
-    Vec3f center = bounds.empty() ? Vec3f(0.0f) : bounds.center();
-    float radius = bounds.empty() ? 1.0f : 0.5f * length(bounds.extent());
-    if (!(radius > 0)) radius = 1.0f;
-    // 60 degrees horizontal: |viewDir| = 1 / tan(30 deg). The narrower half-angle must hold the
-    // bounding sphere.
+CameraSpec auto_camera(std::span<const Vec3f> points, int width, int height) {
+    BBox box;
+    for (const Vec3f& p : points) box.extend(p);
+    const Vec3f unit_cube[2] = {Vec3f(-1.0f), Vec3f(1.0f)};
+    if (box.empty()) {
+        box = BBox{unit_cube[0], unit_cube[1]};
+        points = unit_cube;
+    }
+    Vec3f center = box.center();
+    // Look at the centre from the front-right, slightly above, 60 degrees horizontal field of
+    // view (|viewDir| = 1 / tan(30 deg)).
     const float view_len = 1.0f / std::tan(30.0f * 3.14159265f / 180.0f);
-    const float aspect = static_cast<float>(height) / static_cast<float>(width);
-    float half_fov = std::atan(std::min(1.0f, aspect) / view_len);
-    float distance = radius / std::sin(half_fov) * 1.05f;
+    const float tan_x = 1.0f / view_len;
+    const float tan_y = tan_x * static_cast<float>(height) / static_cast<float>(width);
     Vec3f dir = normalize(Vec3f(0.55f, 0.45f, 1.0f));  // from the centre towards the eye
+    Vec3f forward = -dir;
+    Vec3f right = normalize(cross(forward, Vec3f(0.0f, 1.0f, 0.0f)));
+    Vec3f up = cross(right, forward);
+    // Nearest distance at which every point projects inside the image, with a 5% margin on
+    // each side: a point at offset o needs depth >= |o.right| / tan_x (and likewise
+    // vertically), and its depth is distance - o.dir.
+    float distance = 0.0f;
+    const float margin = 0.9f;
+    for (const Vec3f& p : points) {
+        Vec3f o = p - center;
+        float need = std::max(std::abs(dot(o, right)) / (tan_x * margin),
+                              std::abs(dot(o, up)) / (tan_y * margin)) + dot(o, dir);
+        distance = std::max(distance, need);
+    }
+    float radius = 0.5f * length(box.extent());
+    distance = std::max(distance, radius * 1.01f);  // keep the eye outside the box
+    if (!(distance > 0.0f)) distance = 1.0f;
     CameraSpec cam;
     cam.eye = center + dir * distance;
-    Vec3f forward = -dir;
     cam.gaze = cam.eye + forward * view_len;
-    Vec3f world_up(0.0f, 1.0f, 0.0f);
-    Vec3f right = normalize(cross(forward, world_up));
-    cam.up = normalize(cross(right, forward));
+    cam.up = up;
     return cam;
 }
 

@@ -1,6 +1,7 @@
 #pragma once
 /// The seed's camera: an eye, a gaze point and an up vector, and the view plane built from them.
 
+#include <span>
 #include <string>
 
 #include "toonray/core/bbox.h"
@@ -39,9 +40,10 @@ struct ViewPlane {
 /// Throws Error when eye == gaze, up is zero or parallel to the view direction, or a value is not finite.
 ViewPlane make_view_plane(const CameraSpec& camera, int width, int height);
 
-/// A camera that frames the whole box: looks at its centre from above and to the front-right,
-/// 60 degrees of horizontal field of view, the bounding sphere fitting the image.
-CameraSpec auto_camera(const BBox& bounds, int width, int height);
+/// A camera that frames the points: looks at the centre of their bounds from the front-right
+/// and a little above, with 60 degrees of horizontal field of view, as close as it can while
+/// every point stays inside the image with a 5% margin. No points: frames the unit cube.
+CameraSpec auto_camera(std::span<const Vec3f> points, int width, int height);
 
 /// Parses "ex,ey,ez,gx,gy,gz,ux,uy,uz" (as given to --camera). Throws Error when malformed.
 CameraSpec parse_camera_spec(const std::string& text);

@@ -1,0 +1,29 @@
+#!/usr/bin/env bash
+# Installs the Debian packages toonray needs to build, test and run its demo.
+set -euo pipefail
+
+packages=(
+  # build
+  build-essential cmake ninja-build pkg-config
+  # libraries
+  libcli11-dev libfmt-dev libtbb-dev libdeflate-dev libpng-dev libfluidsynth-dev
+  # tests and benchmarks
+  libgtest-dev libgmock-dev libbenchmark-dev libtinyobjloader-dev libembree-dev
+  # media: video encoding and the piano sound
+  ffmpeg fluid-soundfont-gm
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install-deps: all ${#packages[@]} packages present"
+  exit 0
+fi
+
+sudo=""
+[ "$(id -u)" -eq 0 ] || sudo="sudo"
+echo "install-deps: installing ${missing[*]}"
+$sudo apt-get update -qq
+DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"

@@ -1,0 +1,205 @@
+#include "toonray/accel/bvh.h"
+
+#include <gtest/gtest.h>
+
+#include <random>
+#include <vector>
+
+#include "toonray/accel/triangle_accel.h"
+#include "toonray/scene/obj_loader.h"
+
+using namespace toonray;
+
+namespace {
+
+struct Soup {
+    std::vector<Vec3f> positions;
+    std::vector<std::array<std::uint32_t, 3>> tris;
+};
+
+Soup random_soup(int count, unsigned seed, float size = 0.2f) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> pos(-1.0f, 1.0f), off(-size, size);
+    Soup s;
+    for (int i = 0; i < count; ++i) {
+        Vec3f c(pos(rng), pos(rng), pos(rng));
+        auto base = static_cast<std::uint32_t>(s.positions.size());
+        for (int k = 0; k < 3; ++k) s.positions.push_back(c + Vec3f(off(rng), off(rng), off(rng)));
+        s.tris.push_back({base, base + 1, base + 2});
+    }
+    return s;
+}
+
+Soup from_obj(const std::string& name) {
+    Scene scene;
+    Warnings w;
+    load_obj(std::string(TOONRAY_TEST_DATA_DIR) + "/" + name, scene, w);
+    return {scene.positions, scene.tri_positions};
+}
+
+Hit brute_force(const Soup& s, const Ray& ray) {
+    Hit best;
+    for (std::uint32_t i = 0; i < s.tris.size(); ++i) {
+        float t, u, v;
+        Ray r = ray;
+        r.tmax = best.t;
+        if (intersect_triangle(r, s.positions[s.tris[i][0]], s.positions[s.tris[i][1]],
+                               s.positions[s.tris[i][2]], t, u, v)) {
+            best.t = t;
+            best.prim = i;
+        }
+    }
+    return best;
+}
+
+// Rays from random points on a sphere around the mesh towards random points inside it.
+void expect_matches_brute_force(const Soup& s, const TriangleAccel& accel, int rays, unsigned seed) {
+    BBox box;
+    for (const Vec3f& p : s.positions) box.extend(p);
+    float radius = length(box.extent());
+    std::mt19937 rng(seed);
+    std::normal_distribution<float> n(0.0f, 1.0f);
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    int hits = 0;
+    for (int i = 0; i < rays; ++i) {
+        Vec3f from = box.center() + normalize(Vec3f(n(rng), n(rng), n(rng))) * radius * 1.5f;
+        Vec3f to(box.lo.x + u(rng) * box.extent().x, box.lo.y + u(rng) * box.extent().y,
+                 box.lo.z + u(rng) * box.extent().z);
+        Ray ray{from, normalize(to - from)};
+        Hit expected = brute_force(s, ray);
+        Hit got;
+        bool found = accel.intersect(ray, got);
+        ASSERT_EQ(found, expected.valid()) << "ray " << i;
+        if (!found) continue;
+        ++hits;
+        // Ties (a ray through a shared edge) may pick either triangle; the distance must agree.
+        ASSERT_NEAR(got.t, expected.t, 1e-6f * expected.t) << "ray " << i;
+        if (got.prim != expected.prim) {
+            float t, uu, vv;
+            ASSERT_TRUE(intersect_triangle(ray, s.positions[s.tris[got.prim][0]],
+                                           s.positions[s.tris[got.prim][1]],
+                                           s.positions[s.tris[got.prim][2]], t, uu, vv));
+            ASSERT_EQ(t, got.t);
+        }
+    }
+    EXPECT_GT(hits, rays / 10);  // the test must actually exercise hits
+}
+
+void expect_valid_tree(const Bvh& bvh, std::size_t prims, int max_leaf) {
+    std::vector<int> seen(prims, 0);
+    for (std::uint32_t p : bvh.prim_indices) seen[p]++;
+    for (std::size_t i = 0; i < prims; ++i) ASSERT_EQ(seen[i], 1) << "primitive " << i;
+    for (std::size_t i = 0; i < bvh.nodes.size(); ++i) {
+        const BvhNode& node = bvh.nodes[i];
+        if (node.is_leaf()) {
+            ASSERT_LE(node.count, static_cast<std::uint32_t>(max_leaf));
+        } else {
+            ASSERT_GT(node.first, i);  // children after parents
+            for (int c = 0; c < 2; ++c) {
+                const BBox& child = bvh.nodes[node.first + c].bounds;
+                ASSERT_LE(node.bounds.lo.x, child.lo.x);
+                ASSERT_LE(node.bounds.lo.y, child.lo.y);
+                ASSERT_LE(node.bounds.lo.z, child.lo.z);
+                ASSERT_GE(node.bounds.hi.x, child.hi.x);
+                ASSERT_GE(node.bounds.hi.y, child.hi.y);
+                ASSERT_GE(node.bounds.hi.z, child.hi.z);
+            }
+        }
+    }
+}
+
+}  // namespace
+
+TEST(Bvh, RandomSoupMatchesBruteForce) {
+    for (unsigned seed : {1u, 2u, 3u}) {
+        Soup s = random_soup(2000, seed);
+        TriangleAccel accel;
+        accel.build(s.positions, s.tris);
+        expect_valid_tree(accel.bvh(), s.tris.size(), Bvh::Config{}.max_leaf_size);
+        expect_matches_brute_force(s, accel, 2000, seed + 10);
+    }
+}
+
+TEST(Bvh, RealMeshesMatchBruteForce) {
+    for (const char* name : {"teapot.obj", "spot.obj"}) {
+        Soup s = from_obj(name);
+        TriangleAccel accel;
+        accel.build(s.positions, s.tris);
+        expect_valid_tree(accel.bvh(), s.tris.size(), Bvh::Config{}.max_leaf_size);
+        expect_matches_brute_force(s, accel, 1500, 42);
+    }
+}
+
+TEST(Bvh, LeafSizeIsAConfigValue) {
+    Soup s = random_soup(3000, 9);
+    for (int leaf : {1, 4, 10}) {
+        Bvh::Config config;
+        config.max_leaf_size = leaf;
+        TriangleAccel accel;
+        accel.build(s.positions, s.tris, config);
+        expect_valid_tree(accel.bvh(), s.tris.size(), leaf);
+        expect_matches_brute_force(s, accel, 300, 5);
+    }
+}
+
+TEST(Bvh, IdenticalCentroidsStillSplitToLeafSize) {
+    // 100 copies of the same triangle: no SAH split exists, the list is cut instead.
+    Soup s;
+    s.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+    for (int i = 0; i < 100; ++i) s.tris.push_back({0, 1, 2});
+    TriangleAccel accel;
+    accel.build(s.positions, s.tris);
+    expect_valid_tree(accel.bvh(), 100, Bvh::Config{}.max_leaf_size);
+    Hit hit;
+    EXPECT_TRUE(accel.intersect({{0.2f, 0.2f, 1.0f}, {0, 0, -1}}, hit));
+    EXPECT_FLOAT_EQ(hit.t, 1.0f);
+}
+
+TEST(Bvh, EmptyAndSingle) {
+    TriangleAccel empty;
+    empty.build({}, {});
+    Hit hit;
+    EXPECT_FALSE(empty.intersect({{0, 0, 0}, {0, 0, 1}}, hit));
+    Soup one;
+    one.positions = {{-1, -1, 5}, {1, -1, 5}, {0, 1, 5}};
+    one.tris = {{0, 1, 2}};
+    TriangleAccel accel;
+    accel.build(one.positions, one.tris);
+    ASSERT_TRUE(accel.intersect({{0, 0, 0}, {0, 0, 1}}, hit));
+    EXPECT_FLOAT_EQ(hit.t, 5.0f);
+    EXPECT_EQ(hit.prim, 0u);
+    EXPECT_FALSE(accel.intersect({{0, 0, 0}, {0, 0, -1}}, hit));
+    Ray short_ray{{0, 0, 0}, {0, 0, 1}, 4.0f};
+    EXPECT_FALSE(accel.intersect(short_ray, hit));
+}
+
+TEST(Bvh, DeepDegenerateTreesStillTraverse) {
+    // Triangles at exponentially growing distances make SAH peel one off per level; the
+    // builder must not recurse and traversal must not overflow its stack.
+    Soup s;
+    for (int i = 0; i < 400; ++i) {
+        float x = std::ldexp(1.0f, i / 4) * (1.0f + (i % 4) * 0.1f);
+        auto base = static_cast<std::uint32_t>(s.positions.size());
+        s.positions.push_back({x, 0, 0});
+        s.positions.push_back({x, 1, 0});
+        s.positions.push_back({x, 0, 1});
+        s.tris.push_back({base, base + 1, base + 2});
+    }
+    TriangleAccel accel;
+    accel.build(s.positions, s.tris);
+    expect_valid_tree(accel.bvh(), s.tris.size(), Bvh::Config{}.max_leaf_size);
+    Hit hit;
+    ASSERT_TRUE(accel.intersect({{-1.0f, 0.25f, 0.25f}, {1, 0, 0}}, hit));
+    EXPECT_EQ(hit.prim, 0u);
+}
+
+TEST(Bvh, RefitFollowsMovedVertices) {
+    Soup s = random_soup(1500, 21);
+    TriangleAccel accel;
+    accel.build(s.positions, s.tris);
+    // Move every vertex: a shear and a shift.
+    for (Vec3f& p : s.positions) p = Vec3f(p.x + 0.5f * p.y, p.y * 1.5f, p.z - 0.3f);
+    accel.refit(s.positions, s.tris);
+    expect_valid_tree(accel.bvh(), s.tris.size(), Bvh::Config{}.max_leaf_size);
+    expect_matches_brute_force(s, accel, 1500, 77);
+}

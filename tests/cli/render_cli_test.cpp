@@ -1,0 +1,87 @@
+#include <gtest/gtest.h>
+
+#include "cli/cli_test_util.h"
+#include "toonray/io/png.h"
+
+namespace fs = std::filesystem;
+using toonray::read_png;
+
+namespace {
+const std::string kData = TOONRAY_TEST_DATA_DIR;
+}
+
+TEST(RenderCli, HelpDocumentsEveryOptionAndItsDefault) {
+    CommandResult r = run_toonray("render --help");
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    for (const char* opt : {"--output", "--size", "--light", "--camera", "--background", "--edges",
+                            "--depth-threshold", "--normal-threshold", "--aov", "--threads",
+                            "--bvh-leaf-size", "--png-level"})
+        EXPECT_NE(r.output.find(opt), std::string::npos) << opt;
+    for (const char* def : {"1280x720", "classic", "=8", "=4"})
+        EXPECT_NE(r.output.find(def), std::string::npos) << def << "\n" << r.output;
+}
+
+TEST(RenderCli, RendersTheTeapotAtTheDefaultSize) {
+    TempDir dir("cli_render");
+    CommandResult r = run_toonray("render " + kData + "/teapot.obj -o " + (dir / "t.png").string());
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    auto png = read_png(dir / "t.png");
+    EXPECT_EQ(png.width, 1280);
+    EXPECT_EQ(png.height, 720);
+}
+
+TEST(RenderCli, SizeLightThresholdsAndAovs) {
+    TempDir dir("cli_opts");
+    CommandResult r = run_toonray("render " + kData + "/teapot.obj -o " + (dir / "f.png").string() +
+                                  " --size 320x200 --light 4,6,10 --aov " + (dir / "aov").string() +
+                                  " --depth-threshold 8 --normal-threshold 4 --edges classic --threads 2");
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_EQ(read_png(dir / "f.png").width, 320);
+    for (const char* name : {"depth", "normal", "edges_depth", "edges_normal", "edges", "cel"})
+        EXPECT_TRUE(fs::exists(dir / "aov" / (std::string("f_") + name + ".png"))) << name;
+}
+
+TEST(RenderCli, BadSceneIsAnErrorWithFileAndLineAndNoOutput) {
+    TempDir dir("cli_bad");
+    dir.write("bad.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n");
+    CommandResult r = run_toonray("render " + (dir / "bad.obj").string() + " -o " + (dir / "out.png").string());
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_NE(r.output.find("bad.obj:4: face vertex index 4 out of range"), std::string::npos) << r.output;
+    EXPECT_FALSE(fs::exists(dir / "out.png"));
+}
+
+TEST(RenderCli, BadCameraIsAnErrorAndNoOutput) {
+    TempDir dir("cli_cam");
+    CommandResult r = run_toonray("render " + kData + "/teapot.obj -o " + (dir / "out.png").string() +
+                                  " --camera 0,0,5,0,0,5,0,1,0");
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_NE(r.output.find("eye and gaze point are the same"), std::string::npos) << r.output;
+    EXPECT_FALSE(fs::exists(dir / "out.png"));
+}
+
+TEST(RenderCli, BadOptionValuesAreRejected) {
+    TempDir dir("cli_opt");
+    std::string base = "render " + kData + "/teapot.obj -o " + (dir / "o.png").string();
+    for (const char* bad : {" --size 0x10", " --light 1,2", " --edges fancy", " --threads -1", " --background 2,0,0"}) {
+        CommandResult r = run_toonray(base + bad);
+        EXPECT_NE(r.exit_code, 0) << bad;
+        EXPECT_FALSE(fs::exists(dir / "o.png")) << bad;
+    }
+    EXPECT_NE(run_toonray("render /nonexistent.obj -o x.png").exit_code, 0);
+}
+
+TEST(RenderCli, MissingMaterialLibraryWarnsAndRenders) {
+    TempDir dir("cli_warn");
+    dir.write("s.obj", "mtllib gone.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl red\nf 1 2 3\n");
+    CommandResult r = run_toonray("render " + (dir / "s.obj").string() + " -o " + (dir / "o.png").string() + " --size 64x64");
+    EXPECT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_NE(r.output.find("warning"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("gone.mtl"), std::string::npos) << r.output;
+    EXPECT_TRUE(fs::exists(dir / "o.png"));
+}
+
+TEST(RenderCli, UnwritableOutputIsAnError) {
+    CommandResult r = run_toonray("render " + kData + "/teapot.obj -o /nonexistent-dir/o.png --size 32x32");
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_NE(r.output.find("/nonexistent-dir/o.png"), std::string::npos) << r.output;
+}

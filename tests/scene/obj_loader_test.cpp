@@ -1,0 +1,234 @@
+#include "toonray/scene/obj_loader.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "toonray/core/error.h"
+
+using namespace toonray;
+namespace fs = std::filesystem;
+
+namespace {
+
+Scene parse(std::string_view text, Warnings* warnings_out = nullptr, const fs::path& path = "test.obj") {
+    Scene scene;
+    Warnings warnings;
+    parse_obj(text, path, scene, warnings);
+    if (warnings_out) *warnings_out = warnings;
+    return scene;
+}
+
+std::string error_of(std::string_view text, const fs::path& path = "test.obj") {
+    try {
+        parse(text, nullptr, path);
+    } catch (const Error& e) {
+        return e.what();
+    }
+    return "(no error)";
+}
+
+fs::path temp_dir(const std::string& name) {
+    fs::path dir = fs::temp_directory_path() / ("toonray_obj_" + name + "_" + std::to_string(::getpid()));
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    return dir;
+}
+
+void write(const fs::path& p, std::string_view text) {
+    std::ofstream(p, std::ios::binary) << text;
+}
+
+const char* kQuad = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n";
+
+}  // namespace
+
+TEST(ObjLoader, ReadsAllFourIndexForms) {
+    Scene s = parse(std::string(kQuad) +
+                    "vt 0 0\nvt 1 0\nvt 1 1\nvn 0 0 1\nvn 0 0 -1\n"
+                    "f 1 2 3\nf 1/1 2/2 3/3\nf 1//1 2//1 3//2\nf 1/1/1 2/2/1 3/3/1\n");
+    ASSERT_EQ(s.triangle_count(), 4u);
+    for (std::size_t i = 0; i < 4; ++i) EXPECT_EQ(s.tri_positions[i], (std::array<std::uint32_t, 3>{0, 1, 2}));
+    EXPECT_EQ(s.tri_normals[0][0], kNoIndex);
+    EXPECT_EQ(s.tri_texcoords[1], (std::array<std::uint32_t, 3>{0, 1, 2}));
+    EXPECT_EQ(s.tri_normals[1][2], kNoIndex);
+    EXPECT_EQ(s.tri_normals[2], (std::array<std::uint32_t, 3>{0, 0, 1}));
+    EXPECT_EQ(s.tri_texcoords[2][0], kNoIndex);
+    EXPECT_EQ(s.tri_normals[3], (std::array<std::uint32_t, 3>{0, 0, 0}));
+    EXPECT_EQ(s.tri_texcoords[3], (std::array<std::uint32_t, 3>{0, 1, 2}));
+}
+
+TEST(ObjLoader, NegativeIndicesAreRelativeToVerticesSoFar) {
+    Scene s = parse("v 0 0 0\nv 1 0 0\nv 1 1 0\nf -3 -2 -1\nv 5 5 5\nf -4 -1 -2\n");
+    ASSERT_EQ(s.triangle_count(), 2u);
+    EXPECT_EQ(s.tri_positions[0], (std::array<std::uint32_t, 3>{0, 1, 2}));
+    EXPECT_EQ(s.tri_positions[1], (std::array<std::uint32_t, 3>{0, 3, 2}));
+}
+
+TEST(ObjLoader, PolygonsAreFanTriangulated) {
+    Scene s = parse("v 0 0 0\nv 1 0 0\nv 2 1 0\nv 1 2 0\nv 0 1 0\nf 1 2 3 4 5\n");
+    ASSERT_EQ(s.triangle_count(), 3u);
+    EXPECT_EQ(s.tri_positions[0], (std::array<std::uint32_t, 3>{0, 1, 2}));
+    EXPECT_EQ(s.tri_positions[1], (std::array<std::uint32_t, 3>{0, 2, 3}));
+    EXPECT_EQ(s.tri_positions[2], (std::array<std::uint32_t, 3>{0, 3, 4}));
+}
+
+TEST(ObjLoader, AcceptsWComponentCommentsSmoothingCrlfBomAndContinuations) {
+    Scene s = parse("\xEF\xBB\xBF# comment\r\nv 0 0 0 1\r\nv 1 0 0 1.0 # trailing\r\n"
+                    "v 1 1 \\\r\n 0\r\ns 1\r\ns off\r\nf 1 \\\n 2 3\r\n");
+    ASSERT_EQ(s.positions.size(), 3u);
+    EXPECT_EQ(s.positions[2], Vec3f(1, 1, 0));
+    ASSERT_EQ(s.triangle_count(), 1u);
+}
+
+TEST(ObjLoader, ErrorsNameThePhysicalLineAfterContinuations) {
+    std::string e = error_of("v 0 0 \\\n0\nv 1 0 0\nv 0 1 0\nf 1 2 \\\n 3\nf 1 2 x\n");
+    EXPECT_NE(e.find("test.obj:7:"), std::string::npos) << e;
+}
+
+TEST(ObjLoader, ObjectsAndGroupsGetIds) {
+    Scene s = parse(std::string(kQuad) + "o first\nf 1 2 3\ng second\nf 1 3 4\no first\nf 2 3 4\n");
+    ASSERT_EQ(s.triangle_count(), 3u);
+    EXPECT_EQ(s.objects[s.tri_object[0]], "first");
+    EXPECT_EQ(s.objects[s.tri_object[1]], "second");
+    EXPECT_EQ(s.tri_object[2], s.tri_object[0]);
+}
+
+TEST(ObjLoader, MaterialsFromSeveralLibrariesRelativeToTheObj) {
+    fs::path dir = temp_dir("mtl");
+    fs::create_directories(dir / "sub");
+    write(dir / "sub" / "a.mtl", "newmtl red\nKd 1 0 0\nKa 0.1 0.1 0.1\nKs 0.5 0.5 0.5\nNs 20\nd 0.5\nillum 2\nmap_Kd -s 1 1 1 tex.png\n");
+    write(dir / "b.mtl", "# b\nnewmtl blue\r\nKd 0 0 1\r\nunknown_statement 1 2 3\r\n");
+    write(dir / "scene.obj", std::string("mtllib sub/a.mtl b.mtl\n") + kQuad +
+                                 "f 1 2 3\nusemtl red\nf 1 2 3\nusemtl blue\nf 1 3 4\nusemtl\nf 2 3 4\n");
+    Scene s;
+    Warnings w;
+    load_obj(dir / "scene.obj", s, w);
+    EXPECT_TRUE(w.empty()) << w.front();
+    ASSERT_EQ(s.triangle_count(), 4u);
+    EXPECT_EQ(s.tri_material[0], 0u);
+    EXPECT_EQ(s.materials[0].kd, Vec3f(0.8f));
+    const Material& red = s.materials[s.tri_material[1]];
+    EXPECT_EQ(red.name, "red");
+    EXPECT_EQ(red.kd, Vec3f(1, 0, 0));
+    EXPECT_EQ(red.ka, Vec3f(0.1f));
+    EXPECT_EQ(red.ks, Vec3f(0.5f));
+    EXPECT_EQ(red.ns, 20.0f);
+    EXPECT_EQ(red.d, 0.5f);
+    EXPECT_EQ(red.illum, 2);
+    EXPECT_EQ(fs::path(red.map_kd), dir / "sub" / "tex.png");
+    EXPECT_EQ(s.materials[s.tri_material[2]].name, "blue");
+    EXPECT_EQ(s.materials[s.tri_material[2]].kd, Vec3f(0, 0, 1));
+    EXPECT_EQ(s.tri_material[3], 0u);
+    fs::remove_all(dir);
+}
+
+TEST(ObjLoader, MissingLibraryAndUnknownMaterialWarnAndUseTheDefault) {
+    fs::path dir = temp_dir("missing");
+    write(dir / "scene.obj", std::string("mtllib nothere.mtl\n") + kQuad + "usemtl ghost\nf 1 2 3\n");
+    Scene s;
+    Warnings w;
+    load_obj(dir / "scene.obj", s, w);
+    ASSERT_EQ(w.size(), 2u);
+    EXPECT_NE(w[0].find("scene.obj:1:"), std::string::npos) << w[0];
+    EXPECT_NE(w[0].find("nothere.mtl"), std::string::npos) << w[0];
+    EXPECT_NE(w[1].find("scene.obj:6:"), std::string::npos) << w[1];
+    EXPECT_NE(w[1].find("ghost"), std::string::npos) << w[1];
+    EXPECT_EQ(s.tri_material[0], 0u);
+    fs::remove_all(dir);
+}
+
+TEST(ObjLoader, BadInputIsAnErrorWithFileAndLine) {
+    struct Case {
+        std::string text;
+        std::string expect;
+    };
+    const std::string q = kQuad;  // lines 1-4
+    const Case cases[] = {
+        {q + "f 1 2 0\n", "test.obj:5: face vertex index 0"},
+        {q + "f 1 2 5\n", "test.obj:5: face vertex index 5 out of range (4 vertices"},
+        {q + "f 1 2 -5\n", "test.obj:5: face vertex index -5 out of range"},
+        {q + "f 1 2 3000000000\n", "test.obj:5: face vertex index 3000000000 out of range"},
+        {q + "f 1 2\n", "test.obj:5: face needs at least 3 corners, has 2"},
+        {q + "f 1/9 2 3\n", "test.obj:5: face texture index 9 out of range"},
+        {q + "f 1//9 2 3\n", "test.obj:5: face normal index 9 out of range"},
+        {q + "f 1/2/3/4 2 3\n", "test.obj:5: malformed face corner '1/2/3/4'"},
+        {q + "f a b c\n", "test.obj:5: malformed face corner 'a'"},
+        {"v 1 2\n", "test.obj:1: missing number in 'v' statement"},
+        {"v 1 2 abc\n", "test.obj:1: malformed number 'abc' in 'v' statement"},
+        {"v 1 2 3.0.0\n", "test.obj:1: malformed number '3.0.0'"},
+        {"v 1 nan 3\n", "test.obj:1: non-finite number 'nan'"},
+        {"v 1 1e99 3\n", "test.obj:1: number '1e99' out of range"},
+        {"vn 1 2\n", "test.obj:1: missing number in 'vn' statement"},
+        {std::string("v 0 0 0\n\0\0\0 binary\n", 19), "test.obj:2: binary data"},
+    };
+    for (const Case& c : cases) {
+        std::string e = error_of(c.text);
+        EXPECT_NE(e.find(c.expect), std::string::npos) << "input:\n" << c.text << "\ngot: " << e;
+    }
+}
+
+TEST(ObjLoader, MissingFileIsAnError) {
+    Scene s;
+    Warnings w;
+    EXPECT_THROW(load_obj("/nonexistent/scene.obj", s, w), Error);
+}
+
+TEST(ObjLoader, UnknownStatementsWarnOnce) {
+    Warnings w;
+    Scene s = parse(std::string(kQuad) + "foo 1\nfoo 2\nl 1 2\nf 1 2 3\n", &w);
+    ASSERT_EQ(w.size(), 1u);
+    EXPECT_NE(w[0].find("unknown statement 'foo'"), std::string::npos);
+    EXPECT_EQ(s.triangle_count(), 1u);
+}
+
+TEST(ObjLoader, MtlErrorsNameTheMtlFileAndLine) {
+    std::vector<Material> materials;
+    Warnings w;
+    try {
+        parse_mtl("newmtl a\nKd 1 x 0\n", "lib.mtl", materials, w);
+        FAIL();
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("lib.mtl:2: malformed number 'x'"), std::string::npos) << e.what();
+    }
+    EXPECT_THROW(parse_mtl("Kd 1 1 1\n", "lib.mtl", materials, w), Error);  // before newmtl
+}
+
+TEST(ObjLoader, MtlSingleValueKdIsGrey) {
+    std::vector<Material> materials;
+    Warnings w;
+    parse_mtl("newmtl g\nKd 0.25\n", "lib.mtl", materials, w);
+    ASSERT_EQ(materials.size(), 1u);
+    EXPECT_EQ(materials[0].kd, Vec3f(0.25f));
+}
+
+TEST(CameraBlock, ReadsTheSeedsBlock) {
+    Scene s = parse("# Camera start\n"
+                    "v 16.270052 26.948549 25.997269\n"
+                    "v 15.863070 26.491430 25.206442\n"
+                    "vn -0.419904 0.862497 -0.282451\n"
+                    "c 1 2 1\n"
+                    "# Camera end\n" + std::string(kQuad) + "f 3 4 5\n");
+    ASSERT_TRUE(s.camera);
+    EXPECT_EQ(s.camera->eye, Vec3f(16.270052f, 26.948549f, 25.997269f));
+    EXPECT_EQ(s.camera->gaze, Vec3f(15.863070f, 26.491430f, 25.206442f));
+    EXPECT_EQ(s.camera->up, Vec3f(-0.419904f, 0.862497f, -0.282451f));
+    // Camera vertices are ordinary vertices but do not count towards the scene bounds.
+    EXPECT_EQ(s.bounds().hi, Vec3f(1, 1, 0));
+}
+
+TEST(CameraBlock, RelativeIndices) {
+    Scene s = parse(std::string(kQuad) + "v 0 0 5\nv 0 0 4\nvn 0 1 0\nc -2 -1 -1\n");
+    ASSERT_TRUE(s.camera);
+    EXPECT_EQ(s.camera->eye, Vec3f(0, 0, 5));
+    EXPECT_EQ(s.camera->gaze, Vec3f(0, 0, 4));
+}
+
+TEST(CameraBlock, InvalidBlocksAreErrors) {
+    EXPECT_NE(error_of("v 0 0 5\nv 0 0 4\nvn 0 1 0\nc 1 2 2\n").find("test.obj:4: camera up index 2 out of range"), std::string::npos);
+    EXPECT_NE(error_of("v 0 0 5\nv 0 0 4\nvn 0 1 0\nc 0 2 1\n").find("test.obj:4: camera eye index 0"), std::string::npos);
+    EXPECT_NE(error_of("v 0 0 5\nv 0 0 5\nvn 0 1 0\nc 1 2 1\n").find("test.obj:4: invalid camera: eye and gaze"), std::string::npos);
+    EXPECT_NE(error_of("v 0 0 5\nv 0 0 4\nvn 0 0 1\nc 1 2 1\n").find("test.obj:4: invalid camera: up vector"), std::string::npos);
+    EXPECT_NE(error_of("v 0 0 5\nv 0 0 4\nvn 0 1 0\nc 1 2\n").find("test.obj:4: camera statement needs three"), std::string::npos);
+}
