@@ -7,6 +7,10 @@
 #include <optional>
 #include <string>
 
+#include <csignal>
+
+#include "toonray/anim/batch.h"
+#include "toonray/anim/progress.h"
 #include "toonray/core/error.h"
 #include "toonray/core/parse.h"
 #include "toonray/render/render_file.h"
@@ -85,6 +89,50 @@ void print_warnings(const Warnings& warnings) {
     for (const auto& w : warnings) fmt::print(stderr, "toonray: warning: {}\n", w);
 }
 
+// Set by SIGINT/SIGTERM: long runs finish the frames in flight and stop.
+std::atomic<bool> g_stop{false};
+
+extern "C" void request_stop(int) { g_stop = true; }
+
+void install_stop_handlers() {
+    struct sigaction sa {};
+    sa.sa_handler = request_stop;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGINT, &sa, nullptr);
+    sigaction(SIGTERM, &sa, nullptr);
+}
+
+struct BatchArgs {
+    std::string name;
+    int first = 1, last = 1;
+    std::string input = ".", output = ".";
+    std::string pattern, output_pattern, shard;
+    int jobs = 0;
+    bool resume = false, fail_fast = false, quiet = false;
+
+    void add_to(CLI::App& app) {
+        app.add_option("name", name, "Animation name: frame N is read from NAME_NNNNNN.obj, "
+                                     "NAME_NNNN.obj, NAMEN.obj or NAME_N.obj, the first that exists")
+            ->required();
+        app.add_option("first", first, "First frame number")->required()->check(CLI::NonNegativeNumber);
+        app.add_option("last", last, "Last frame number (inclusive)")->required()->check(CLI::NonNegativeNumber);
+        app.add_option("-i,--input", input, "Directory of the frame OBJ files")->capture_default_str();
+        app.add_option("-o,--output", output, "Directory for the PNG frames (created if missing)")
+            ->capture_default_str();
+        app.add_option("--pattern", pattern, "Input file pattern, e.g. 'keys_%06d.obj'");
+        app.add_option("--output-pattern", output_pattern, "Output file pattern (default: NAME_%06d.png)");
+        app.add_option("--jobs", jobs, "Frames rendered at once (0 = one per core)")
+            ->check(CLI::Range(0, 256))
+            ->capture_default_str();
+        app.add_option("--shard", shard,
+                       "Render shard K of N (K/N): frames at positions K-1, K-1+N, ... of the range. "
+                       "Default: from SLURM_ARRAY_TASK_ID/COUNT/MIN when set, else all frames");
+        app.add_flag("--resume", resume, "Skip frames whose PNG already exists and is valid");
+        app.add_flag("--fail-fast", fail_fast, "Stop at the first frame that fails");
+        app.add_flag("-q,--quiet", quiet, "No progress output (failures are still reported)");
+    }
+};
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -101,6 +149,13 @@ int main(int argc, char** argv) {
     render->add_option("-o,--output", render_output, "Output PNG file")->required();
     render_args.add_to(*render);
 
+    RenderArgs batch_render_args;
+    BatchArgs batch_args;
+    CLI::App* batch = app.add_subcommand(
+        "batch", "Render numbered frames NAME FIRST LAST to a PNG sequence (all render options apply)");
+    batch_args.add_to(*batch);
+    batch_render_args.add_to(*batch);
+
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
@@ -114,6 +169,32 @@ int main(int argc, char** argv) {
             FileRenderer renderer;
             renderer.render(render_input, render_output, options, warnings);
             print_warnings(warnings);
+        } else if (*batch) {
+            BatchOptions options;
+            options.name = batch_args.name;
+            options.first = batch_args.first;
+            options.last = batch_args.last;
+            options.input_dir = batch_args.input;
+            options.output_dir = batch_args.output;
+            if (!batch_args.pattern.empty()) options.input_pattern = batch_args.pattern;
+            if (!batch_args.output_pattern.empty()) options.output_pattern = batch_args.output_pattern;
+            options.render = batch_render_args.resolve();
+            options.jobs = batch_args.jobs;
+            options.resume = batch_args.resume;
+            options.fail_fast = batch_args.fail_fast;
+            if (!batch_args.shard.empty()) {
+                options.shard = parse_shard(batch_args.shard);
+            } else if (auto slurm = shard_from_environment()) {
+                options.shard = *slurm;
+            }
+            install_stop_handlers();
+            options.cancel = &g_stop;
+            auto frames = shard_frames(options.first, options.last, options.shard);
+            ProgressReporter progress(static_cast<int>(frames.size()), stderr, batch_args.quiet);
+            BatchReport report = run_batch(options, &progress);
+            progress.finish(report);
+            if (report.cancelled) return 130;
+            return report.failed > 0 ? 1 : 0;
         }
     } catch (const Error& e) {
         fmt::print(stderr, "toonray: error: {}\n", e.what());

@@ -1,0 +1,77 @@
+#pragma once
+/// Batch rendering of numbered frames: `toonray batch keys 1 2229`.
+
+#include <atomic>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "toonray/anim/frame_pattern.h"
+#include "toonray/render/render_file.h"
+
+namespace toonray {
+
+/// Shard K of N (1-based): frames are dealt out interleaved, so shard K renders the frames at
+/// positions K-1, K-1+N, K-1+2N, ... of the range. Every shard gets an even share of slow
+/// and fast parts of an animation, and all N shards together cover each frame exactly once.
+struct Shard {
+    int index = 1;
+    int count = 1;
+};
+
+/// Parses "K/N" with 1 <= K <= N. Throws Error.
+Shard parse_shard(const std::string& text);
+
+/// The shard from a Slurm job array: K = SLURM_ARRAY_TASK_ID - SLURM_ARRAY_TASK_MIN + 1 and
+/// N = SLURM_ARRAY_TASK_COUNT (MIN defaults to 1 when absent). nullopt when not in an array.
+/// Throws Error when the variables are present but inconsistent.
+std::optional<Shard> shard_from_environment();
+
+/// The frames of [first, last] that belong to `shard`, in order.
+std::vector<int> shard_frames(int first, int last, const Shard& shard);
+
+struct BatchOptions {
+    std::string name;  ///< animation name, e.g. "keys"
+    int first = 1, last = 1;
+    std::filesystem::path input_dir = ".";
+    std::filesystem::path output_dir = ".";
+    std::optional<std::string> input_pattern;  ///< default: see default_input_patterns()
+    std::optional<std::string> output_pattern; ///< default: NAME_%06d.png
+    FileRenderOptions render;
+    int jobs = 0;  ///< frames rendered at once; 0 = one per hardware thread
+    bool resume = false;     ///< skip frames whose PNG exists and is valid
+    bool fail_fast = false;  ///< stop at the first failed frame
+    Shard shard;
+    const std::atomic<bool>* cancel = nullptr;  ///< set (e.g. by SIGINT) to stop cleanly
+};
+
+enum class FrameStatus { Rendered, Skipped, Failed };
+
+struct FrameFailure {
+    int frame = 0;
+    std::string message;  ///< names the file and line when the input was bad
+};
+
+struct BatchReport {
+    int total = 0;  ///< frames in this shard
+    int rendered = 0, skipped = 0, failed = 0;
+    bool cancelled = false;
+    std::vector<FrameFailure> failures;  ///< sorted by frame
+    double seconds = 0.0;
+};
+
+/// Receives progress from the worker threads (calls are serialised).
+class BatchObserver {
+public:
+    virtual ~BatchObserver() = default;
+    virtual void frame_done(int frame, FrameStatus status, const std::string& message) = 0;
+    virtual void warning(int frame, const std::string& message) = 0;
+};
+
+/// Renders the frames. Frames that fail are reported and the rest go on (unless fail_fast).
+/// Output is byte-identical for any number of jobs and threads. Throws Error only for
+/// problems with the whole run (bad pattern or range, unwritable output directory).
+BatchReport run_batch(const BatchOptions& options, BatchObserver* observer = nullptr);
+
+}  // namespace toonray
