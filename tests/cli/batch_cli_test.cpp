@@ -1,0 +1,121 @@
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+
+#include <chrono>
+#include <fstream>
+#include <thread>
+
+#include "cli/cli_test_util.h"
+#include "toonray/io/png.h"
+
+namespace fs = std::filesystem;
+extern char** environ;
+
+namespace {
+
+// Frames that differ by camera position; each a copy of the teapot with a camera block.
+void write_frames(const TempDir& dir, int count) {
+    std::ifstream in(std::string(TOONRAY_TEST_DATA_DIR) + "/teapot.obj");
+    std::string teapot((std::istreambuf_iterator<char>(in)), {});
+    fs::create_directories(dir.path / "in");
+    for (int f = 1; f <= count; ++f) {
+        char name[64];
+        std::snprintf(name, sizeof name, "in/keys_%06d.obj", f);
+        float x = 0.02f * f;
+        std::string camera = "v " + std::to_string(x) + " 2 8\nv " + std::to_string(x) + " 1.8 7\nvn 0 1 0\nc -2 -1 -1\n";
+        dir.write(name, teapot + camera);
+    }
+}
+
+int count_files(const fs::path& dir, const std::string& needle) {
+    int n = 0;
+    for (auto& e : fs::directory_iterator(dir))
+        if (e.path().filename().string().find(needle) != std::string::npos) ++n;
+    return n;
+}
+
+}  // namespace
+
+TEST(BatchCli, RendersASequenceAndReportsFailuresWithExitCode) {
+    TempDir dir("cli_batch");
+    write_frames(dir, 4);
+    dir.write("in/keys_000003.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 0\n");
+    CommandResult r = run_toonray("batch keys 1 4 --input " + (dir / "in").string() + " --output " +
+                                  (dir / "png").string() + " --size 160x90 --quiet");
+    EXPECT_EQ(r.exit_code, 1) << r.output;
+    EXPECT_NE(r.output.find("frame 3 failed"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("keys_000003.obj:4: face vertex index 0"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("3 rendered, 0 skipped, 1 failed of 4 frames"), std::string::npos) << r.output;
+    EXPECT_EQ(count_files(dir / "png", ".png"), 3);
+}
+
+TEST(BatchCli, ShardsTogetherRenderEveryFrameOnce) {
+    TempDir dir("cli_shard");
+    write_frames(dir, 7);
+    for (int k = 1; k <= 3; ++k) {
+        CommandResult r = run_toonray("batch keys 1 7 --input " + (dir / "in").string() + " --output " +
+                                      (dir / "png").string() + " --size 64x36 --quiet --shard " +
+                                      std::to_string(k) + "/3");
+        ASSERT_EQ(r.exit_code, 0) << r.output;
+    }
+    EXPECT_EQ(count_files(dir / "png", ".png"), 7);
+    CommandResult env = run_toonray("batch keys 1 7 --input " + (dir / "in").string() + " --output " +
+                                    (dir / "png2").string() + " --size 64x36 --quiet");
+    ASSERT_EQ(env.exit_code, 0);
+    // Slurm variables pick the shard when --shard is absent.
+    std::string cmd = std::string("env SLURM_ARRAY_TASK_ID=2 SLURM_ARRAY_TASK_COUNT=3 ") + TOONRAY_CLI +
+                      " batch keys 1 7 --input " + (dir / "in").string() + " --output " +
+                      (dir / "png3").string() + " --size 64x36 --quiet";
+    ASSERT_EQ(std::system(cmd.c_str()), 0);
+    EXPECT_EQ(count_files(dir / "png3", ".png"), 2);  // frames 2 and 5
+    EXPECT_TRUE(fs::exists(dir / "png3/keys_000005.png"));
+}
+
+TEST(BatchCli, ProgressLinesWhenNotATerminal) {
+    TempDir dir("cli_progress");
+    write_frames(dir, 2);
+    CommandResult r = run_toonray("batch keys 1 2 --input " + (dir / "in").string() + " --output " +
+                                  (dir / "png").string() + " --size 64x36");
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_NE(r.output.find("2/2 frames"), std::string::npos) << r.output;
+    EXPECT_EQ(r.output.find("\r"), std::string::npos) << "no bar redraws in a log";
+}
+
+TEST(BatchCli, InterruptStopsCleanlyAndResumeCompletes) {
+    TempDir dir("cli_interrupt");
+    const int frames = 150;
+    write_frames(dir, frames);
+    std::string in = (dir / "in").string(), out = (dir / "png").string();
+    std::vector<std::string> args = {TOONRAY_CLI, "batch", "keys", "1", std::to_string(frames), "--input", in,
+                                     "--output", out, "--size", "640x360", "--quiet", "--jobs", "2"};
+    std::vector<char*> argv;
+    for (auto& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    pid_t pid;
+    ASSERT_EQ(posix_spawn(&pid, TOONRAY_CLI, nullptr, nullptr, argv.data(), environ), 0);
+    // Wait until some frames exist, then interrupt.
+    for (int i = 0; i < 500 && (!fs::exists(out) || count_files(out, ".png") < 5); ++i)
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    ::kill(pid, SIGINT);
+    int status = 0;
+    ::waitpid(pid, &status, 0);
+    ASSERT_TRUE(WIFEXITED(status));
+    int done = count_files(out, ".png");
+    EXPECT_EQ(WEXITSTATUS(status), 130);
+    EXPECT_GE(done, 5);
+    EXPECT_LT(done, frames) << "the run should have been stopped early";
+    EXPECT_EQ(count_files(out, ".tmp"), 0) << "no partial files";
+    for (auto& e : fs::directory_iterator(out)) EXPECT_TRUE(toonray::is_valid_png(e.path())) << e.path();
+    CommandResult r = run_toonray("batch keys 1 " + std::to_string(frames) + " --input " + in + " --output " +
+                                  out + " --size 640x360 --quiet --resume");
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_EQ(count_files(out, ".png"), frames);
+}
+
+TEST(BatchCli, RangeErrors) {
+    CommandResult r = run_toonray("batch keys 5 4 --quiet");
+    EXPECT_NE(r.exit_code, 0);
+    EXPECT_NE(r.output.find("first frame is after the last"), std::string::npos) << r.output;
+}
