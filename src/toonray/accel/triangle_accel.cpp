@@ -18,7 +18,7 @@ inline bool mt_test(const Vec3f& org, const Vec3f& dir, const Vec3f& v0, const V
     v = dot(dir, q) * inv;
     if (v < 0.0f || u + v > 1.0f) return false;
     t = dot(e2, q) * inv;
-    return t > 0.0f && t < tmax;
+    return t > 0.0f && t <= tmax;
 }
 
 // Slab test; returns the entry distance or +inf for a miss.
@@ -51,7 +51,7 @@ struct HeapStack {
 
 bool intersect_triangle(const Ray& ray, const Vec3f& v0, const Vec3f& v1, const Vec3f& v2,
                         float& t, float& u, float& v) {
-    return mt_test(ray.origin, ray.dir, v0, v1 - v0, v2 - v0, ray.tmax, t, u, v);
+    return mt_test(ray.origin, ray.dir, v0, v1 - v0, v2 - v0, ray.tmax, t, u, v) && t < ray.tmax;
 }
 
 void TriangleAccel::build(std::span<const Vec3f> positions,
@@ -92,7 +92,7 @@ template <typename Stack>
 bool TriangleAccel::traverse(const Ray& ray, Hit& hit, Stack& stack) const {
     const Vec3f inv_dir(1.0f / ray.dir.x, 1.0f / ray.dir.y, 1.0f / ray.dir.z);
     float tmax = ray.tmax;
-    std::uint32_t best = 0xffffffffu;
+    std::uint32_t best = 0xffffffffu, best_prim = 0xffffffffu;
     const BvhNode* nodes = bvh_.nodes.data();
     if (box_entry(nodes[0].bounds, ray.origin, inv_dir, tmax) == std::numeric_limits<float>::infinity())
         return false;
@@ -103,9 +103,14 @@ bool TriangleAccel::traverse(const Ray& ray, Hit& hit, Stack& stack) const {
             for (std::uint32_t i = node.first; i < node.first + node.count; ++i) {
                 const PackedTriangle& tri = tris_[i];
                 float t, u, v;
-                if (mt_test(ray.origin, ray.dir, tri.v0, tri.e1, tri.e2, tmax, t, u, v)) {
+                // Accept t == tmax too, and break the tie by the lower input index: the hit
+                // then does not depend on the tree's shape, so a refitted BVH and a fresh one
+                // give the same image.
+                if (mt_test(ray.origin, ray.dir, tri.v0, tri.e1, tri.e2, tmax, t, u, v) &&
+                    (t < tmax || (best_prim != 0xffffffffu && bvh_.prim_indices[i] < best_prim))) {
                     tmax = t;
                     best = i;
+                    best_prim = bvh_.prim_indices[i];
                     hit.u = u;
                     hit.v = v;
                 }

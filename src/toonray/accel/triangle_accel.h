@@ -35,6 +35,7 @@ public:
     void refit(std::span<const Vec3f> positions, std::span<const std::array<std::uint32_t, 3>> tris);
 
     /// Closest hit with 0 < t < ray.tmax. Returns true and fills `hit` when there is one.
+    /// Among hits at the same distance the lowest triangle index wins, whatever the tree.
     bool intersect(const Ray& ray, Hit& hit) const;
 
     [[nodiscard]] const Bvh& bvh() const { return bvh_; }
