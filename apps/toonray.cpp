@@ -13,6 +13,8 @@
 #include "toonray/anim/progress.h"
 #include "toonray/core/error.h"
 #include "toonray/core/parse.h"
+#include "toonray/media/encode.h"
+#include "toonray/score/score_io.h"
 #include "toonray/render/render_file.h"
 
 namespace {
@@ -156,6 +158,33 @@ int main(int argc, char** argv) {
     batch_args.add_to(*batch);
     batch_render_args.add_to(*batch);
 
+    std::string encode_dir, encode_output, encode_audio;
+    double encode_fps = 24.0;
+    int encode_start = -1;
+    CLI::App* encode = app.add_subcommand(
+        "encode", "Compile a PNG sequence into an H.264 MP4 (yuv420p) with ffmpeg, optionally with audio");
+    encode->add_option("frames", encode_dir, "Directory holding one numbered PNG sequence")
+        ->required()
+        ->check(CLI::ExistingDirectory);
+    encode->add_option("-o,--output", encode_output, "MP4 file to write")->required();
+    encode->add_option("--fps", encode_fps, "Frames per second")
+        ->check(CLI::Range(0.001, 1000.0))
+        ->capture_default_str();
+    encode->add_option("--audio", encode_audio, "Soundtrack (WAV or anything ffmpeg reads), aligned with frame 0");
+    encode->add_option("--start-number", encode_start, "First frame number (default: the lowest present)")
+        ->check(CLI::NonNegativeNumber);
+
+    std::string convert_input, convert_output;
+    CLI::App* score = app.add_subcommand("score", "Work with scores (note scripts and MIDI files)");
+    score->require_subcommand(1);
+    CLI::App* convert = score->add_subcommand(
+        "convert", "Convert between a MIDI file and a note script, losslessly where the script can say it "
+                   "(the output's extension chooses: .mid/.midi or .notes)");
+    convert->add_option("input", convert_input, "Score to read (MIDI or note script)")
+        ->required()
+        ->check(CLI::ExistingFile);
+    convert->add_option("output", convert_output, "Score to write")->required();
+
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
@@ -195,6 +224,21 @@ int main(int argc, char** argv) {
             progress.finish(report);
             if (report.cancelled) return 130;
             return report.failed > 0 ? 1 : 0;
+        } else if (*convert) {
+            Warnings warnings;
+            convert_score(convert_input, convert_output, &warnings);
+            print_warnings(warnings);
+        } else if (*encode) {
+            EncodeOptions options;
+            options.frames_dir = encode_dir;
+            options.output = encode_output;
+            options.fps = encode_fps;
+            options.audio = encode_audio;
+            if (encode_start >= 0) options.start_number = encode_start;
+            EncodeResult result = encode_video(options);
+            fmt::print(stderr, "toonray: wrote {}: {} frames ({}), {:.2f} s{}\n", encode_output,
+                       result.frames.count, result.frames.pattern(), result.duration,
+                       encode_audio.empty() ? "" : ", with audio");
         }
     } catch (const Error& e) {
         fmt::print(stderr, "toonray: error: {}\n", e.what());

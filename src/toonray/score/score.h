@@ -26,6 +26,9 @@ struct PedalEvent {
 struct Score {
     std::vector<Note> notes;          ///< sorted by start, then key
     std::vector<PedalEvent> sustain;  ///< sorted by time
+    /// End of the piece including a final rest (MIDI end of track, a note script's last line);
+    /// never before duration(). 0 when unknown, as in a Score built by hand.
+    double end_time = 0.0;
     /// End of the last note (or pedal event), in seconds.
     [[nodiscard]] double duration() const;
 };
