@@ -11,6 +11,8 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev libtinyobjloader-dev libembree-dev
   # media: video encoding and the piano sound
   ffmpeg fluid-soundfont-gm
+  # the cluster integration test starts a real one-node Slurm cluster
+  slurm-wlm munge
 )
 
 missing=()
