@@ -10,6 +10,8 @@
 #include <csignal>
 
 #include "toonray/anim/batch.h"
+#include "toonray/anim/piano_movie.h"
+#include "toonray/media/audio.h"
 #include "toonray/anim/progress.h"
 #include "toonray/core/error.h"
 #include "toonray/core/parse.h"
@@ -137,6 +139,64 @@ struct BatchArgs {
 
 }  // namespace
 
+/// Options of `piano` and `demo`.
+struct PianoArgs {
+    std::string score, camera_path, soundfont, export_obj, audio;
+    double start = 0.0, seconds = 0.0, fps = 24.0;
+    std::string name = "keys";
+    int jobs = 0;
+    bool resume = false, quiet = false;
+
+    void add_common(CLI::App& app) {
+        app.add_option("--camera-path", camera_path,
+                       "Camera path file (docs/camera-path.md; default: the built-in path)");
+        app.add_option("--fps", fps, "Frames per second")->check(CLI::Range(0.001, 1000.0))->capture_default_str();
+        app.add_option("--start", start, "Score time of the first frame, seconds")
+            ->check(CLI::NonNegativeNumber)
+            ->capture_default_str();
+        app.add_option("--jobs", jobs, "Frames rendered at once (0 = one per core)")
+            ->check(CLI::Range(0, 256))
+            ->capture_default_str();
+        app.add_option("--soundfont", soundfont, "SoundFont for the audio (default: FluidR3 GM)");
+        app.add_flag("--resume", resume, "Skip frames whose PNG already exists and is valid");
+        app.add_flag("-q,--quiet", quiet, "No progress output");
+    }
+};
+
+Score load_score_or_demo(const std::string& path) {
+    if (path.empty()) return load_demo_score();
+    Warnings warnings;
+    Score score = load_score(path, &warnings);
+    print_warnings(warnings);
+    return score;
+}
+
+PianoMovieReport run_piano_movie(const Score& score, const PianoArgs& args, PianoMovieOptions options) {
+    CameraPath path = args.camera_path.empty() ? load_demo_camera_path() : load_camera_path(args.camera_path);
+    options.start = args.start;
+    options.fps = args.fps;
+    options.jobs = args.jobs;
+    options.resume = args.resume;
+    install_stop_handlers();
+    options.cancel = &g_stop;
+    double seconds = options.seconds ? *options.seconds
+                                     : std::max(0.0, (score.notes.empty() ? 0.0 : score.duration()) - options.start);
+    ProgressReporter progress(frame_count(seconds, options.fps), stderr, args.quiet);
+    PianoMovieReport report = render_piano_movie(score, path, options, &progress);
+    progress.finish(report.batch);
+    if (report.dropped_holes)
+        fmt::print(stderr, "toonray: warning: {} roll holes did not fit the hole pool\n", report.dropped_holes);
+    return report;
+}
+
+AudioOptions audio_options(const PianoArgs& args, std::optional<double> seconds) {
+    AudioOptions audio;
+    audio.soundfont = args.soundfont;
+    audio.start = args.start;
+    audio.length = seconds;
+    return audio;
+}
+
 int main(int argc, char** argv) {
     CLI::App app{"toonray: a toon ray tracer. OBJ/MTL scenes in, cel-shaded and outlined PNG out."};
     app.require_subcommand(1);
@@ -185,6 +245,41 @@ int main(int argc, char** argv) {
         ->check(CLI::ExistingFile);
     convert->add_option("output", convert_output, "Score to write")->required();
 
+    PianoArgs piano_args;
+    RenderArgs piano_render_args;
+    std::string piano_output;
+    CLI::App* piano = app.add_subcommand(
+        "piano", "Render the procedural player piano playing a score, or export its frames as OBJ files");
+    piano->add_option("--score", piano_args.score,
+                      "Score: a MIDI file or a note script (default: the built-in Entertainer)");
+    piano->add_option("-o,--output", piano_output, "Directory for the PNG frames");
+    piano->add_option("--export-obj", piano_args.export_obj,
+                      "Instead of rendering, write one OBJ + MTL per frame with its camera block to this "
+                      "directory (render them with `toonray batch NAME 1 N`)");
+    piano->add_option("--seconds", piano_args.seconds, "Length in seconds (default: to the end of the music)")
+        ->check(CLI::PositiveNumber);
+    piano->add_option("--name", piano_args.name, "Frame file name prefix")->capture_default_str();
+    piano->add_option("--audio", piano_args.audio, "Also write the soundtrack of the same stretch to this WAV");
+    piano_args.add_common(*piano);
+    piano_render_args.add_to(*piano);
+
+    PianoArgs demo_args;
+    RenderArgs demo_render_args;
+    std::string demo_output = "out";
+    bool demo_full = false;
+    demo_args.seconds = 30.0;
+    CLI::App* demo = app.add_subcommand(
+        "demo", "The main job: a movie of the player piano playing Scott Joplin's \"The Entertainer\", "
+                "with sound (frames in DIR/frames, DIR/entertainer.wav, DIR/entertainer.mp4)");
+    demo->add_option("-o,--output", demo_output, "Output directory")->capture_default_str();
+    demo->add_flag("--full", demo_full, "The whole piece (about 4 min 13 s) instead of the first seconds");
+    demo->add_option("--seconds", demo_args.seconds, "Length in seconds")
+        ->check(CLI::PositiveNumber)
+        ->capture_default_str();
+    demo->add_option("--score", demo_args.score, "Play another score (MIDI or note script)");
+    demo_args.add_common(*demo);
+    demo_render_args.add_to(*demo);
+
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
@@ -224,6 +319,58 @@ int main(int argc, char** argv) {
             progress.finish(report);
             if (report.cancelled) return 130;
             return report.failed > 0 ? 1 : 0;
+        } else if (*piano) {
+            if (piano_output.empty() == piano_args.export_obj.empty())
+                throw Error("piano: give exactly one of --output DIR (render PNG frames) or --export-obj DIR");
+            Score score = load_score_or_demo(piano_args.score);
+            PianoMovieOptions options;
+            options.name = piano_args.name;
+            options.output_dir = piano_output;
+            if (!piano_args.export_obj.empty()) options.export_obj_dir = piano_args.export_obj;
+            if (piano_args.seconds > 0) options.seconds = piano_args.seconds;
+            options.render = piano_render_args.resolve();
+            PianoMovieReport report = run_piano_movie(score, piano_args, options);
+            if (report.batch.cancelled) return 130;
+            if (report.batch.failed > 0) return 1;
+            if (!piano_args.audio.empty()) {
+                AudioResult audio = render_audio(score, piano_args.audio, audio_options(piano_args, options.seconds));
+                print_warnings(audio.warnings);
+            }
+        } else if (*demo) {
+            namespace fs = std::filesystem;
+            Score score = load_score_or_demo(demo_args.score);
+            fs::path dir = demo_output;
+            PianoMovieOptions options;
+            options.name = "entertainer";
+            options.output_dir = dir / "frames";
+            if (!demo_full) options.seconds = demo_args.seconds;
+            options.render = demo_render_args.resolve();
+            // Frames left from a longer earlier run would join the movie: remove them.
+            std::error_code ec;
+            double seconds = options.seconds ? *options.seconds : score.duration() - demo_args.start;
+            int frames = frame_count(seconds, demo_args.fps);
+            for (int f = frames + 1; fs::exists(options.output_dir / fmt::format("entertainer_{:06d}.png", f), ec); ++f)
+                fs::remove(options.output_dir / fmt::format("entertainer_{:06d}.png", f), ec);
+            if (!demo_args.quiet)
+                fmt::print(stderr, "toonray: demo: {} frames at {}x{}, {} fps -> {}\n", frames,
+                           options.render.settings.width, options.render.settings.height, demo_args.fps,
+                           (dir / "entertainer.mp4").string());
+            PianoMovieReport report = run_piano_movie(score, demo_args, options);
+            if (report.batch.cancelled) return 130;
+            if (report.batch.failed > 0) return 1;
+            if (!demo_args.quiet) fmt::print(stderr, "toonray: demo: synthesising the audio\n");
+            AudioResult audio = render_audio(score, dir / "entertainer.wav", audio_options(demo_args, options.seconds));
+            print_warnings(audio.warnings);
+            if (!demo_args.quiet) fmt::print(stderr, "toonray: demo: encoding the movie\n");
+            EncodeOptions encode_options;
+            encode_options.frames_dir = options.output_dir;
+            encode_options.output = dir / "entertainer.mp4";
+            encode_options.fps = demo_args.fps;
+            encode_options.audio = dir / "entertainer.wav";
+            encode_options.start_number = 1;
+            EncodeResult result = encode_video(encode_options);
+            fmt::print(stderr, "toonray: demo: wrote {} ({} frames, {:.1f} s, {} triangles)\n",
+                       encode_options.output.string(), result.frames.count, result.duration, report.triangles);
         } else if (*convert) {
             Warnings warnings;
             convert_score(convert_input, convert_output, &warnings);

@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
-# The README's main command: installs dependencies, builds, and runs the demo.
+# The README's main command: installs dependencies, builds, and makes the demo movie:
+# out/entertainer.mp4, the player piano playing the first 30 s of "The Entertainer", with sound.
+# Extra arguments go to `toonray demo` (e.g. --full for the whole piece).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
 bash scripts/build.sh
-mkdir -p out
-./build/apps/toonray render tests/data/teapot.obj -o out/teapot.png --aov out/aov
-echo "demo: wrote out/teapot.png and its feature images in out/aov/"
+./build/apps/toonray demo -o out "$@"

@@ -35,10 +35,15 @@ void FileRenderer::render(const Scene& scene, const std::filesystem::path& outpu
     make_view_plane(camera, options.settings.width, options.settings.height);
     accel_.build(scene.positions, scene.tri_positions, options.bvh);
     const ImageRgb8& image = renderer_.render(scene, accel_, camera, options.settings);
+    write_frame(renderer_, image, output, options);
+}
+
+void write_frame(const Renderer& renderer, const ImageRgb8& image, const std::filesystem::path& output,
+                 const FileRenderOptions& options) {
     if (options.aov_dir) {
         std::filesystem::create_directories(*options.aov_dir);
         AovPaths paths = aov_paths(*options.aov_dir, output);
-        const Aovs& aovs = renderer_.aovs();
+        const Aovs& aovs = renderer.aovs();
         write_png(paths.depth, aovs.depth, options.png);
         write_png(paths.normal, aovs.normal, options.png);
         write_png(paths.edges_depth, aovs.edges_depth, options.png);

@@ -27,6 +27,10 @@ struct AovPaths {
 };
 AovPaths aov_paths(const std::filesystem::path& dir, const std::filesystem::path& output);
 
+/// Writes a rendered frame (and, with options.aov_dir, its feature images) atomically.
+void write_frame(const Renderer& renderer, const ImageRgb8& image, const std::filesystem::path& output,
+                 const FileRenderOptions& options);
+
 class FileRenderer {
 public:
     /// Renders `input` to `output` (and AOVs). Throws Error on bad input or a failed write;

@@ -1,0 +1,122 @@
+#include "toonray/anim/piano_movie.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "toonray/anim/batch.h"
+#include "toonray/piano/piano_animation.h"
+
+using namespace toonray;
+namespace fs = std::filesystem;
+
+namespace {
+
+struct TempDir {
+    fs::path path;
+    explicit TempDir(const std::string& name) {
+        path = fs::temp_directory_path() / ("toonray_movie_" + name + "_" + std::to_string(::getpid()));
+        fs::remove_all(path);
+        fs::create_directories(path);
+    }
+    ~TempDir() { fs::remove_all(path); }
+};
+
+std::string bytes(const fs::path& p) {
+    std::ifstream f(p, std::ios::binary);
+    return {std::istreambuf_iterator<char>(f), {}};
+}
+
+}  // namespace
+
+TEST(PianoMovie, DemoAssetsAreBuiltIn) {
+    Score score = load_demo_score();
+    EXPECT_EQ(score.notes.size(), 2621u);
+    CameraPath path = load_demo_camera_path();
+    EXPECT_FALSE(path.empty());
+}
+
+TEST(PianoMovie, FrameCountCoversTheLength) {
+    EXPECT_EQ(frame_count(30.0, 24.0), 720);
+    EXPECT_EQ(frame_count(0.5, 24.0), 12);
+    EXPECT_EQ(frame_count(0.51, 24.0), 13);
+}
+
+TEST(PianoMovie, ExportedObjFramesRenderIdenticallyWithBatch) {
+    // The seed's path (one OBJ per frame, rendered by batch) and the in-memory path (posing
+    // and refitting) must give the same bytes. Frames from the middle of the piece, where keys,
+    // roll holes, pedals and camera all move.
+    TempDir dir("export");
+    Score score = load_demo_score();
+    CameraPath path = load_demo_camera_path();
+    PianoMovieOptions options;
+    options.start = 12.0;
+    options.seconds = 0.25;
+    options.fps = 24.0;
+    options.render.settings.width = 320;
+    options.render.settings.height = 180;
+    options.output_dir = dir.path / "memory";
+    PianoMovieReport memory = render_piano_movie(score, path, options);
+    ASSERT_EQ(memory.batch.rendered, 6);
+    EXPECT_GT(memory.triangles, 30000u);
+    EXPECT_LT(memory.triangles, 60000u);
+
+    options.export_obj_dir = dir.path / "frames";
+    PianoMovieReport exported = render_piano_movie(score, path, options);
+    ASSERT_EQ(exported.batch.rendered, 6);
+    ASSERT_TRUE(fs::exists(dir.path / "frames/keys_000001.obj"));
+
+    BatchOptions batch;
+    batch.name = "keys";
+    batch.first = 1;
+    batch.last = 6;
+    batch.input_dir = dir.path / "frames";
+    batch.output_dir = dir.path / "batch";
+    batch.render = options.render;
+    BatchReport r = run_batch(batch);
+    ASSERT_EQ(r.rendered, 6) << (r.failures.empty() ? "" : r.failures[0].message);
+    for (int f = 1; f <= 6; ++f) {
+        char name[32];
+        std::snprintf(name, sizeof name, "keys_%06d.png", f);
+        std::string a = bytes(dir.path / "memory" / name);
+        ASSERT_FALSE(a.empty());
+        EXPECT_EQ(a, bytes(dir.path / "batch" / name)) << name;
+    }
+    EXPECT_NE(bytes(dir.path / "memory/keys_000001.png"), bytes(dir.path / "memory/keys_000006.png"));
+}
+
+TEST(PianoMovie, JobsGiveIdenticalFrames) {
+    TempDir dir("jobs");
+    Score score = load_demo_score();
+    CameraPath path = load_demo_camera_path();
+    PianoMovieOptions options;
+    options.start = 3.0;
+    options.seconds = 4.0 / 24.0;
+    options.render.settings.width = 160;
+    options.render.settings.height = 90;
+    for (int jobs : {1, 2}) {
+        options.jobs = jobs;
+        options.output_dir = dir.path / std::to_string(jobs);
+        ASSERT_EQ(render_piano_movie(score, path, options).batch.rendered, 4);
+    }
+    for (int f = 1; f <= 4; ++f) {
+        std::string name = "keys_00000" + std::to_string(f) + ".png";
+        EXPECT_EQ(bytes(dir.path / "1" / name), bytes(dir.path / "2" / name)) << name;
+    }
+}
+
+TEST(PianoMovie, BadOptionsAreErrors) {
+    Score score = load_demo_score();
+    CameraPath path = load_demo_camera_path();
+    PianoMovieOptions options;
+    options.output_dir = fs::temp_directory_path();
+    options.fps = 0;
+    EXPECT_THROW(render_piano_movie(score, path, options), Error);
+    options.fps = 24;
+    options.start = 1e6;  // past the end of the music
+    EXPECT_THROW(render_piano_movie(score, path, options), Error);
+    options.start = 0;
+    options.name = "a/b";
+    EXPECT_THROW(render_piano_movie(score, path, options), Error);
+}
