@@ -169,6 +169,20 @@ TEST(ObjLoader, BadInputIsAnErrorWithFileAndLine) {
     }
 }
 
+TEST(ObjLoader, UnderflowReadsAsZeroOverflowIsAnError) {
+    Scene s = parse("v 1e-50 -1e-400 2.5e-39\n");
+    EXPECT_EQ(s.positions[0].x, 0.0f);
+    EXPECT_EQ(s.positions[0].y, 0.0f);
+    EXPECT_GT(s.positions[0].z, 0.0f);  // a denormal, kept
+    EXPECT_NE(error_of("v 1 1e400 0\n").find("test.obj:1: number '1e400' out of range"), std::string::npos);
+}
+
+TEST(ObjLoader, CommentsAreNotContinued) {
+    Scene s = parse("# C:\\models\\\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+    EXPECT_EQ(s.positions.size(), 3u);
+    EXPECT_EQ(s.triangle_count(), 1u);
+}
+
 TEST(ObjLoader, MissingFileIsAnError) {
     Scene s;
     Warnings w;

@@ -26,7 +26,8 @@ public:
         if (pos_ >= text_.size()) return false;
         line_number = ++physical_;
         std::string_view piece = take_physical();
-        if (!ends_with_backslash(piece)) {
+        // A comment is a whole line: "# C:\models\" must not swallow the next line.
+        if (!ends_with_backslash(piece) || is_comment(piece)) {
             line = piece;
             return true;
         }
@@ -48,6 +49,10 @@ public:
 
 private:
     static bool ends_with_backslash(std::string_view s) { return !s.empty() && s.back() == '\\'; }
+    static bool is_comment(std::string_view s) {
+        std::size_t i = s.find_first_not_of(" \t");
+        return i != std::string_view::npos && s[i] == '#';
+    }
 
     std::string_view take_physical() {
         const char* begin = text_.data() + pos_;
@@ -114,8 +119,19 @@ public:
         if (*b == '+') ++b;
         float v;
         auto [ptr, ec] = std::from_chars(b, e, v);
-        if (ec == std::errc::result_out_of_range)
-            fail(fmt::format("number '{}' out of range in '{}' statement", tok, what));
+        if (ec == std::errc::result_out_of_range && ptr == e) {
+            // Too small for a float reads as zero (as strtof and other readers do: exporters
+            // that write doubles produce such values); too large is an error.
+            double d;
+            auto [dptr, dec] = std::from_chars(b, e, d);
+            std::string_view digits(b, static_cast<std::size_t>(e - b));
+            bool underflow = dec == std::errc() ? std::abs(d) < 1.0
+                                                : digits.find("e-") != std::string_view::npos ||
+                                                      digits.find("E-") != std::string_view::npos;
+            if (!underflow) fail(fmt::format("number '{}' out of range in '{}' statement", tok, what));
+            v = dec == std::errc() ? static_cast<float>(d) : 0.0f;
+            ec = std::errc();
+        }
         if (ec != std::errc() || ptr != e)
             fail(fmt::format("malformed number '{}' in '{}' statement", tok, what));
         if (!std::isfinite(v))
