@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include <filesystem>
 #include <fstream>
 
@@ -119,4 +121,27 @@ TEST(PianoMovie, BadOptionsAreErrors) {
     options.start = 0;
     options.name = "a/b";
     EXPECT_THROW(render_piano_movie(score, path, options), Error);
+}
+
+TEST(PianoMovie, EveryOnsetInTheFirstThirtySecondsShowsItsKeyDown) {
+    // The sync check of the demo: for every note starting in the first 30 s of the demo score,
+    // the first 24 fps frame at or after its onset shows its key down, and the pose given to the
+    // mesh carries that depth (piano_pose_test checks that a key angle moves the key's vertices).
+    Score score = load_demo_score();
+    PianoPlayback play(score);
+    const double fps = 24.0;
+    int checked = 0;
+    for (const Note& n : score.notes) {
+        if (n.start >= 30.0) continue;
+        int frame = static_cast<int>(std::ceil(n.start * fps - 1e-9)) + 1;  // frame 1 shows t = 0
+        double t = (frame - 1) / fps;
+        ASSERT_GE(t, n.start - 1e-9);
+        ASSERT_LT(t, n.start + 1.0 / fps);
+        EXPECT_TRUE(play.is_key_down(n.key, t)) << "note " << n.key << " at " << n.start << " s, frame " << frame;
+        PianoPose pose = play.pose_at(t);
+        EXPECT_GE(pose.key_angle[static_cast<std::size_t>(n.key - 21)], kKeyDownDepth * play.settings().key_dip_angle);
+        ++checked;
+    }
+    EXPECT_GT(checked, 250);
+    std::printf("checked %d onsets in the first 30 s\n", checked);
 }

@@ -62,21 +62,24 @@ PianoPlayback::PianoPlayback(const Score& score, const PlaybackSettings& setting
         // less than min_hold down.
         for (std::size_t i = 0; i + 1 < merged.size(); ++i) {
             KeyPress& p = merged[i];
-            p.off = std::min(p.off, merged[i + 1].on - r - settings.min_up);
+            p.off = std::min(p.off, merged[i + 1].on - settings.attack - r - settings.min_up);
         }
         for (KeyPress& p : merged) p.off = std::max(p.off, p.on + settings.min_hold);
         list = std::move(merged);
         // Depth where each press begins (above 0 only when the previous release is cut short).
         for (std::size_t i = 1; i < list.size(); ++i)
-            list[i].start_depth = press_depth(list[i - 1], list[i].on);
+            list[i].start_depth = press_depth(list[i - 1], list[i].on - settings.attack);
         if (!list.empty()) end_ = std::max(end_, list.back().off + r);
     }
 }
 
 float PianoPlayback::press_depth(const KeyPress& p, double t) const {
-    if (t < p.on) return 0.0f;
+    // The key starts down `attack` before the onset and bottoms out at it: the hammer strikes
+    // (and the note sounds) when the key reaches the bottom.
+    const double begin = p.on - settings_.attack;
+    if (t < begin) return 0.0f;
     const double down =
-        std::min(1.0, p.start_depth + (std::min(t, p.off) - p.on) / settings_.attack);
+        std::min(1.0, p.start_depth + (std::min(t, p.off) - begin) / settings_.attack);
     if (t <= p.off) return static_cast<float>(down);
     return static_cast<float>(std::max(0.0, down - (t - p.off) / settings_.release));
 }
@@ -86,8 +89,9 @@ float PianoPlayback::key_depth(int midi, double t) const {
     const auto& list = presses_[static_cast<std::size_t>(midi - kLowestKey)];
     // The latest press that has begun decides the depth (it started from where the previous
     // one had got to).
+    const double attack = settings_.attack;
     auto it = std::upper_bound(list.begin(), list.end(), t,
-                               [](double x, const KeyPress& p) { return x < p.on; });
+                               [attack](double x, const KeyPress& p) { return x < p.on - attack; });
     if (it == list.begin()) return 0.0f;
     return press_depth(*(it - 1), t);
 }

@@ -1,14 +1,16 @@
 #pragma once
 /// Playback: the piano's pose at any time t of a score, as a player piano would play it.
 ///
-/// Keys: a key starts down at its note's onset, reaches the bottom after `attack` seconds,
-/// holds, and comes up over `release` seconds from the note's end. A key counts as *down* when
-/// it is at least kKeyDownDepth (80%) of the way down; every note's key is fully down from
-/// onset + attack and stays so at least until onset + min_hold (1/24 s by default), so a 24 fps
-/// frame at onset + 1/24 s always shows it down. When the same key sounds again, the earlier
-/// note's hold is shortened so that the key is fully up for `min_up` seconds before the next
-/// press (the release stays visible at 24 fps). If notes on one key are closer than
-/// min_hold + release + min_up, the hold wins and the key comes only partly up.
+/// Keys: a key starts down `attack` seconds before its note's onset and reaches the bottom at
+/// the onset, as on a real piano, where the note sounds when the key bottoms out; it holds, and
+/// comes up over `release` seconds from the note's end. A key counts as *down* when it is at
+/// least kKeyDownDepth (80%) of the way down; every note's key is fully down from its onset
+/// and stays so at least until onset + min_hold (1/24 s by default), so the first frame at or
+/// after an onset, at any frame rate from 24 fps up, shows it down. When the same key sounds
+/// again, the earlier note's hold is shortened so that the key is fully up for `min_up` seconds
+/// before the next press begins (the release stays visible at 24 fps). If notes on one key are
+/// closer than attack + min_hold + release + min_up, the hold wins and the key comes only
+/// partly up.
 ///
 /// Roll: the paper advances at RollGeometry::paper_speed from t = 0 (so a slot punched at a
 /// note's onset reaches the tracker bar then) until the last note has ended, then stops.
@@ -28,8 +30,8 @@ namespace toonray {
 inline constexpr float kKeyDownDepth = 0.8f;
 
 struct PlaybackSettings {
-    double attack = 0.025;        ///< seconds from rest to fully down
-    double release = 0.030;       ///< seconds from fully down to rest
+    double attack = 0.015;        ///< seconds from rest to fully down, ending at the onset
+    double release = 0.025;       ///< seconds from fully down to rest
     double min_hold = 1.0 / 24.0; ///< a key stays fully down at least this long after onset
     double min_up = 1.0 / 24.0;   ///< fully up at least this long between presses of one key
     float key_dip_angle = kKeyDipAngle;
@@ -42,9 +44,9 @@ struct PlaybackSettings {
 
 /// One press of a key after the adjustments above.
 struct KeyPress {
-    double on = 0.0;           ///< starts going down (the note's onset)
+    double on = 0.0;           ///< the note's onset: fully down (it starts `attack` earlier)
     double off = 0.0;          ///< starts coming up
-    float start_depth = 0.0f;  ///< depth at `on` (above 0 only when presses crowd each other)
+    float start_depth = 0.0f;  ///< depth at on - attack (above 0 only when presses crowd each other)
 };
 
 class PianoPlayback {
