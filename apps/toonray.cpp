@@ -29,9 +29,15 @@ struct RenderArgs {
     std::string light;
     std::string camera;
     std::string background = "1,1,1";
-    std::string edges = "classic";
+    std::string edges = "robust";
     float depth_threshold = 8.0f;
     float normal_threshold = 4.0f;
+    std::string lines = "all";
+    float crease_angle = RobustLineSettings{}.crease_angle;
+    float depth_step = RobustLineSettings{}.depth_threshold;
+    float line_width = RobustLineSettings{}.width;
+    std::string line_colour = "0,0,0";
+    int samples = RenderSettings{}.samples;
     int threads = 0;
     int leaf_size = Bvh::Config{}.max_leaf_size;
     int png_level = PngOptions{}.level;
@@ -47,8 +53,32 @@ struct RenderArgs {
                        "file's camera block (default: the block, else a camera framing the scene)");
         app.add_option("--background", background, "Background colour r,g,b in [0,1] or #rrggbb")
             ->capture_default_str();
-        app.add_option("--edges", edges, "Line mode: classic (the seed's Sobel pipeline)")
-            ->check(CLI::IsMember({"classic"}))
+        app.add_option("--edges", edges,
+                       "Line mode: robust (supersampled, plane-aware, resolution-independent lines) or "
+                       "classic (the seed's Sobel pipeline, exactly)")
+            ->check(CLI::IsMember({"robust", "classic"}))
+            ->capture_default_str();
+        app.add_option("--lines", lines,
+                       "Robust: line types to draw, from silhouette,crease,depth,object,material (or all, none)")
+            ->capture_default_str();
+        app.add_option("--crease-angle", crease_angle,
+                       "Robust: angle in degrees between neighbouring surfaces above which a crease is drawn")
+            ->check(CLI::Range(0.0f, 180.0f))
+            ->capture_default_str();
+        app.add_option("--depth-step", depth_step,
+                       "Robust: relative jump in depth (second difference of 1/z over 1/z) that makes a depth line")
+            ->check(CLI::PositiveNumber)
+            ->capture_default_str();
+        app.add_option("--line-width", line_width,
+                       "Robust: line width in pixels at 720 lines; scales with the image height")
+            ->check(CLI::Range(0.0f, 100.0f))
+            ->capture_default_str();
+        app.add_option("--line-color", line_colour, "Robust: line colour r,g,b in [0,1] or #rrggbb")
+            ->capture_default_str();
+        app.add_option("--samples", samples,
+                       "Robust: samples per pixel on a regular grid (1, 4, 9 or 16); lines and colours are "
+                       "filtered down from it")
+            ->check(CLI::IsMember({1, 4, 9, 16}))
             ->capture_default_str();
         app.add_option("--depth-threshold", depth_threshold,
                        "Classic mode: Sobel magnitude on the 8-bit depth map above which a pixel is a line")
@@ -57,8 +87,10 @@ struct RenderArgs {
                        "Classic mode: Sobel magnitude on the 8-bit normal map above which a pixel is a line")
             ->capture_default_str();
         app.add_option("--aov", aov_dir,
-                       "Also write feature images to this directory: NAME_depth, _normal, "
-                       "_edges_depth, _edges_normal, _edges, _cel .png");
+                       "Also write feature images to this directory, named after the output: "
+                       "NAME_depth, _normal, _edges, _cel .png, and per mode: classic _edges_depth, "
+                       "_edges_normal; robust _lines_silhouette, _lines_crease, _lines_depth, _lines_object, "
+                       "_lines_material, _object_id, _material_id");
         app.add_option("--threads", threads, "Threads to use (0 = all)")
             ->check(CLI::Range(0, 1024))
             ->capture_default_str();
@@ -78,7 +110,13 @@ struct RenderArgs {
         if (!light.empty()) o.settings.light = parse_vec3(light, "--light");
         if (!camera.empty()) o.camera = parse_camera_spec(camera);
         o.settings.background = parse_colour(background, "--background");
-        o.settings.edges = EdgeMode::Classic;
+        o.settings.edges = edges == "classic" ? EdgeMode::Classic : EdgeMode::Robust;
+        o.settings.lines.types = parse_line_types(lines);
+        o.settings.lines.crease_angle = crease_angle;
+        o.settings.lines.depth_threshold = depth_step;
+        o.settings.lines.width = line_width;
+        o.settings.lines.colour = parse_colour(line_colour, "--line-color");
+        o.settings.samples = samples;
         o.settings.depth_threshold = depth_threshold;
         o.settings.normal_threshold = normal_threshold;
         o.settings.threads = threads;

@@ -17,7 +17,9 @@ TEST(RenderCli, HelpDocumentsEveryOptionAndItsDefault) {
                             "--depth-threshold", "--normal-threshold", "--aov", "--threads",
                             "--bvh-leaf-size", "--png-level"})
         EXPECT_NE(r.output.find(opt), std::string::npos) << opt;
-    for (const char* def : {"1280x720", "classic", "=8", "=4"})
+    for (const char* opt : {"--lines", "--crease-angle", "--depth-step", "--line-width", "--line-color", "--samples"})
+        EXPECT_NE(r.output.find(opt), std::string::npos) << opt;
+    for (const char* def : {"1280x720", "robust", "classic", "=8", "=4"})
         EXPECT_NE(r.output.find(def), std::string::npos) << def << "\n" << r.output;
 }
 

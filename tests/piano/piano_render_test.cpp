@@ -74,6 +74,7 @@ TEST(PianoRender, KeysAreVisibleAndAPressShowsAfterRefit) {
     TriangleAccel accel;
     accel.build(scene.positions, scene.tri_positions);
     RenderSettings settings;
+    settings.edges = EdgeMode::Classic;  // reads the Euclidean distances of the G-buffer
     settings.width = 480;
     settings.height = 200;
     settings.threads = 1;

@@ -49,7 +49,9 @@ TEST(Renderer, FlatSquareFacingTheLightIsItsKdWithoutLines) {
     // Looking straight down at a plane 5 units away; a narrow field of view keeps depth nearly
     // constant, and a light far along the normal gives l.n close to 1 everywhere.
     CameraSpec cam{{0, 0, 5}, {0, 0, 1}, {0, 1, 0}};
+    for (EdgeMode mode : {EdgeMode::Classic, EdgeMode::Robust}) {
     RenderSettings settings;
+    settings.edges = mode;
     settings.width = 128;
     settings.height = 96;
     settings.light = Vec3f(0, 0, 1e4f);
@@ -59,6 +61,7 @@ TEST(Renderer, FlatSquareFacingTheLightIsItsKdWithoutLines) {
     const ImageRgb8& out = r.render(s, accel, cam, settings);
     for (int y = 0; y < settings.height; ++y)
         for (int x = 0; x < settings.width; ++x) ASSERT_EQ(out(x, y), (Rgb8{51, 102, 153})) << x << "," << y;
+    }
 }
 
 TEST(Renderer, CelBandsFollowThePointLight) {
@@ -67,6 +70,7 @@ TEST(Renderer, CelBandsFollowThePointLight) {
     Scene s = square(10.0f, {1.0f, 1.0f, 1.0f});
     CameraSpec cam{{0, 0, 8}, {0, 0, 7}, {0, 1, 0}};  // 90 degrees: sees x in [-8, 8]
     RenderSettings settings;
+    settings.edges = EdgeMode::Classic;  // one sample per pixel: colours are the formula's
     settings.width = 160;
     settings.height = 120;
     settings.light = Vec3f(0, 0, 2);
@@ -95,6 +99,7 @@ TEST(Renderer, SilhouetteOfASquareOnBackgroundIsOutlined) {
     Scene s = square(1.0f, {0.5f, 0.5f, 0.5f});
     CameraSpec cam{{0, 0, 4}, {0, 0, 3}, {0, 1, 0}};  // sees x in [-4, 4]: the square is the middle quarter
     RenderSettings settings;
+    settings.edges = EdgeMode::Classic;
     settings.width = 200;
     settings.height = 200;
     settings.light = Vec3f(0, 0, 100);
@@ -123,6 +128,7 @@ TEST(Renderer, NormalsFaceTheViewer) {
     Scene s = square(1.0f, {1, 1, 1});
     CameraSpec cam{{0, 0, -4}, {0, 0, -3}, {0, 1, 0}};
     RenderSettings settings;
+    settings.edges = EdgeMode::Classic;
     settings.width = 32;
     settings.height = 32;
     Renderer r;
@@ -137,6 +143,7 @@ TEST(Renderer, InterpolatesVertexNormalsOnlyWhenAllCornersHaveThem) {
     s.tri_normals[1] = {0, kNoIndex, 1};          // one missing: geometric
     CameraSpec cam{{0, 0, 4}, {0, 0, 3}, {0, 1, 0}};
     RenderSettings settings;
+    settings.edges = EdgeMode::Classic;
     settings.width = 64;
     settings.height = 64;
     Renderer r;
@@ -172,6 +179,9 @@ TEST(Renderer, OutputIsIdenticalForEveryThreadCount) {
     accel.build(s.positions, s.tri_positions);
     Renderer one, two, many;
     o.settings.threads = 1;
+    for (EdgeMode mode : {EdgeMode::Classic, EdgeMode::Robust}) {
+    o.settings.edges = mode;
+    o.settings.threads = 1;
     ImageRgb8 a = one.render(s, accel, cam, o.settings);
     o.settings.threads = 2;
     ImageRgb8 b = two.render(s, accel, cam, o.settings);
@@ -180,12 +190,14 @@ TEST(Renderer, OutputIsIdenticalForEveryThreadCount) {
     ASSERT_EQ(0, std::memcmp(a.data(), b.data(), a.size() * 3));
     ASSERT_EQ(0, std::memcmp(a.data(), c.data(), a.size() * 3));
     ASSERT_EQ(0, std::memcmp(one.aovs().depth.data(), two.aovs().depth.data(), a.size()));
+    }
 }
 
 TEST(Renderer, MatchesABruteForceReference) {
     // The same pixels traced by testing every triangle: the BVH must find the same surfaces.
     Scene s = load("spot.obj");
     FileRenderOptions o;
+    o.settings.edges = EdgeMode::Classic;  // its G-buffer holds the Euclidean distance
     o.settings.width = 160;
     o.settings.height = 90;
     CameraSpec cam = choose_camera(s, o);
@@ -220,6 +232,7 @@ TEST(Renderer, TeapotMatchesTheGoldenImage) {
     // figures; tiny differences (a ray through a shared edge) are tolerated.
     Scene s = load("teapot.obj");
     FileRenderOptions o;
+    o.settings.edges = EdgeMode::Classic;
     CameraSpec cam = choose_camera(s, o);
     TriangleAccel accel;
     accel.build(s.positions, s.tri_positions);
@@ -242,14 +255,19 @@ TEST(FileRenderer, WritesTheImageAndAllAovsNamedAfterTheOutput) {
     o.settings.width = 64;
     o.settings.height = 48;
     o.aov_dir = dir / "aov";
-    FileRenderer fr;
-    Warnings w;
-    fr.render(std::string(TOONRAY_TEST_DATA_DIR) + "/teapot.obj", dir / "frame.png", o, w);
-    EXPECT_TRUE(is_valid_png(dir / "frame.png"));
-    for (const char* name : {"depth", "normal", "edges_depth", "edges_normal", "edges", "cel"}) {
-        fs::path p = dir / "aov" / (std::string("frame_") + name + ".png");
-        EXPECT_TRUE(is_valid_png(p)) << p;
-        EXPECT_EQ(read_png(p).width, 64);
+    for (EdgeMode mode : {EdgeMode::Classic, EdgeMode::Robust}) {
+        o.settings.edges = mode;
+        FileRenderer fr;
+        Warnings w;
+        fr.render(std::string(TOONRAY_TEST_DATA_DIR) + "/teapot.obj", dir / "frame.png", o, w);
+        EXPECT_TRUE(is_valid_png(dir / "frame.png"));
+        auto names = aov_names(mode);
+        EXPECT_EQ(names.size(), mode == EdgeMode::Classic ? 6u : 11u);
+        for (const std::string& name : names) {
+            fs::path p = dir / "aov" / ("frame_" + name + ".png");
+            EXPECT_TRUE(is_valid_png(p)) << p;
+            EXPECT_EQ(read_png(p).width, 64);
+        }
     }
     fs::remove_all(dir);
 }

@@ -43,7 +43,7 @@ public:
 
 private:
     struct PackedTriangle {
-        Vec3f v0, e1, e2;  // e1 = v1 - v0, e2 = v2 - v0
+        Vec3f v0, v1, v2;
     };
     void pack(std::span<const Vec3f> positions, std::span<const std::array<std::uint32_t, 3>> tris);
     template <typename Stack>
@@ -54,7 +54,8 @@ private:
     int depth_ = 0;
 };
 
-/// Möller-Trumbore ray/triangle test; exposed for brute-force reference checks in tests.
+/// The watertight ray/triangle test the traversal uses (Woop et al. 2013): 0 < t < ray.tmax.
+/// Exposed for brute-force reference checks in tests.
 bool intersect_triangle(const Ray& ray, const Vec3f& v0, const Vec3f& v1, const Vec3f& v2,
                         float& t, float& u, float& v);
 

@@ -4,11 +4,15 @@
 
 namespace toonray {
 
-AovPaths aov_paths(const std::filesystem::path& dir, const std::filesystem::path& output) {
-    std::string stem = output.stem().string();
-    auto name = [&](const char* suffix) { return dir / (stem + "_" + suffix + ".png"); };
-    return {name("depth"), name("normal"), name("edges_depth"), name("edges_normal"), name("edges"),
-            name("cel")};
+std::filesystem::path aov_path(const std::filesystem::path& dir, const std::filesystem::path& output,
+                               const std::string& name) {
+    return dir / (output.stem().string() + "_" + name + ".png");
+}
+
+std::vector<std::string> aov_names(EdgeMode mode) {
+    if (mode == EdgeMode::Classic) return {"depth", "normal", "edges_depth", "edges_normal", "edges", "cel"};
+    return {"depth",        "normal",       "edges",          "cel",       "lines_silhouette", "lines_crease",
+            "lines_depth",  "lines_object", "lines_material", "object_id", "material_id"};
 }
 
 CameraSpec choose_camera(const Scene& scene, const FileRenderOptions& options) {
@@ -42,14 +46,23 @@ void write_frame(const Renderer& renderer, const ImageRgb8& image, const std::fi
                  const FileRenderOptions& options) {
     if (options.aov_dir) {
         std::filesystem::create_directories(*options.aov_dir);
-        AovPaths paths = aov_paths(*options.aov_dir, output);
-        const Aovs& aovs = renderer.aovs();
-        write_png(paths.depth, aovs.depth, options.png);
-        write_png(paths.normal, aovs.normal, options.png);
-        write_png(paths.edges_depth, aovs.edges_depth, options.png);
-        write_png(paths.edges_normal, aovs.edges_normal, options.png);
-        write_png(paths.edges, aovs.edges, options.png);
-        write_png(paths.cel, aovs.cel, options.png);
+        const Aovs& a = renderer.aovs();
+        for (const std::string& name : aov_names(options.settings.edges)) {
+            std::filesystem::path path = aov_path(*options.aov_dir, output, name);
+            if (name == "depth") write_png(path, a.depth, options.png);
+            else if (name == "normal") write_png(path, a.normal, options.png);
+            else if (name == "edges_depth") write_png(path, a.edges_depth, options.png);
+            else if (name == "edges_normal") write_png(path, a.edges_normal, options.png);
+            else if (name == "edges") write_png(path, a.edges, options.png);
+            else if (name == "cel") write_png(path, a.cel, options.png);
+            else if (name == "lines_silhouette") write_png(path, a.lines_silhouette, options.png);
+            else if (name == "lines_crease") write_png(path, a.lines_crease, options.png);
+            else if (name == "lines_depth") write_png(path, a.lines_depth, options.png);
+            else if (name == "lines_object") write_png(path, a.lines_object, options.png);
+            else if (name == "lines_material") write_png(path, a.lines_material, options.png);
+            else if (name == "object_id") write_png(path, a.object_id, options.png);
+            else if (name == "material_id") write_png(path, a.material_id, options.png);
+        }
     }
     write_png(output, image, options.png);
 }

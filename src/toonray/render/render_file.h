@@ -4,6 +4,8 @@
 
 #include <filesystem>
 #include <optional>
+#include <string>
+#include <vector>
 
 #include "toonray/accel/triangle_accel.h"
 #include "toonray/core/error.h"
@@ -21,11 +23,15 @@ struct FileRenderOptions {
     PngOptions png;
 };
 
-/// The AOV file names for an output: `<dir>/<stem>_depth.png`, ... .
-struct AovPaths {
-    std::filesystem::path depth, normal, edges_depth, edges_normal, edges, cel;
-};
-AovPaths aov_paths(const std::filesystem::path& dir, const std::filesystem::path& output);
+/// The AOV file for an output and a feature name: `<dir>/<stem>_<name>.png`.
+std::filesystem::path aov_path(const std::filesystem::path& dir, const std::filesystem::path& output,
+                               const std::string& name);
+
+/// Feature images written for a line mode. Classic: depth, normal, edges_depth, edges_normal,
+/// edges (merged, before blur), cel. Robust: depth, normal, edges (line coverage), cel,
+/// lines_silhouette, lines_crease, lines_depth, lines_object, lines_material, object_id,
+/// material_id.
+std::vector<std::string> aov_names(EdgeMode mode);
 
 /// Writes a rendered frame (and, with options.aov_dir, its feature images) atomically.
 void write_frame(const Renderer& renderer, const ImageRgb8& image, const std::filesystem::path& output,

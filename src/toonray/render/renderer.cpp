@@ -3,6 +3,9 @@
 #include <cmath>
 #include <limits>
 
+#include <fmt/format.h>
+
+#include "toonray/core/error.h"
 #include "toonray/core/parallel.h"
 #include "toonray/render/classic.h"
 
@@ -10,6 +13,55 @@ namespace toonray {
 namespace {
 
 constexpr int kTile = 16;
+
+// Geometric normal of the hit triangle, unit, turned to face the viewer.
+Vec3f geometric_normal(const Scene& scene, const Hit& hit, const Vec3f& dir) {
+    const auto& tri = scene.tri_positions[hit.prim];
+    const Vec3f& p0 = scene.positions[tri[0]];
+    Vec3f n = cross(scene.positions[tri[1]] - p0, scene.positions[tri[2]] - p0);
+    float len = length(n);
+    n = len > 0.0f ? n / len : -dir;
+    return dot(n, dir) > 0.0f ? -n : n;
+}
+
+// A distinct, stable colour for an id (AOVs); black for misses.
+Rgb8 id_colour(std::uint32_t id) {
+    if (id == kNoIndex) return {0, 0, 0};
+    std::uint32_t h = id * 2654435761u;
+    h ^= h >> 15;
+    return {static_cast<std::uint8_t>(64 + (h & 127)), static_cast<std::uint8_t>(64 + ((h >> 8) & 127)),
+            static_cast<std::uint8_t>(64 + ((h >> 16) & 127))};
+}
+
+// Depth, normal and id images at pixel resolution from the first sample of each pixel, and the
+// line seeds of each type filtered down.
+void robust_feature_images(const GBuffer& g, const Image<std::uint8_t>& seeds, Aovs& aovs, int threads) {
+    const int sub = g.sub;
+    const int w = g.view_depth.width() / sub, h = g.view_depth.height() / sub;
+    float z_max = 0.0f;
+    for (std::size_t i = 0; i < g.view_depth.size(); ++i)
+        if (std::isfinite(g.view_depth.data()[i])) z_max = std::max(z_max, g.view_depth.data()[i]);
+    aovs.depth.resize(w, h);
+    aovs.normal.resize(w, h);
+    aovs.object_id.resize(w, h);
+    aovs.material_id.resize(w, h);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            int fx = x * sub, fy = y * sub;
+            float z = g.view_depth(fx, fy);
+            aovs.depth(x, y) = std::isfinite(z) && z_max > 0 ? static_cast<std::uint8_t>(std::lround(z / z_max * 255.0f)) : 255;
+            Vec3f n = g.geometric_normal(fx, fy);
+            aovs.normal(x, y) = std::isfinite(z) ? Rgb8{to_byte(n.x * 0.5f + 0.5f), to_byte(n.y * 0.5f + 0.5f), to_byte(n.z * 0.5f + 0.5f)}
+                                                 : Rgb8{0, 0, 0};
+            aovs.object_id(x, y) = id_colour(g.object(fx, fy));
+            aovs.material_id(x, y) = id_colour(g.material(fx, fy));
+        }
+    resolve_seed_type(seeds, kLineSilhouette, sub, aovs.lines_silhouette, threads);
+    resolve_seed_type(seeds, kLineCrease, sub, aovs.lines_crease, threads);
+    resolve_seed_type(seeds, kLineDepth, sub, aovs.lines_depth, threads);
+    resolve_seed_type(seeds, kLineObject, sub, aovs.lines_object, threads);
+    resolve_seed_type(seeds, kLineMaterial, sub, aovs.lines_material, threads);
+}
 
 // Shading normal at a hit: interpolated vertex normals when all three corners have one,
 // else the geometric normal; turned to face the viewer.
@@ -44,15 +96,29 @@ Vec3f default_light(const Scene& scene, const ViewPlane& view) {
     return view.eye + (view.up + view.right) * (0.5f * radius);
 }
 
+int samples_per_side(int samples) {
+    for (int sub = 1; sub <= 4; ++sub)
+        if (sub * sub == samples) return sub;
+    throw Error(fmt::format("--samples {}: must be 1, 4, 9 or 16 (a square grid per pixel)", samples));
+}
+
 void Renderer::trace(const Scene& scene, const TriangleAccel& accel, const ViewPlane& view,
-                     const RenderSettings& settings) {
-    const int w = settings.width, h = settings.height;
+                     const RenderSettings& settings, int sub) {
+    const int w = settings.width * sub, h = settings.height * sub;
+    const bool classic = settings.edges == EdgeMode::Classic;
     const float inf = std::numeric_limits<float>::infinity();
-    gbuffer_.distance.resize(w, h, inf);
-    gbuffer_.normal.resize(w, h);
-    gbuffer_.colour.resize(w, h);
-    gbuffer_.material.resize(w, h, kNoIndex);
-    gbuffer_.object.resize(w, h, kNoIndex);
+    GBuffer& g = gbuffer_;
+    g.sub = sub;
+    // Only the buffers this mode reads are kept at full size.
+    g.distance.resize(classic ? w : 0, classic ? h : 0, inf);
+    g.normal.resize(classic ? w : 0, classic ? h : 0);
+    g.view_depth.resize(classic ? 0 : w, classic ? 0 : h, inf);
+    g.geometric_normal.resize(classic ? 0 : w, classic ? 0 : h);
+    g.colour.resize(w, h);
+    g.material.resize(w, h, kNoIndex);
+    g.object.resize(w, h, kNoIndex);
+    const Vec3f forward = view.forward;
+    const float inv_sub = 1.0f / static_cast<float>(sub);
 
     const int tiles_x = (w + kTile - 1) / kTile, tiles_y = (h + kTile - 1) / kTile;
     parallel_for(tiles_x * tiles_y, 1, settings.threads, [&](int begin, int end) {
@@ -61,16 +127,24 @@ void Renderer::trace(const Scene& scene, const TriangleAccel& accel, const ViewP
             int x1 = std::min(x0 + kTile, w), y1 = std::min(y0 + kTile, h);
             for (int y = y0; y < y1; ++y)
                 for (int x = x0; x < x1; ++x) {
-                    Vec3f target = view.pixel_point(x + 0.5f, y + 0.5f);
+                    // Sample centres on a regular grid: (x + 0.5) / sub, exactly the pixel
+                    // centre when sub = 1.
+                    Vec3f target = sub == 1 ? view.pixel_point(x + 0.5f, y + 0.5f)
+                                            : view.pixel_point((x + 0.5f) * inv_sub, (y + 0.5f) * inv_sub);
                     Vec3f dir = normalize(target - view.eye);
                     Ray ray{view.eye, dir};
                     Hit hit;
                     if (!accel.intersect(ray, hit)) {
-                        gbuffer_.distance(x, y) = inf;
-                        gbuffer_.normal(x, y) = Vec3f(0.0f);
-                        gbuffer_.colour(x, y) = settings.background;
-                        gbuffer_.material(x, y) = kNoIndex;
-                        gbuffer_.object(x, y) = kNoIndex;
+                        if (classic) {
+                            g.distance(x, y) = inf;
+                            g.normal(x, y) = Vec3f(0.0f);
+                        } else {
+                            g.view_depth(x, y) = inf;
+                            g.geometric_normal(x, y) = Vec3f(0.0f);
+                        }
+                        g.colour(x, y) = settings.background;
+                        g.material(x, y) = kNoIndex;
+                        g.object(x, y) = kNoIndex;
                         continue;
                     }
                     Vec3f n = shading_normal(scene, hit, dir);
@@ -79,11 +153,16 @@ void Renderer::trace(const Scene& scene, const TriangleAccel& accel, const ViewP
                     float len = length(to_light);
                     float l_dot_n = len > 0.0f ? dot(to_light, n) / len : 1.0f;
                     std::uint32_t m = scene.tri_material[hit.prim];
-                    gbuffer_.distance(x, y) = hit.t;
-                    gbuffer_.normal(x, y) = n;
-                    gbuffer_.colour(x, y) = scene.materials[m].kd * classic_cel_level(l_dot_n);
-                    gbuffer_.material(x, y) = m;
-                    gbuffer_.object(x, y) = scene.tri_object[hit.prim];
+                    if (classic) {
+                        g.distance(x, y) = hit.t;
+                        g.normal(x, y) = n;
+                    } else {
+                        g.view_depth(x, y) = hit.t * dot(dir, forward);
+                        g.geometric_normal(x, y) = geometric_normal(scene, hit, dir);
+                    }
+                    g.colour(x, y) = scene.materials[m].kd * classic_cel_level(l_dot_n);
+                    g.material(x, y) = m;
+                    g.object(x, y) = scene.tri_object[hit.prim];
                 }
         }
     });
@@ -93,8 +172,17 @@ const ImageRgb8& Renderer::render(const Scene& scene, const TriangleAccel& accel
                                   const CameraSpec& camera, const RenderSettings& settings) {
     ViewPlane view = make_view_plane(camera, settings.width, settings.height);
     light_ = settings.light ? *settings.light : default_light(scene, view);
-    trace(scene, accel, view, settings);
+    if (settings.edges == EdgeMode::Classic) {
+        trace(scene, accel, view, settings, 1);
+        render_classic(settings);
+    } else {
+        trace(scene, accel, view, settings, samples_per_side(settings.samples));
+        render_robust(settings);
+    }
+    return final_;
+}
 
+void Renderer::render_classic(const RenderSettings& settings) {
     const int threads = settings.threads;
     classic_depth_map(gbuffer_.distance, aovs_.depth, threads);
     classic_normal_map(gbuffer_.normal, gbuffer_.distance, aovs_.normal, threads);
@@ -102,13 +190,23 @@ const ImageRgb8& Renderer::render(const Scene& scene, const TriangleAccel& accel
     sobel_edges(aovs_.normal, settings.normal_threshold, aovs_.edges_normal, threads);
     merge_edges(aovs_.edges_depth, aovs_.edges_normal, aovs_.edges);
     compose_lines(gbuffer_.colour, aovs_.edges, final_, threads);
-
     aovs_.cel.resize(settings.width, settings.height);
     for (std::size_t i = 0; i < aovs_.cel.size(); ++i) {
         const Vec3f& c = gbuffer_.colour.data()[i];
         aovs_.cel.data()[i] = {to_byte(c.x), to_byte(c.y), to_byte(c.z)};
     }
-    return final_;
+}
+
+void Renderer::render_robust(const RenderSettings& settings) {
+    const int threads = settings.threads;
+    const GBuffer& g = gbuffer_;
+    FineBuffers fine{g.view_depth, g.geometric_normal, g.object, g.material};
+    find_line_seeds(fine, settings.lines, seeds_, threads);
+    distance_to_seeds(seeds_, distance_, threads);
+    float thickness = line_thickness(settings.lines.width, settings.height, g.sub);
+    resolve_lines(g.colour, distance_, thickness, g.sub, settings.lines.colour, final_, aovs_.cel, aovs_.edges,
+                  threads);
+    robust_feature_images(g, seeds_, aovs_, threads);
 }
 
 }  // namespace toonray

@@ -5,12 +5,16 @@
 
 #include "toonray/accel/triangle_accel.h"
 #include "toonray/core/image.h"
+#include "toonray/render/robust.h"
 #include "toonray/scene/camera.h"
 #include "toonray/scene/scene.h"
 
 namespace toonray {
 
-enum class EdgeMode { Classic };
+enum class EdgeMode {
+    Robust,   ///< the default: supersampled, plane-aware, resolution-independent lines
+    Classic,  ///< the seed's pipeline, exactly: Sobel on 8-bit depth and normal maps
+};
 
 struct RenderSettings {
     int width = 1280;
@@ -18,29 +22,41 @@ struct RenderSettings {
     std::optional<Vec3f> light;  ///< point light; default: the eye moved by half the scene
                                  ///< radius along the camera's up and right
     Vec3f background{1.0f};      ///< colour of pixels that hit nothing
-    EdgeMode edges = EdgeMode::Classic;
+    EdgeMode edges = EdgeMode::Robust;
     float depth_threshold = 8.0f;   ///< classic: Sobel magnitude on the 8-bit depth map
     float normal_threshold = 4.0f;  ///< classic: Sobel magnitude on the 8-bit normal map
+    RobustLineSettings lines;       ///< robust: line types, thresholds, width, colour
+    int samples = 4;                ///< robust: samples per pixel on a regular grid (1, 4, 9 or 16)
     int threads = 0;                ///< 0 = all hardware threads
 };
 
-/// Per-pixel results of the primary rays.
+/// Sub-samples per pixel side for a sample count: 1, 4, 9, 16 -> 1, 2, 3, 4. Throws Error otherwise.
+int samples_per_side(int samples);
+
+/// Per-sample results of the primary rays. Classic mode fills distance and normal; robust mode
+/// fills view_depth and geometric_normal, on a grid `sub` times finer than the image.
 struct GBuffer {
-    ImageF distance;        ///< Euclidean distance from the eye; +inf where the ray misses
-    Image<Vec3f> normal;    ///< shading normal facing the viewer; zero where the ray misses
-    Image<Vec3f> colour;    ///< cel-shaded colour (background where the ray misses)
-    Image<std::uint32_t> material;  ///< kNoIndex where the ray misses
-    Image<std::uint32_t> object;    ///< kNoIndex where the ray misses
+    int sub = 1;                       ///< samples per pixel side
+    ImageF distance;                   ///< Euclidean distance from the eye; +inf where the ray misses
+    Image<Vec3f> normal;               ///< shading normal facing the viewer; zero where the ray misses
+    ImageF view_depth;                 ///< distance along the view direction; +inf where it misses
+    Image<Vec3f> geometric_normal;     ///< facing the viewer; zero where the ray misses
+    Image<Vec3f> colour;               ///< cel-shaded colour (background where the ray misses)
+    Image<std::uint32_t> material;     ///< kNoIndex where the ray misses
+    Image<std::uint32_t> object;       ///< kNoIndex where the ray misses
 };
 
-/// Feature images a user tunes thresholds with; all 8-bit.
+/// Feature images a user tunes thresholds with; all 8-bit. Which are filled depends on the
+/// line mode (see aov names in render_file.h).
 struct Aovs {
     ImageGray8 depth;         ///< lighter = farther
     ImageRgb8 normal;
-    ImageGray8 edges_depth;   ///< black lines on white
-    ImageGray8 edges_normal;
-    ImageGray8 edges;         ///< merged, before blur
+    ImageGray8 edges_depth;   ///< classic: Sobel lines of the depth map, black on white
+    ImageGray8 edges_normal;  ///< classic: Sobel lines of the normal map
+    ImageGray8 edges;         ///< all lines: classic merged before blur; robust coverage
     ImageRgb8 cel;            ///< colour without lines
+    ImageGray8 lines_silhouette, lines_crease, lines_depth, lines_object, lines_material;  ///< robust
+    ImageRgb8 object_id, material_id;  ///< robust: ids in false colour
 };
 
 /// Renders frames, keeping its buffers between calls so an animation allocates once.
@@ -56,14 +72,20 @@ public:
     [[nodiscard]] const Aovs& aovs() const { return aovs_; }
     /// Light position used for the last frame.
     [[nodiscard]] Vec3f light() const { return light_; }
+    /// Robust mode: the line seeds of the last frame on the fine grid (LineType bits).
+    [[nodiscard]] const Image<std::uint8_t>& line_seeds() const { return seeds_; }
 
 private:
     void trace(const Scene& scene, const TriangleAccel& accel, const ViewPlane& view,
-               const RenderSettings& settings);
+               const RenderSettings& settings, int sub);
+    void render_classic(const RenderSettings& settings);
+    void render_robust(const RenderSettings& settings);
 
     GBuffer gbuffer_;
     Aovs aovs_;
     ImageRgb8 final_;
+    Image<std::uint8_t> seeds_;
+    ImageF distance_;
     Vec3f light_;
 };
 

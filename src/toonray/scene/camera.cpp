@@ -37,6 +37,7 @@ ViewPlane make_view_plane(const CameraSpec& camera, int width, int height) {
     plane.step_y = (ll - ul) / static_cast<float>(height);
     plane.right = right;
     plane.up = normalize(cross(right, view_dir));
+    plane.forward = view_dir / view_len;
     return plane;
 }
 

@@ -1,0 +1,74 @@
+#pragma once
+/// The robust line mode (`--edges robust`, the default): lines found on a supersampled G-buffer
+/// by tests that do not misfire on planes at grazing angles or on finely tessellated meshes,
+/// drawn with a width that scales with the image height, and anti-aliased by filtering the
+/// fine grid down. Everything is on a fixed sub-pixel grid, so animations do not flicker.
+
+#include <cstdint>
+#include <string>
+
+#include "toonray/core/image.h"
+#include "toonray/core/math.h"
+
+namespace toonray {
+
+/// Line types, combinable as bits (`--lines silhouette,crease,depth,object,material`).
+enum LineType : unsigned {
+    kLineSilhouette = 1u << 0,  ///< surface next to background, or a large jump in depth
+    kLineCrease = 1u << 1,      ///< geometric normals of neighbours differ by more than the crease angle
+    kLineDepth = 1u << 2,       ///< a step in depth where the surface is not a continuous plane or slope
+    kLineObject = 1u << 3,      ///< neighbours belong to different objects
+    kLineMaterial = 1u << 4,    ///< neighbours have different materials
+    kLineAll = 31u,
+};
+
+/// Parses "silhouette,crease,depth,object,material" (any subset, or "all" / "none").
+unsigned parse_line_types(const std::string& text);
+
+struct RobustLineSettings {
+    unsigned types = kLineAll;
+    float crease_angle = 40.0f;      ///< degrees between neighbouring geometric normals
+    /// Depth lines where |second difference of 1/z| / (1/z) exceeds this. 1/z is linear in
+    /// screen space across any plane, so planes never cross it however steep the view.
+    float depth_threshold = 0.02f;
+    /// Silhouette lines where neighbouring depths differ by more than this fraction of the nearer.
+    float silhouette_ratio = 0.1f;
+    float width = 2.0f;              ///< line width in pixels at 720 lines; scales with image height
+    Vec3f colour{0.0f};
+};
+
+/// The fine-grid inputs of the line tests; misses have depth +inf.
+struct FineBuffers {
+    const ImageF& depth;                   ///< view-space depth z (along the view direction)
+    const Image<Vec3f>& geometric_normal;  ///< unit, facing the viewer; zero where the ray misses
+    const Image<std::uint32_t>& object;
+    const Image<std::uint32_t>& material;
+};
+
+/// Marks line seeds: each fine pixel gets the bits of the line types found between it and a
+/// 4-neighbour, on the nearer of the two (the foreground owns the line). 0 = no line.
+void find_line_seeds(const FineBuffers& fine, const RobustLineSettings& settings, Image<std::uint8_t>& seeds,
+                     int threads);
+
+/// Squared Euclidean distance (in fine pixels) from every pixel to the nearest non-zero seed
+/// (Felzenszwalb and Huttenlocher's linear-time transform, exact). +inf where there is none.
+void distance_to_seeds(const Image<std::uint8_t>& seeds, ImageF& squared_distance, int threads);
+
+/// Line thickness in fine pixels for `width` (pixels at 720 lines), an image `height` pixels
+/// tall and `sub` x `sub` samples per pixel: width * height / 720 * sub.
+float line_thickness(float width, int height, int sub);
+
+/// Filters the fine grid down. A fine sample at distance d from the nearest seed is covered by
+/// clamp(thickness / 2 + 0.5 - d, 0, 1), which integrates to exactly `thickness` across a
+/// straight line, so widths scale smoothly with resolution; a pixel's coverage is the mean
+/// over its samples, and its colour the mean fine colour. Writes
+/// final = colour * (1 - coverage) + line * coverage, the mean colour (`cel`) and the
+/// coverage as 8-bit (`lines`, 255 = no line: black lines on white).
+void resolve_lines(const Image<Vec3f>& fine_colour, const ImageF& squared_distance, float thickness, int sub,
+                   const Vec3f& line_colour, ImageRgb8& final_image, ImageRgb8& cel, ImageGray8& lines,
+                   int threads);
+
+/// One line type's seeds filtered down to pixels (255 = none, 0 = a seed in every sample), for AOVs.
+void resolve_seed_type(const Image<std::uint8_t>& seeds, unsigned type, int sub, ImageGray8& out, int threads);
+
+}  // namespace toonray
