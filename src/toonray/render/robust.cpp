@@ -16,6 +16,7 @@ namespace {
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
 constexpr int kRowGrain = 16;
+constexpr float kTieTolerance = 1e-5f;
 
 // 1-D squared distance transform of f (n samples, +inf = no seed) into d, using v and z as
 // scratch (Felzenszwalb & Huttenlocher 2012, "Distance Transforms of Sampled Functions").
@@ -82,15 +83,15 @@ void find_line_seeds(const FineBuffers& fine, const RobustLineSettings& s, Image
     const float cos_crease = std::cos(s.crease_angle * 3.14159265f / 180.0f);
     const unsigned types = s.types;
 
-    // The line bits between 4-neighbours a and b (the caller decides which one gets them).
+    // The line bits between 4-neighbours a and b that need no depth test: background next to
+    // a surface, different objects or materials, a crease. (Which of the two gets them is
+    // decided by the caller.)
     auto pair_bits = [&](int ax, int ay, int bx, int by) -> unsigned {
         float za = fine.depth(ax, ay), zb = fine.depth(bx, by);
         bool hit_a = za != kInf, hit_b = zb != kInf;
         if (!hit_a && !hit_b) return 0;
-        unsigned bits = 0;
         if (hit_a != hit_b) return types & kLineSilhouette;
-        if ((types & kLineSilhouette) && std::abs(za - zb) > s.silhouette_ratio * std::min(za, zb))
-            bits |= kLineSilhouette;
+        unsigned bits = 0;
         if ((types & kLineObject) && fine.object(ax, ay) != fine.object(bx, by)) bits |= kLineObject;
         if ((types & kLineMaterial) && fine.material(ax, ay) != fine.material(bx, by)) bits |= kLineMaterial;
         if ((types & kLineCrease) &&
@@ -99,24 +100,30 @@ void find_line_seeds(const FineBuffers& fine, const RobustLineSettings& s, Image
         return bits;
     };
 
-    // Depth: second difference of 1/z across the pixel, along x and along y, relative to 1/z.
-    // Zero on any plane (1/z is affine in screen space for a pinhole camera) however steep the
-    // view, large at a step. The seed goes on the near side only: the neighbour across the
-    // larger jump in 1/z must be the farther one.
-    auto depth_bit = [&](int x, int y) -> bool {
+    // Depth discontinuities: the second difference of 1/z across the pixel, along x and along
+    // y, relative to 1/z. It is zero on any plane (1/z is affine in screen space for a pinhole
+    // camera) however steep the view, and large at a step. The seed goes on the near side only
+    // (the neighbour across the larger jump in 1/z is the farther one). A step by more than
+    // silhouette_ratio of the depth is a silhouette (one thing in front of another), a smaller
+    // one a depth line (a fold of the same surface).
+    auto depth_bits = [&](int x, int y) -> unsigned {
         float z = fine.depth(x, y);
-        if (z == kInf) return false;
+        if (z == kInf) return 0;
         const float inv = 1.0f / z;
-        auto along = [&](int x0, int y0, int x1, int y1) -> bool {
+        float farthest_step = -1.0f;  // (z_far - z) / z of the largest near-side step found
+        auto along = [&](int x0, int y0, int x1, int y1) {
             float z0 = fine.depth(x0, y0), z1 = fine.depth(x1, y1);
-            if (z0 == kInf || z1 == kInf) return false;  // silhouettes handle misses
+            if (z0 == kInf || z1 == kInf) return;  // silhouettes against the background are found above
             float i0 = 1.0f / z0, i1 = 1.0f / z1;
-            if (!(std::abs(i0 - 2.0f * inv + i1) > s.depth_threshold * inv)) return false;
-            float across = std::abs(i0 - inv) > std::abs(i1 - inv) ? i0 : i1;
-            return across < inv;  // smaller 1/z: farther
+            if (!(std::abs(i0 - 2.0f * inv + i1) > s.depth_threshold * inv)) return;
+            bool first = std::abs(i0 - inv) > std::abs(i1 - inv);
+            float z_across = first ? z0 : z1;
+            if (z_across > z) farthest_step = std::max(farthest_step, (z_across - z) / z);
         };
-        return (x > 0 && x + 1 < w && along(x - 1, y, x + 1, y)) ||
-               (y > 0 && y + 1 < h && along(x, y - 1, x, y + 1));
+        if (x > 0 && x + 1 < w) along(x - 1, y, x + 1, y);
+        if (y > 0 && y + 1 < h) along(x, y - 1, x, y + 1);
+        if (farthest_step < 0.0f) return 0;
+        return types & (farthest_step > s.silhouette_ratio ? kLineSilhouette : kLineDepth);
     };
 
     parallel_for(h, kRowGrain, threads, [&](int y0, int y1) {
@@ -130,13 +137,17 @@ void find_line_seeds(const FineBuffers& fine, const RobustLineSettings& s, Image
                     if (nx[i] < 0 || nx[i] >= w || ny[i] < 0 || ny[i] >= h) continue;
                     unsigned b = pair_bits(x, y, nx[i], ny[i]);
                     if (!b) continue;
-                    // Ties (equal depth: a crease or an id boundary on one surface) go to the
-                    // pixel that comes first in scan order, so each boundary is marked once.
+                    // The nearer pixel owns the line. Depths within a hair of each other (a
+                    // crease or an id boundary on one surface, where rounding decides which
+                    // is "nearer") count as equal and go to the pixel first in scan order,
+                    // so such lines come out straight rather than hopping sides.
                     float z_self = fine.depth(x, y), z_other = fine.depth(nx[i], ny[i]);
-                    bool mine = z_self < z_other || (z_self == z_other && (ny[i] > y || (ny[i] == y && nx[i] > x)));
+                    bool tie = std::abs(z_self - z_other) <= kTieTolerance * std::min(z_self, z_other);
+                    bool first_in_scan = ny[i] > y || (ny[i] == y && nx[i] > x);
+                    bool mine = tie ? first_in_scan : z_self < z_other;
                     if (mine) bits |= b;
                 }
-                if ((types & kLineDepth) && depth_bit(x, y)) bits |= kLineDepth;
+                bits |= depth_bits(x, y);
                 seeds(x, y) = static_cast<std::uint8_t>(bits);
             }
     });

@@ -14,7 +14,7 @@ namespace toonray {
 
 /// Line types, combinable as bits (`--lines silhouette,crease,depth,object,material`).
 enum LineType : unsigned {
-    kLineSilhouette = 1u << 0,  ///< surface next to background, or a large jump in depth
+    kLineSilhouette = 1u << 0,  ///< surface next to background, or in front of something much farther
     kLineCrease = 1u << 1,      ///< geometric normals of neighbours differ by more than the crease angle
     kLineDepth = 1u << 2,       ///< a step in depth where the surface is not a continuous plane or slope
     kLineObject = 1u << 3,      ///< neighbours belong to different objects
@@ -31,7 +31,8 @@ struct RobustLineSettings {
     /// Depth lines where |second difference of 1/z| / (1/z) exceeds this. 1/z is linear in
     /// screen space across any plane, so planes never cross it however steep the view.
     float depth_threshold = 0.02f;
-    /// Silhouette lines where neighbouring depths differ by more than this fraction of the nearer.
+    /// A depth discontinuity larger than this fraction of the nearer depth is a silhouette
+    /// (one thing in front of another) rather than a depth line (a fold of one surface).
     float silhouette_ratio = 0.1f;
     float width = 2.0f;              ///< line width in pixels at 720 lines; scales with image height
     Vec3f colour{0.0f};

@@ -1,0 +1,434 @@
+// The robust line mode measured on scenes built in code where the right answer is known.
+#include "toonray/render/robust.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <functional>
+#include <set>
+#include <vector>
+
+#include "toonray/core/error.h"
+#include "toonray/render/renderer.h"
+
+using namespace toonray;
+
+namespace {
+
+constexpr float kPi = 3.14159265f;
+
+struct Frame {
+    Renderer renderer;
+    RenderSettings settings;
+    CameraSpec camera;
+    ViewPlane view;
+};
+
+void render(Frame& f, const Scene& scene) {
+    TriangleAccel accel;
+    accel.build(scene.positions, scene.tri_positions);
+    f.view = make_view_plane(f.camera, f.settings.width, f.settings.height);
+    f.renderer.render(scene, accel, f.camera, f.settings);
+}
+
+// Line coverage of pixel (x, y) in [0, 1]: robust from the coverage image, classic from the
+// merged edge image (1 on an edge).
+float coverage(const Frame& f, int x, int y) {
+    return 1.0f - f.renderer.aovs().edges(x, y) / 255.0f;
+}
+
+// Pixel coordinates (continuous, pixel centres at +0.5) of a world point.
+Vec2f project(const ViewPlane& v, const Vec3f& p) {
+    Vec3f d = p - v.eye;
+    // The image plane holds upper_left; intersect the ray eye -> p with it.
+    float s = dot(v.upper_left - v.eye, v.forward) / dot(d, v.forward);
+    Vec3f q = v.eye + d * s - v.upper_left;
+    return {dot(q, v.step_x) / dot(v.step_x, v.step_x), dot(q, v.step_y) / dot(v.step_y, v.step_y)};
+}
+
+CameraSpec look_at(const Vec3f& eye, const Vec3f& target, float fov_degrees, const Vec3f& world_up = {0, 1, 0}) {
+    Vec3f fwd = normalize(target - eye);
+    Vec3f right = normalize(cross(fwd, world_up));
+    Vec3f up = cross(right, fwd);
+    float dist = 1.0f / std::tan(fov_degrees * kPi / 360.0f);
+    return {eye, eye + fwd * dist, up};
+}
+
+// A mesh of unit voxels: faces between a filled and an empty cell, all vertices on the integer
+// grid, so faces share whole edges (no T-junctions). `material_of(x, y, z)` picks the material.
+Scene voxels(const std::vector<std::array<int, 3>>& cells, float scale,
+             const std::function<std::uint32_t(int, int, int)>& material_of = nullptr) {
+    std::set<std::array<int, 3>> filled(cells.begin(), cells.end());
+    Scene s;
+    for (const char* name : {"red", "blue"}) {
+        Material m(name);
+        m.kd = std::string(name) == "red" ? Vec3f(0.9f, 0.3f, 0.3f) : Vec3f(0.3f, 0.4f, 0.9f);
+        s.materials.push_back(m);
+    }
+    for (const auto& c : cells)
+        for (int axis = 0; axis < 3; ++axis)
+            for (int side = 0; side < 2; ++side) {
+                std::array<int, 3> n = c;
+                n[axis] += side ? 1 : -1;
+                if (filled.count(n)) continue;
+                // The face on the plane axis = c[axis] + side, spanned by the other two axes.
+                int a = (axis + 1) % 3, b = (axis + 2) % 3;
+                auto base = static_cast<std::uint32_t>(s.positions.size());
+                for (int k = 0; k < 4; ++k) {
+                    std::array<float, 3> p{float(c[0]), float(c[1]), float(c[2])};
+                    p[axis] += side;
+                    p[a] += (k == 1 || k == 2) ? 1 : 0;
+                    p[b] += (k >= 2) ? 1 : 0;
+                    s.positions.push_back(Vec3f(p[0], p[1], p[2]) * scale);
+                }
+                std::uint32_t m = material_of ? material_of(c[0], c[1], c[2]) : 1;
+                s.add_triangle({base, base + 1, base + 2}, m, 0);
+                s.add_triangle({base, base + 2, base + 3}, m, 0);
+            }
+    return s;
+}
+
+// Visible samples along a 3D segment, projected; ends within `margin` pixels are skipped.
+std::vector<Vec2f> visible_samples(const Frame& f, const Scene& scene, Vec3f a, Vec3f b, float margin) {
+    TriangleAccel accel;
+    accel.build(scene.positions, scene.tri_positions);
+    std::vector<Vec2f> out;
+    Vec2f pa = project(f.view, a), pb = project(f.view, b);
+    float len = std::hypot(pb.x - pa.x, pb.y - pa.y);
+    int n = std::max(2, static_cast<int>(len));
+    for (int i = 0; i <= n; ++i) {
+        float u = static_cast<float>(i) / n;
+        if (u * len < margin || (1 - u) * len < margin) continue;
+        Vec3f p = a + (b - a) * u;
+        Vec2f q = project(f.view, p);
+        if (q.x < 2 || q.y < 2 || q.x > f.settings.width - 2 || q.y > f.settings.height - 2) continue;
+        // Visible when nothing is hit well before the point.
+        Vec3f d = p - f.view.eye;
+        float dist = length(d);
+        Hit hit;
+        Ray ray{f.view.eye, d / dist, dist * (1.0f - 1e-3f)};
+        if (accel.intersect(ray, hit)) continue;
+        out.push_back(q);
+    }
+    return out;
+}
+
+// Largest coverage within one pixel of a continuous position.
+float coverage_near(const Frame& f, Vec2f q) {
+    float best = 0.0f;
+    int cx = static_cast<int>(q.x), cy = static_cast<int>(q.y);
+    for (int y = cy - 1; y <= cy + 1; ++y)
+        for (int x = cx - 1; x <= cx + 1; ++x)
+            if (x >= 0 && y >= 0 && x < f.settings.width && y < f.settings.height)
+                best = std::max(best, coverage(f, x, y));
+    return best;
+}
+
+// Fraction of samples along the edges that are drawn.
+float drawn_fraction(const Frame& f, const Scene& scene, const std::vector<std::pair<Vec3f, Vec3f>>& edges,
+                     int* samples_out = nullptr) {
+    int samples = 0, drawn = 0;
+    for (const auto& [a, b] : edges)
+        for (Vec2f q : visible_samples(f, scene, a, b, 3.0f)) {
+            ++samples;
+            if (coverage_near(f, q) > 0.5f) ++drawn;
+            else if (std::getenv("TOONRAY_DEBUG_LINES")) std::printf("undrawn sample at %.2f %.2f\n", q.x, q.y);
+        }
+    if (samples_out) *samples_out = samples;
+    return samples ? static_cast<float>(drawn) / samples : 0.0f;
+}
+
+// Pixels whose every sample hits, and no pixel within `margin` misses.
+std::vector<std::pair<int, int>> interior_pixels(const Frame& f, int margin) {
+    const GBuffer& g = f.renderer.gbuffer();
+    const int sub = g.sub, w = f.settings.width, h = f.settings.height;
+    auto hit = [&](int x, int y) {
+        for (int j = 0; j < sub; ++j)
+            for (int i = 0; i < sub; ++i)
+                if (g.material(x * sub + i, y * sub + j) == kNoIndex) return false;
+        return true;
+    };
+    std::vector<std::pair<int, int>> out;
+    for (int y = margin; y < h - margin; ++y)
+        for (int x = margin; x < w - margin; ++x) {
+            bool inside = true;
+            for (int dy = -margin; dy <= margin && inside; ++dy)
+                for (int dx = -margin; dx <= margin && inside; ++dx) inside = hit(x + dx, y + dy);
+            if (inside) out.emplace_back(x, y);
+        }
+    return out;
+}
+
+Scene floor_plane(float half, int cells) {
+    Scene s;
+    for (int j = 0; j <= cells; ++j)
+        for (int i = 0; i <= cells; ++i)
+            s.positions.push_back({-half + 2 * half * i / cells, 0.0f, -half + 2 * half * j / cells});
+    for (int j = 0; j < cells; ++j)
+        for (int i = 0; i < cells; ++i) {
+            std::uint32_t a = j * (cells + 1) + i, b = a + 1, c = a + cells + 1, d = c + 1;
+            s.add_triangle({a, c, b}, 0, 0);
+            s.add_triangle({b, c, d}, 0, 0);
+        }
+    return s;
+}
+
+Scene sphere(int segments, int rings, float r) {
+    Scene s;
+    for (int j = 0; j <= rings; ++j) {
+        float phi = kPi * j / rings;
+        for (int i = 0; i < segments; ++i) {
+            float theta = 2 * kPi * i / segments;
+            s.positions.push_back({r * std::sin(phi) * std::cos(theta), r * std::cos(phi), r * std::sin(phi) * std::sin(theta)});
+        }
+    }
+    for (int j = 0; j < rings; ++j)
+        for (int i = 0; i < segments; ++i) {
+            std::uint32_t a = j * segments + i, b = j * segments + (i + 1) % segments;
+            std::uint32_t c = a + segments, d = b + segments;
+            if (j > 0) s.add_triangle({a, b, c}, 0, 0);
+            if (j < rings - 1) s.add_triangle({b, d, c}, 0, 0);
+        }
+    return s;
+}
+
+}  // namespace
+
+TEST(RobustLines, GrazingPlaneHasNoLinesInside) {
+    // A tessellated floor seen at 80 to 89 degrees from its normal: no line may appear inside
+    // it, in robust mode. Classic mode is measured for comparison (its depth threshold fires).
+    Scene floor = floor_plane(500.0f, 60);
+    for (float angle : {80.0f, 85.0f, 89.0f}) {
+        float a = angle * kPi / 180.0f;
+        // Looking down at the floor with the view direction `angle` from the normal (+y).
+        Vec3f dir(0.0f, -std::cos(a), -std::sin(a));
+        Vec3f eye(0.0f, 2.0f, 0.0f);
+        int false_lines[2] = {0, 0};
+        for (EdgeMode mode : {EdgeMode::Classic, EdgeMode::Robust}) {
+            Frame f;
+            f.settings.width = 320;
+            f.settings.height = 180;
+            f.settings.edges = mode;
+            f.settings.light = Vec3f(0, 1000, 0);
+            f.camera = look_at(eye, eye + dir, 60.0f, {0, 1, 0});
+            render(f, floor);
+            auto inside = interior_pixels(f, 3);
+            ASSERT_GT(inside.size(), 3000u) << angle;
+            int lines = 0;
+            for (auto [x, y] : inside)
+                if (coverage(f, x, y) > 0.0f) ++lines;
+            false_lines[mode == EdgeMode::Robust] = lines;
+        }
+        std::printf("grazing plane at %.0f deg: false line pixels classic %d, robust %d\n", angle, false_lines[0],
+                    false_lines[1]);
+        EXPECT_EQ(false_lines[1], 0) << angle;
+    }
+}
+
+TEST(RobustLines, TessellatedSphereHasLinesOnlyAtItsSilhouette) {
+    // 40,000 triangles, no vertex normals: robust lines only near the silhouette, and all of it.
+    Scene ball = sphere(200, 101, 1.0f);
+    ASSERT_GT(ball.triangle_count(), 39000u);
+    int false_lines[2] = {0, 0};
+    for (EdgeMode mode : {EdgeMode::Classic, EdgeMode::Robust}) {
+        Frame f;
+        f.settings.width = 640;
+        f.settings.height = 360;
+        f.settings.edges = mode;
+        f.camera = look_at({0.3f, 0.8f, 4.0f}, {0, 0, 0}, 45.0f);
+        render(f, ball);
+        const GBuffer& g = f.renderer.gbuffer();
+        const int sub = g.sub;
+        // Distance of each pixel to the silhouette, from the per-pixel hit mask.
+        auto hit = [&](int x, int y) { return g.material(x * sub + sub / 2, y * sub + sub / 2) != kNoIndex; };
+        const float width = f.settings.lines.width;  // pixels at 720 lines
+        const int near = static_cast<int>(std::ceil(width * f.settings.height / 720.0f)) + 1;
+        int silhouette = 0, silhouette_drawn = 0;
+        for (int y = near; y < f.settings.height - near; ++y)
+            for (int x = near; x < f.settings.width - near; ++x) {
+                bool near_miss = false, near_hit = false;
+                for (int dy = -near; dy <= near; ++dy)
+                    for (int dx = -near; dx <= near; ++dx) (hit(x + dx, y + dy) ? near_hit : near_miss) = true;
+                float c = coverage(f, x, y);
+                if (hit(x, y) && !near_miss && c > 0.0f) ++false_lines[mode == EdgeMode::Robust];
+                // Silhouette pixels: a hit with a miss as a 4-neighbour.
+                if (hit(x, y) && (!hit(x - 1, y) || !hit(x + 1, y) || !hit(x, y - 1) || !hit(x, y + 1))) {
+                    ++silhouette;
+                    if (coverage_near(f, {x + 0.5f, y + 0.5f}) > 0.5f) ++silhouette_drawn;
+                }
+            }
+        if (mode == EdgeMode::Robust) {
+            EXPECT_GT(silhouette, 500);
+            EXPECT_EQ(silhouette_drawn, silhouette) << "silhouette incomplete";
+        }
+    }
+    std::printf("tessellated sphere: line pixels away from the silhouette: classic %d, robust %d\n",
+                false_lines[0], false_lines[1]);
+    EXPECT_EQ(false_lines[1], 0);
+}
+
+TEST(RobustLines, EveryVisibleCreaseOfACubeAndAStairIsDrawn) {
+    Frame f;
+    f.settings.width = 960;
+    f.settings.height = 720;
+    // A cube seen from a corner: three faces, nine visible edges; the three that meet at the
+    // near corner are creases between visible faces, the other six its outline.
+    Scene cube = voxels({{0, 0, 0}}, 1.0f);
+    f.camera = look_at({2.6f, 2.1f, 3.0f}, {0.5f, 0.5f, 0.5f}, 40.0f);
+    render(f, cube);
+    std::vector<std::pair<Vec3f, Vec3f>> edges, inner;
+    for (int axis = 0; axis < 3; ++axis)
+        for (int i = 0; i < 4; ++i) {
+            Vec3f a(0.0f), b(0.0f);
+            a[(axis + 1) % 3] = b[(axis + 1) % 3] = float(i & 1);
+            a[(axis + 2) % 3] = b[(axis + 2) % 3] = float(i >> 1);
+            b[axis] = 1.0f;
+            edges.push_back({a, b});
+            if (i == 3) inner.push_back({a, b});  // the edges through the corner (1, 1, 1)
+        }
+    int samples = 0;
+    float cube_drawn = drawn_fraction(f, cube, edges, &samples);
+    EXPECT_GT(samples, 1000);
+    EXPECT_EQ(cube_drawn, 1.0f);
+    f.settings.lines.types = kLineCrease;  // creases alone find the inner three
+    render(f, cube);
+    EXPECT_EQ(drawn_fraction(f, cube, inner, &samples), 1.0f);
+    EXPECT_GT(samples, 300);
+
+    // A staircase of voxels: convex and concave creases.
+    std::vector<std::array<int, 3>> cells;
+    for (int z = 0; z < 2; ++z)
+        for (int step = 0; step < 3; ++step)
+            for (int x = 0; x < 3 - step; ++x) cells.push_back({x, step, z});
+    Scene stair = voxels(cells, 1.0f);
+    Frame g;
+    g.settings = f.settings;
+    g.camera = look_at({5.5f, 4.5f, 6.0f}, {1.5f, 1.2f, 1.0f}, 45.0f);
+    render(g, stair);
+    std::vector<std::pair<Vec3f, Vec3f>> stair_edges;
+    for (int step = 0; step < 3; ++step) {
+        float x = 3.0f - step, y = step + 1.0f;
+        stair_edges.push_back({{x, y, 0}, {x, y, 2}});                  // convex nosing
+        stair_edges.push_back({{x, y - 1, 2}, {x, y, 2}});              // riser, front side edge
+        if (step < 2) stair_edges.push_back({{x - 1, y, 0}, {x - 1, y, 2}});  // concave foot of the next riser
+        stair_edges.push_back({{x - 1, y, 2}, {x, y, 2}});              // tread, front side edge
+    }
+    float stair_drawn = drawn_fraction(g, stair, stair_edges, &samples);
+    EXPECT_GT(samples, 300);
+    EXPECT_EQ(stair_drawn, 1.0f);
+}
+
+TEST(RobustLines, BoundariesBetweenMaterialsAndObjects) {
+    // Two unit boxes side by side, touching at x = 1, their front faces coplanar: nothing but
+    // the material (or object) change marks the boundary.
+    std::vector<std::array<int, 3>> cells = {{0, 0, 0}, {1, 0, 0}};
+    Scene two = voxels(cells, 1.0f, [](int x, int, int) { return x == 0 ? 1u : 2u; });
+    Frame f;
+    f.settings.width = 960;
+    f.settings.height = 720;
+    f.camera = look_at({1.0f, 0.5f, 4.0f}, {1.0f, 0.5f, 0.0f}, 40.0f);  // straight at the front
+    render(f, two);
+    std::vector<std::pair<Vec3f, Vec3f>> boundary = {{{1, 0, 1}, {1, 1, 1}}};
+    EXPECT_EQ(drawn_fraction(f, two, boundary), 1.0f);
+    // Without the material lines, or with one material, there is no line there.
+    f.settings.lines.types = kLineAll & ~kLineMaterial;
+    render(f, two);
+    EXPECT_EQ(drawn_fraction(f, two, boundary), 0.0f);
+    Scene same = voxels(cells, 1.0f);
+    f.settings.lines.types = kLineAll;
+    render(f, same);
+    EXPECT_EQ(drawn_fraction(f, same, boundary), 0.0f);
+    // Two objects of one material: the object lines mark it.
+    for (std::size_t t = 0; t < same.triangle_count(); ++t)
+        same.tri_object[t] = same.positions[same.tri_positions[t][0]].x + same.positions[same.tri_positions[t][1]].x +
+                                         same.positions[same.tri_positions[t][2]].x > 3.0f ? 1u : 0u;
+    same.objects.push_back("right");
+    render(f, same);
+    EXPECT_EQ(drawn_fraction(f, same, boundary), 1.0f);
+}
+
+TEST(RobustLines, WidthScalesWithResolution) {
+    // The same cube at 720p and 2160p: lines three times as wide (within 15%). Width is total
+    // coverage over line length, and length itself scales by 3.
+    Scene cube = voxels({{0, 0, 0}}, 1.0f);
+    double total[2] = {0, 0};
+    int i = 0;
+    for (int height : {720, 2160}) {
+        Frame f;
+        f.settings.width = height * 16 / 9;
+        f.settings.height = height;
+        f.settings.samples = 1;  // keeps the 4K G-buffer small; widths do not depend on it
+        f.camera = look_at({2.6f, 2.1f, 3.0f}, {0.5f, 0.5f, 0.5f}, 40.0f);
+        render(f, cube);
+        for (int y = 0; y < height; ++y)
+            for (int x = 0; x < f.settings.width; ++x) total[i] += coverage(f, x, y);
+        ++i;
+    }
+    double width_ratio = total[1] / total[0] / 3.0;
+    std::printf("line width 2160p / 720p = %.3f (ideal 3)\n", width_ratio);
+    EXPECT_NEAR(width_ratio, 3.0, 0.45);
+}
+
+TEST(RobustLines, LinesChangeSmoothlyUnderASlowCameraMove) {
+    // Ten frames of a slow orbit around a tessellated sphere on a stepped block: the amount of
+    // line in each frame stays within a small fraction of its neighbours' mean (no flicker).
+    std::vector<std::array<int, 3>> cells;
+    for (int x = -2; x < 2; ++x)
+        for (int z = -2; z < 2; ++z) cells.push_back({x, -1, z});
+    cells.push_back({-2, 0, -2});
+    cells.push_back({1, 0, 1});
+    Scene scene = voxels(cells, 1.0f);
+    Scene ball = sphere(64, 33, 0.8f);
+    auto base = static_cast<std::uint32_t>(scene.positions.size());
+    for (const Vec3f& p : ball.positions) scene.positions.push_back(p + Vec3f(0, 0.8f, 0));
+    for (std::size_t t = 0; t < ball.triangle_count(); ++t) {
+        auto tri = ball.tri_positions[t];
+        scene.add_triangle({tri[0] + base, tri[1] + base, tri[2] + base}, 2, 0);
+    }
+    std::vector<double> amount;
+    for (int frame = 0; frame < 10; ++frame) {
+        float a = 0.6f + 0.004f * frame;  // about a quarter of a degree per frame
+        Frame f;
+        f.settings.width = 480;
+        f.settings.height = 270;
+        f.camera = look_at({6.0f * std::sin(a), 3.5f, 6.0f * std::cos(a)}, {0, 0.3f, 0}, 45.0f);
+        render(f, scene);
+        double sum = 0;
+        for (int y = 0; y < f.settings.height; ++y)
+            for (int x = 0; x < f.settings.width; ++x) sum += coverage(f, x, y);
+        amount.push_back(sum);
+    }
+    double worst = 0;
+    for (int i = 1; i + 1 < 10; ++i) {
+        double mean = 0.5 * (amount[i - 1] + amount[i + 1]);
+        worst = std::max(worst, std::abs(amount[i] - mean) / mean);
+    }
+    std::printf("slow camera move: largest deviation of a frame's line amount from its neighbours' mean: %.4f\n",
+                worst);
+    EXPECT_LT(worst, 0.01);
+}
+
+TEST(RobustLines, ParsesLineTypes) {
+    EXPECT_EQ(parse_line_types("all"), static_cast<unsigned>(kLineAll));
+    EXPECT_EQ(parse_line_types("none"), 0u);
+    EXPECT_EQ(parse_line_types("silhouette,crease"), static_cast<unsigned>(kLineSilhouette | kLineCrease));
+    EXPECT_THROW(parse_line_types("silhouette,outline"), Error);
+}
+
+TEST(RobustLines, DistanceTransformIsExact) {
+    Image<std::uint8_t> seeds(9, 7, 0);
+    seeds(2, 3) = 1;
+    seeds(7, 1) = 4;
+    ImageF d;
+    distance_to_seeds(seeds, d, 1);
+    for (int y = 0; y < 7; ++y)
+        for (int x = 0; x < 9; ++x) {
+            float a = float((x - 2) * (x - 2) + (y - 3) * (y - 3)), b = float((x - 7) * (x - 7) + (y - 1) * (y - 1));
+            EXPECT_EQ(d(x, y), std::min(a, b)) << x << "," << y;
+        }
+    Image<std::uint8_t> none(4, 4, 0);
+    distance_to_seeds(none, d, 1);
+    EXPECT_TRUE(std::isinf(d(2, 2)));
+}
