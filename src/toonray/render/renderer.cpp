@@ -8,11 +8,10 @@
 #include "toonray/core/error.h"
 #include "toonray/core/parallel.h"
 #include "toonray/render/classic.h"
+#include "toonray/render/trace.h"
 
 namespace toonray {
 namespace {
-
-constexpr int kTile = 16;
 
 // Geometric normal of the hit triangle, unit, turned to face the viewer.
 Vec3f geometric_normal(const Scene& scene, const Hit& hit, const Vec3f& dir) {
@@ -118,53 +117,43 @@ void Renderer::trace(const Scene& scene, const TriangleAccel& accel, const ViewP
     g.material.resize(w, h, kNoIndex);
     g.object.resize(w, h, kNoIndex);
     const Vec3f forward = view.forward;
-    const float inv_sub = 1.0f / static_cast<float>(sub);
 
-    const int tiles_x = (w + kTile - 1) / kTile, tiles_y = (h + kTile - 1) / kTile;
-    parallel_for(tiles_x * tiles_y, 1, settings.threads, [&](int begin, int end) {
-        for (int tile = begin; tile < end; ++tile) {
-            int x0 = (tile % tiles_x) * kTile, y0 = (tile / tiles_x) * kTile;
-            int x1 = std::min(x0 + kTile, w), y1 = std::min(y0 + kTile, h);
-            for (int y = y0; y < y1; ++y)
-                for (int x = x0; x < x1; ++x) {
-                    // Sample centres on a regular grid: (x + 0.5) / sub, exactly the pixel
-                    // centre when sub = 1.
-                    Vec3f target = sub == 1 ? view.pixel_point(x + 0.5f, y + 0.5f)
-                                            : view.pixel_point((x + 0.5f) * inv_sub, (y + 0.5f) * inv_sub);
-                    Vec3f dir = normalize(target - view.eye);
-                    Ray ray{view.eye, dir};
-                    Hit hit;
-                    if (!accel.intersect(ray, hit)) {
-                        if (classic) {
-                            g.distance(x, y) = inf;
-                            g.normal(x, y) = Vec3f(0.0f);
-                        } else {
-                            g.view_depth(x, y) = inf;
-                            g.geometric_normal(x, y) = Vec3f(0.0f);
-                        }
-                        g.colour(x, y) = settings.background;
-                        g.material(x, y) = kNoIndex;
-                        g.object(x, y) = kNoIndex;
-                        continue;
-                    }
-                    Vec3f n = shading_normal(scene, hit, dir);
-                    Vec3f p = view.eye + dir * hit.t;
-                    Vec3f to_light = light_ - p;
-                    float len = length(to_light);
-                    float l_dot_n = len > 0.0f ? dot(to_light, n) / len : 1.0f;
-                    std::uint32_t m = scene.tri_material[hit.prim];
+    trace_primary(accel, view, settings.width, settings.height, sub, settings.threads, [&](const SampleTile& t) {
+        int i = 0;
+        for (int y = t.y0; y < t.y1; ++y)
+            for (int x = t.x0; x < t.x1; ++x, ++i) {
+                const Vec3f& dir = t.dirs[i];
+                if (!t.found[i]) {
                     if (classic) {
-                        g.distance(x, y) = hit.t;
-                        g.normal(x, y) = n;
+                        g.distance(x, y) = inf;
+                        g.normal(x, y) = Vec3f(0.0f);
                     } else {
-                        g.view_depth(x, y) = hit.t * dot(dir, forward);
-                        g.geometric_normal(x, y) = geometric_normal(scene, hit, dir);
+                        g.view_depth(x, y) = inf;
+                        g.geometric_normal(x, y) = Vec3f(0.0f);
                     }
-                    g.colour(x, y) = scene.materials[m].kd * classic_cel_level(l_dot_n);
-                    g.material(x, y) = m;
-                    g.object(x, y) = scene.tri_object[hit.prim];
+                    g.colour(x, y) = settings.background;
+                    g.material(x, y) = kNoIndex;
+                    g.object(x, y) = kNoIndex;
+                    continue;
                 }
-        }
+                const Hit& hit = t.hits[i];
+                Vec3f n = shading_normal(scene, hit, dir);
+                Vec3f p = view.eye + dir * hit.t;
+                Vec3f to_light = light_ - p;
+                float len = length(to_light);
+                float l_dot_n = len > 0.0f ? dot(to_light, n) / len : 1.0f;
+                std::uint32_t m = scene.tri_material[hit.prim];
+                if (classic) {
+                    g.distance(x, y) = hit.t;
+                    g.normal(x, y) = n;
+                } else {
+                    g.view_depth(x, y) = hit.t * dot(dir, forward);
+                    g.geometric_normal(x, y) = geometric_normal(scene, hit, dir);
+                }
+                g.colour(x, y) = scene.materials[m].kd * classic_cel_level(l_dot_n);
+                g.material(x, y) = m;
+                g.object(x, y) = scene.tri_object[hit.prim];
+            }
     });
 }
 
