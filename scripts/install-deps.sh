@@ -13,6 +13,8 @@ packages=(
   ffmpeg fluid-soundfont-gm
   # the cluster integration test starts a real one-node Slurm cluster
   slurm-wlm munge
+  # the Blender add-on is tested in a real, headless Blender
+  blender
 )
 
 missing=()
