@@ -26,7 +26,11 @@ using namespace toonray;
 /// Options shared by every command that renders, kept as text until validated.
 struct RenderArgs {
     std::string size = "1280x720";
-    std::string light;
+    std::vector<std::string> lights;
+    std::string lights_file;
+    std::string ramp;
+    bool shadows = false, specular = false, no_textures = false;
+    float rim = 0.0f;
     std::string camera;
     std::string background = "1,1,1";
     std::string edges = "robust";
@@ -45,9 +49,22 @@ struct RenderArgs {
 
     void add_to(CLI::App& app) {
         app.add_option("--size", size, "Image size WIDTHxHEIGHT")->capture_default_str();
-        app.add_option("--light", light,
-                       "Point light position x,y,z (default: the eye moved by half the scene "
-                       "radius along the camera's up and right)");
+        app.add_option("--light", lights,
+                       "A light, repeatable: x,y,z or point:x,y,z (a point light), dir:x,y,z (a directional "
+                       "light shining along the vector), each with an optional @intensity (default: one "
+                       "point light at the eye moved by half the scene radius along the camera's up and right)");
+        app.add_option("--lights", lights_file,
+                       "File of lights, one per line: point x y z [intensity] | directional x y z [intensity]")
+            ->check(CLI::ExistingFile);
+        app.add_option("--ramp", ramp,
+                       "Toon bands LEVELS@THRESHOLDS, e.g. 0.5,0.75,1.0@0.25,0.5 (the seed's ramp, the default): "
+                       "diffuse light below the first threshold gives the first level, and so on");
+        app.add_flag("--shadows", shadows, "Toon shadows: lights blocked by geometry do not light a point");
+        app.add_flag("--specular", specular, "A hard-edged highlight band from the material's Ks and Ns");
+        app.add_option("--rim", rim, "Rim band width in [0,1) (0 = off): brightens surfaces seen edge-on")
+            ->check(CLI::Range(0.0f, 0.99f))
+            ->capture_default_str();
+        app.add_flag("--no-textures", no_textures, "Ignore map_Kd textures");
         app.add_option("--camera", camera,
                        "Camera ex,ey,ez,gx,gy,gz,ux,uy,uz: eye, gaze point, up; overrides the "
                        "file's camera block (default: the block, else a camera framing the scene)");
@@ -107,7 +124,16 @@ struct RenderArgs {
         ImageSize s = parse_image_size(size, "--size");
         o.settings.width = s.width;
         o.settings.height = s.height;
-        if (!light.empty()) o.settings.light = parse_vec3(light, "--light");
+        for (const std::string& l : lights) o.settings.shading.lights.push_back(parse_light(l));
+        if (!lights_file.empty()) {
+            auto from_file = load_lights(lights_file);
+            o.settings.shading.lights.insert(o.settings.shading.lights.end(), from_file.begin(), from_file.end());
+        }
+        if (!ramp.empty()) o.settings.shading.ramp = parse_ramp(ramp);
+        o.settings.shading.shadows = shadows;
+        o.settings.shading.specular = specular;
+        o.settings.shading.rim = rim;
+        o.settings.shading.textures = !no_textures;
         if (!camera.empty()) o.camera = parse_camera_spec(camera);
         o.settings.background = parse_colour(background, "--background");
         o.settings.edges = edges == "classic" ? EdgeMode::Classic : EdgeMode::Robust;

@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include "cli/cli_test_util.h"
+#include "toonray/core/image.h"
 #include "toonray/io/png.h"
 
 namespace fs = std::filesystem;
@@ -86,4 +87,40 @@ TEST(RenderCli, UnwritableOutputIsAnError) {
     CommandResult r = run_toonray("render " + kData + "/teapot.obj -o /nonexistent-dir/o.png --size 32x32");
     EXPECT_EQ(r.exit_code, 1);
     EXPECT_NE(r.output.find("/nonexistent-dir/o.png"), std::string::npos) << r.output;
+}
+
+TEST(RenderCli, ToonShadingOptions) {
+    TempDir dir("cli_shading");
+    std::string base = "render " + kData + "/teapot.obj --size 160x90 -o ";
+    CommandResult r = run_toonray(base + (dir / "a.png").string() +
+                                  " --ramp 0.3,0.6,0.9,1@0.2,0.4,0.7 --light dir:-1,-1,-1 --light 3,4,5@0.5"
+                                  " --shadows --specular --rim 0.3 --samples 9 --line-width 3 --line-color '#402010'"
+                                  " --lines silhouette,crease --crease-angle 60");
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_TRUE(fs::exists(dir / "a.png"));
+    dir.write("lights.txt", "point 1 2 3\nsun 1 2 3\n");
+    r = run_toonray(base + (dir / "b.png").string() + " --lights " + (dir / "lights.txt").string());
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_NE(r.output.find("lights.txt:2: unknown light 'sun'"), std::string::npos) << r.output;
+    EXPECT_FALSE(fs::exists(dir / "b.png"));
+    for (const char* bad : {" --ramp 1,2", " --lines outline", " --samples 3", " --rim 1.5"}) {
+        r = run_toonray(base + (dir / "c.png").string() + bad);
+        EXPECT_NE(r.exit_code, 0) << bad;
+    }
+}
+
+TEST(RenderCli, TexturedObjRendersItsTextureAndAMissingOneWarns) {
+    TempDir dir("cli_texture");
+    toonray::ImageRgb8 tex(8, 8, toonray::Rgb8{0, 200, 0});
+    toonray::write_png(dir / "green.png", tex);
+    dir.write("t.mtl", "newmtl tex\nKd 1 1 1\nmap_Kd green.png\nnewmtl gone\nKd 0.5 0.5 0.5\nmap_Kd nothere.png\n");
+    dir.write("t.obj", "mtllib t.mtl\nv -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
+                       "usemtl tex\nf 1/1 2/2 3/3\nusemtl gone\nf 1/1 3/3 4/4\n");
+    CommandResult r = run_toonray("render " + (dir / "t.obj").string() + " -o " + (dir / "t.png").string() +
+                                  " --size 64x64 --camera 0,0,3,0,0,2,0,1,0 --light 0,0,10 --lines none");
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_NE(r.output.find("nothere.png"), std::string::npos) << r.output;
+    auto png = toonray::read_png(dir / "t.png");
+    EXPECT_EQ(png.rgb(40, 40), (toonray::Rgb8{0, 200, 0}));     // the textured triangle (lower right)
+    EXPECT_EQ(png.rgb(22, 22), (toonray::Rgb8{128, 128, 128}));  // the other keeps its Kd
 }

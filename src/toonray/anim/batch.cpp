@@ -138,7 +138,7 @@ private:
     void finish(LoadedFrame& f, const Scene& scene, FileRenderer& renderer, const FileRenderOptions& render) {
         if (f.state == LoadedFrame::State::Load) {
             try {
-                renderer.render(scene, f.output, render);
+                renderer.render(scene, f.output, render, f.warnings);
             } catch (const Error& e) {
                 f.state = LoadedFrame::State::Fail;
                 f.error = e.what();

@@ -29,16 +29,18 @@ CameraSpec choose_camera(const Scene& scene, const FileRenderOptions& options) {
 void FileRenderer::render(const std::filesystem::path& input, const std::filesystem::path& output,
                           const FileRenderOptions& options, Warnings& warnings) {
     load_obj(input, scene_, warnings);
-    render(scene_, output, options);
+    render(scene_, output, options, warnings);
 }
 
 void FileRenderer::render(const Scene& scene, const std::filesystem::path& output,
-                          const FileRenderOptions& options) {
+                          const FileRenderOptions& options, Warnings& warnings) {
     CameraSpec camera = choose_camera(scene, options);
     // Validate the camera before any work so a bad one fails with nothing written.
     make_view_plane(camera, options.settings.width, options.settings.height);
     accel_.build(scene.positions, scene.tri_positions, options.bvh);
-    const ImageRgb8& image = renderer_.render(scene, accel_, camera, options.settings);
+    if (options.settings.shading.textures) textures_.load(scene, warnings);
+    const ImageRgb8& image = renderer_.render(scene, accel_, camera, options.settings,
+                                              options.settings.shading.textures ? &textures_ : nullptr);
     write_frame(renderer_, image, output, options);
 }
 

@@ -45,7 +45,8 @@ public:
                 const FileRenderOptions& options, Warnings& warnings);
 
     /// Renders an already loaded scene (the camera comes from options or the scene).
-    void render(const Scene& scene, const std::filesystem::path& output, const FileRenderOptions& options);
+    void render(const Scene& scene, const std::filesystem::path& output, const FileRenderOptions& options,
+                Warnings& warnings);
 
     [[nodiscard]] const Renderer& renderer() const { return renderer_; }
     [[nodiscard]] const Scene& scene() const { return scene_; }
@@ -54,6 +55,7 @@ private:
     Scene scene_;
     TriangleAccel accel_;
     Renderer renderer_;
+    TextureSet textures_;
 };
 
 /// The camera a frame uses: the override, else the file's camera block, else an automatic one.

@@ -13,16 +13,6 @@
 namespace toonray {
 namespace {
 
-// Geometric normal of the hit triangle, unit, turned to face the viewer.
-Vec3f geometric_normal(const Scene& scene, const Hit& hit, const Vec3f& dir) {
-    const auto& tri = scene.tri_positions[hit.prim];
-    const Vec3f& p0 = scene.positions[tri[0]];
-    Vec3f n = cross(scene.positions[tri[1]] - p0, scene.positions[tri[2]] - p0);
-    float len = length(n);
-    n = len > 0.0f ? n / len : -dir;
-    return dot(n, dir) > 0.0f ? -n : n;
-}
-
 // A distinct, stable colour for an id (AOVs); black for misses.
 Rgb8 id_colour(std::uint32_t id) {
     if (id == kNoIndex) return {0, 0, 0};
@@ -62,31 +52,6 @@ void robust_feature_images(const GBuffer& g, const Image<std::uint8_t>& seeds, A
     resolve_seed_type(seeds, kLineMaterial, sub, aovs.lines_material, threads);
 }
 
-// Shading normal at a hit: interpolated vertex normals when all three corners have one,
-// else the geometric normal; turned to face the viewer.
-Vec3f shading_normal(const Scene& scene, const Hit& hit, const Vec3f& dir) {
-    const auto& tri = scene.tri_positions[hit.prim];
-    const auto& tn = scene.tri_normals[hit.prim];
-    Vec3f n;
-    bool interpolated = false;
-    if (tn[0] != kNoIndex && tn[1] != kNoIndex && tn[2] != kNoIndex) {
-        float w0 = 1.0f - hit.u - hit.v;
-        n = scene.normals[tn[0]] * w0 + scene.normals[tn[1]] * hit.u + scene.normals[tn[2]] * hit.v;
-        float len = length(n);
-        if (len > 0.0f && std::isfinite(len)) {
-            n = n / len;
-            interpolated = true;
-        }
-    }
-    if (!interpolated) {
-        const Vec3f& p0 = scene.positions[tri[0]];
-        n = cross(scene.positions[tri[1]] - p0, scene.positions[tri[2]] - p0);
-        float len = length(n);
-        n = len > 0.0f ? n / len : -normalize(dir);
-    }
-    return dot(n, dir) > 0.0f ? -n : n;
-}
-
 }  // namespace
 
 Vec3f default_light(const Scene& scene, const ViewPlane& view) {
@@ -102,7 +67,8 @@ int samples_per_side(int samples) {
 }
 
 void Renderer::trace(const Scene& scene, const TriangleAccel& accel, const ViewPlane& view,
-                     const RenderSettings& settings, int sub) {
+                     const RenderSettings& settings, int sub, const TextureSet* textures) {
+    const ShadingContext shading{scene, accel, settings.shading, lights_, textures};
     const int w = settings.width * sub, h = settings.height * sub;
     const bool classic = settings.edges == EdgeMode::Classic;
     const float inf = std::numeric_limits<float>::infinity();
@@ -138,10 +104,6 @@ void Renderer::trace(const Scene& scene, const TriangleAccel& accel, const ViewP
                 }
                 const Hit& hit = t.hits[i];
                 Vec3f n = shading_normal(scene, hit, dir);
-                Vec3f p = view.eye + dir * hit.t;
-                Vec3f to_light = light_ - p;
-                float len = length(to_light);
-                float l_dot_n = len > 0.0f ? dot(to_light, n) / len : 1.0f;
                 std::uint32_t m = scene.tri_material[hit.prim];
                 if (classic) {
                     g.distance(x, y) = hit.t;
@@ -150,7 +112,7 @@ void Renderer::trace(const Scene& scene, const TriangleAccel& accel, const ViewP
                     g.view_depth(x, y) = hit.t * dot(dir, forward);
                     g.geometric_normal(x, y) = geometric_normal(scene, hit, dir);
                 }
-                g.colour(x, y) = scene.materials[m].kd * classic_cel_level(l_dot_n);
+                g.colour(x, y) = shade_hit(shading, hit, view.eye, dir, n);
                 g.material(x, y) = m;
                 g.object(x, y) = scene.tri_object[hit.prim];
             }
@@ -158,14 +120,17 @@ void Renderer::trace(const Scene& scene, const TriangleAccel& accel, const ViewP
 }
 
 const ImageRgb8& Renderer::render(const Scene& scene, const TriangleAccel& accel,
-                                  const CameraSpec& camera, const RenderSettings& settings) {
+                                  const CameraSpec& camera, const RenderSettings& settings,
+                                  const TextureSet* textures) {
     ViewPlane view = make_view_plane(camera, settings.width, settings.height);
     light_ = settings.light ? *settings.light : default_light(scene, view);
+    lights_ = settings.shading.lights;
+    if (lights_.empty()) lights_.push_back(Light{Light::Kind::Point, light_, 1.0f});
     if (settings.edges == EdgeMode::Classic) {
-        trace(scene, accel, view, settings, 1);
+        trace(scene, accel, view, settings, 1, textures);
         render_classic(settings);
     } else {
-        trace(scene, accel, view, settings, samples_per_side(settings.samples));
+        trace(scene, accel, view, settings, samples_per_side(settings.samples), textures);
         render_robust(settings);
     }
     return final_;

@@ -6,6 +6,7 @@
 #include "toonray/accel/triangle_accel.h"
 #include "toonray/core/image.h"
 #include "toonray/render/robust.h"
+#include "toonray/render/shading.h"
 #include "toonray/scene/camera.h"
 #include "toonray/scene/scene.h"
 
@@ -19,8 +20,9 @@ enum class EdgeMode {
 struct RenderSettings {
     int width = 1280;
     int height = 720;
-    std::optional<Vec3f> light;  ///< point light; default: the eye moved by half the scene
-                                 ///< radius along the camera's up and right
+    std::optional<Vec3f> light;  ///< the point light when shading.lights is empty; default: the
+                                 ///< eye moved by half the scene radius along the camera's up and right
+    ShadingSettings shading;     ///< ramp, extra lights, shadows, specular, rim, textures
     Vec3f background{1.0f};      ///< colour of pixels that hit nothing
     EdgeMode edges = EdgeMode::Robust;
     float depth_threshold = 8.0f;   ///< classic: Sobel magnitude on the 8-bit depth map
@@ -65,19 +67,21 @@ public:
     /// Renders the final image. Never throws for a valid scene, camera and settings; the
     /// camera must already have been validated (make_view_plane throws on a bad one).
     const ImageRgb8& render(const Scene& scene, const TriangleAccel& accel, const CameraSpec& camera,
-                            const RenderSettings& settings);
+                            const RenderSettings& settings, const TextureSet* textures = nullptr);
 
     /// Valid after render(): the G-buffer and AOVs of the last frame.
     [[nodiscard]] const GBuffer& gbuffer() const { return gbuffer_; }
     [[nodiscard]] const Aovs& aovs() const { return aovs_; }
-    /// Light position used for the last frame.
+    /// The single point light of the last frame (settings.light or the default).
     [[nodiscard]] Vec3f light() const { return light_; }
+    /// All lights of the last frame.
+    [[nodiscard]] const std::vector<Light>& lights() const { return lights_; }
     /// Robust mode: the line seeds of the last frame on the fine grid (LineType bits).
     [[nodiscard]] const Image<std::uint8_t>& line_seeds() const { return seeds_; }
 
 private:
     void trace(const Scene& scene, const TriangleAccel& accel, const ViewPlane& view,
-               const RenderSettings& settings, int sub);
+               const RenderSettings& settings, int sub, const TextureSet* textures);
     void render_classic(const RenderSettings& settings);
     void render_robust(const RenderSettings& settings);
 
@@ -87,6 +91,7 @@ private:
     Image<std::uint8_t> seeds_;
     ImageF distance_;
     Vec3f light_;
+    std::vector<Light> lights_;
 };
 
 /// The default light: the eye moved by half the scene radius along the view's up and right.

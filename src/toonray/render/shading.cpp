@@ -1,0 +1,242 @@
+#include "toonray/render/shading.h"
+
+#include <charconv>
+#include <cmath>
+#include <fmt/format.h>
+#include <sstream>
+
+#include "toonray/core/parse.h"
+#include "toonray/io/file.h"
+#include "toonray/io/png.h"
+
+namespace toonray {
+namespace {
+
+std::vector<float> parse_float_list(std::string_view text, std::string_view what) {
+    std::vector<float> out;
+    std::string s(text);
+    std::stringstream in(s);
+    std::string item;
+    while (std::getline(in, item, ',')) {
+        float v;
+        const char* b = item.data();
+        auto [p, ec] = std::from_chars(b, b + item.size(), v);
+        if (item.empty() || ec != std::errc() || p != b + item.size() || !std::isfinite(v))
+            throw Error(fmt::format("{}: malformed number '{}'", what, item));
+        out.push_back(v);
+    }
+    return out;
+}
+
+// Bilinear lookup with wrap-around (texture coordinates repeat), v = 0 at the bottom as OBJ has it.
+Vec3f sample_texture(const ImageRgb8& tex, float u, float v) {
+    const int w = tex.width(), h = tex.height();
+    float x = (u - std::floor(u)) * w - 0.5f;
+    float y = (1.0f - (v - std::floor(v))) * h - 0.5f;
+    int x0 = static_cast<int>(std::floor(x)), y0 = static_cast<int>(std::floor(y));
+    float fx = x - x0, fy = y - y0;
+    auto at = [&](int xi, int yi) {
+        xi = ((xi % w) + w) % w;
+        yi = ((yi % h) + h) % h;
+        const Rgb8& c = tex(xi, yi);
+        return Vec3f(c[0], c[1], c[2]) * (1.0f / 255.0f);
+    };
+    return (at(x0, y0) * (1 - fx) + at(x0 + 1, y0) * fx) * (1 - fy) +
+           (at(x0, y0 + 1) * (1 - fx) + at(x0 + 1, y0 + 1) * fx) * fy;
+}
+
+}  // namespace
+
+ToonRamp parse_ramp(const std::string& text) {
+    auto at = text.find('@');
+    ToonRamp ramp;
+    ramp.levels = parse_float_list(text.substr(0, at), "--ramp");
+    ramp.thresholds = at == std::string::npos ? std::vector<float>{} : parse_float_list(text.substr(at + 1), "--ramp");
+    if (ramp.levels.empty()) throw Error("--ramp: needs at least one level");
+    if (ramp.thresholds.size() + 1 != ramp.levels.size())
+        throw Error(fmt::format("--ramp '{}': {} levels need {} thresholds after '@', got {}", text,
+                                ramp.levels.size(), ramp.levels.size() - 1, ramp.thresholds.size()));
+    for (std::size_t i = 1; i < ramp.thresholds.size(); ++i)
+        if (!(ramp.thresholds[i] > ramp.thresholds[i - 1]))
+            throw Error(fmt::format("--ramp '{}': thresholds must increase", text));
+    return ramp;
+}
+
+Light parse_light(const std::string& text) {
+    Light light;
+    std::string body = text;
+    if (body.rfind("point:", 0) == 0) {
+        body = body.substr(6);
+    } else if (body.rfind("dir:", 0) == 0) {
+        light.kind = Light::Kind::Directional;
+        body = body.substr(4);
+    }
+    auto at = body.find('@');
+    if (at != std::string::npos) {
+        auto v = parse_float_list(body.substr(at + 1), "--light");
+        if (v.size() != 1 || v[0] < 0) throw Error(fmt::format("--light '{}': intensity must be one number >= 0", text));
+        light.intensity = v[0];
+        body = body.substr(0, at);
+    }
+    light.vector = parse_vec3(body, "--light");
+    if (light.kind == Light::Kind::Directional && !(length(light.vector) > 0))
+        throw Error(fmt::format("--light '{}': a directional light needs a non-zero direction", text));
+    return light;
+}
+
+std::vector<Light> parse_lights(std::string_view text, const std::string& file) {
+    std::vector<Light> lights;
+    std::string s(text);
+    std::stringstream in(s);
+    std::string line;
+    std::size_t number = 0;
+    while (std::getline(in, line)) {
+        ++number;
+        if (auto hash = line.find('#'); hash != std::string::npos) line.resize(hash);
+        std::stringstream words(line);
+        std::string kind;
+        if (!(words >> kind)) continue;
+        Light light;
+        if (kind == "point") light.kind = Light::Kind::Point;
+        else if (kind == "directional") light.kind = Light::Kind::Directional;
+        else throw_at(file, number, fmt::format("unknown light '{}' (point or directional)", kind));
+        std::vector<float> v;
+        std::string word;
+        while (words >> word) {
+            float f;
+            auto [p, ec] = std::from_chars(word.data(), word.data() + word.size(), f);
+            if (ec != std::errc() || p != word.data() + word.size() || !std::isfinite(f))
+                throw_at(file, number, fmt::format("malformed number '{}'", word));
+            v.push_back(f);
+        }
+        if (v.size() != 3 && v.size() != 4) throw_at(file, number, "expected x y z [intensity]");
+        light.vector = {v[0], v[1], v[2]};
+        if (v.size() == 4) {
+            if (v[3] < 0) throw_at(file, number, "intensity must not be negative");
+            light.intensity = v[3];
+        }
+        if (light.kind == Light::Kind::Directional && !(length(light.vector) > 0))
+            throw_at(file, number, "a directional light needs a non-zero direction");
+        lights.push_back(light);
+    }
+    if (lights.empty()) throw Error(fmt::format("{}: no lights", file));
+    return lights;
+}
+
+std::vector<Light> load_lights(const std::filesystem::path& path) {
+    return parse_lights(read_file(path), path.string());
+}
+
+void TextureSet::load(const Scene& scene, Warnings& warnings) {
+    textures_.assign(scene.materials.size(), nullptr);
+    for (std::size_t m = 0; m < scene.materials.size(); ++m) {
+        const std::string& path = scene.materials[m].map_kd;
+        if (path.empty()) continue;
+        if (auto it = cache_.find(path); it != cache_.end()) {
+            textures_[m] = it->second;
+            continue;
+        }
+        if (failed_.count(path)) continue;
+        try {
+            DecodedPng png = read_png(path);
+            auto image = std::make_shared<const ImageRgb8>(std::move(png.rgb));
+            cache_[path] = image;
+            textures_[m] = image;
+        } catch (const Error& e) {
+            failed_[path] = true;
+            warnings.push_back(fmt::format("material '{}': texture not used: {}", scene.materials[m].name, e.what()));
+        }
+    }
+}
+
+Vec3f geometric_normal(const Scene& scene, const Hit& hit, const Vec3f& dir) {
+    const auto& tri = scene.tri_positions[hit.prim];
+    const Vec3f& p0 = scene.positions[tri[0]];
+    Vec3f n = cross(scene.positions[tri[1]] - p0, scene.positions[tri[2]] - p0);
+    float len = length(n);
+    n = len > 0.0f ? n / len : -dir;
+    return dot(n, dir) > 0.0f ? -n : n;
+}
+
+Vec3f shading_normal(const Scene& scene, const Hit& hit, const Vec3f& dir) {
+    const auto& tri = scene.tri_positions[hit.prim];
+    const auto& tn = scene.tri_normals[hit.prim];
+    Vec3f n;
+    bool interpolated = false;
+    if (tn[0] != kNoIndex && tn[1] != kNoIndex && tn[2] != kNoIndex) {
+        float w0 = 1.0f - hit.u - hit.v;
+        n = scene.normals[tn[0]] * w0 + scene.normals[tn[1]] * hit.u + scene.normals[tn[2]] * hit.v;
+        float len = length(n);
+        if (len > 0.0f && std::isfinite(len)) {
+            n = n / len;
+            interpolated = true;
+        }
+    }
+    if (!interpolated) {
+        const Vec3f& p0 = scene.positions[tri[0]];
+        n = cross(scene.positions[tri[1]] - p0, scene.positions[tri[2]] - p0);
+        float len = length(n);
+        n = len > 0.0f ? n / len : -normalize(dir);
+    }
+    return dot(n, dir) > 0.0f ? -n : n;
+}
+
+Vec3f shade_hit(const ShadingContext& ctx, const Hit& hit, const Vec3f& eye, const Vec3f& dir, const Vec3f& n) {
+    const Scene& scene = ctx.scene;
+    const ShadingSettings& s = ctx.settings;
+    const std::uint32_t m = scene.tri_material[hit.prim];
+    const Material& material = scene.materials[m];
+    const Vec3f p = eye + dir * hit.t;
+
+    float diffuse = 0.0f;
+    float highlight = 0.0f;
+    for (const Light& light : ctx.lights) {
+        Vec3f to_light;
+        float distance = std::numeric_limits<float>::infinity();
+        float l_dot_n;
+        if (light.kind == Light::Kind::Point) {
+            to_light = light.vector - p;
+            float len = length(to_light);
+            // The seed's l.n, computed as it did (unit light vector against the unit normal).
+            l_dot_n = len > 0.0f ? dot(to_light, n) / len : 1.0f;
+            to_light = len > 0.0f ? to_light / len : n;
+            distance = len;
+        } else {
+            to_light = -normalize(light.vector);
+            l_dot_n = dot(to_light, n);
+        }
+        if (s.shadows && l_dot_n > 0.0f) {
+            // Leave the surface along its normal to avoid hitting it again.
+            Vec3f origin = p + n * (1e-4f * std::max(1.0f, hit.t));
+            Ray shadow{origin, to_light, distance};
+            Hit blocker;
+            if (ctx.accel.intersect(shadow, blocker)) continue;
+        }
+        diffuse += light.intensity * std::max(0.0f, l_dot_n);
+        if (s.specular && material.ns > 0.0f && (material.ks.x > 0 || material.ks.y > 0 || material.ks.z > 0)) {
+            Vec3f half = normalize(to_light - dir);
+            float n_dot_h = std::max(0.0f, dot(n, half));
+            if (std::pow(n_dot_h, material.ns) > 0.5f) highlight = 1.0f;  // one hard-edged band
+        }
+    }
+    // With one unit light this is max(0, l.n): the same band as the seed's int(l.n * 16).
+    Vec3f kd = material.kd;
+    if (s.textures && ctx.textures) {
+        if (const ImageRgb8* tex = ctx.textures->get(m)) {
+            const auto& tt = scene.tri_texcoords[hit.prim];
+            if (tt[0] != kNoIndex && tt[1] != kNoIndex && tt[2] != kNoIndex) {
+                float w0 = 1.0f - hit.u - hit.v;
+                const Vec2f& a = scene.texcoords[tt[0]];
+                const Vec2f& b = scene.texcoords[tt[1]];
+                const Vec2f& c = scene.texcoords[tt[2]];
+                kd = kd * sample_texture(*tex, a.x * w0 + b.x * hit.u + c.x * hit.v, a.y * w0 + b.y * hit.u + c.y * hit.v);
+            }
+        }
+    }
+    Vec3f colour = kd * s.ramp.level(std::min(diffuse, 1.0f));
+    if (highlight > 0.0f) colour += material.ks;
+    if (s.rim > 0.0f && 1.0f - std::abs(dot(n, dir)) > 1.0f - s.rim) colour += kd * s.rim_strength;
+    return colour;
+}
+
+}  // namespace toonray

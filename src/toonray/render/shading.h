@@ -1,0 +1,97 @@
+#pragma once
+/// Toon shading of a hit: the diffuse light picks a band of a ramp that scales the material's
+/// colour; optional hard-edged specular and rim bands, toon shadows and textures.
+///
+/// With the defaults (the seed's ramp, one point light, nothing optional) this is exactly the
+/// seed's cel shading: k = clamp(int(l.n * 16), 0, 15) into {0.5 x4, 0.75 x4, 1.0 x8}.
+
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "toonray/accel/triangle_accel.h"
+#include "toonray/core/error.h"
+#include "toonray/core/image.h"
+#include "toonray/core/math.h"
+#include "toonray/scene/scene.h"
+
+namespace toonray {
+
+/// Bands of a toon ramp: diffuse light below thresholds[0] gives levels[0], below
+/// thresholds[1] levels[1], ..., and levels.back() above the last threshold.
+struct ToonRamp {
+    std::vector<float> levels{0.5f, 0.75f, 1.0f};
+    std::vector<float> thresholds{0.25f, 0.5f};
+
+    [[nodiscard]] float level(float diffuse) const {
+        std::size_t i = 0;
+        while (i < thresholds.size() && diffuse >= thresholds[i]) ++i;
+        return levels[i];
+    }
+};
+
+/// Parses "0.5,0.75,1.0@0.25,0.5": N levels, then N-1 increasing thresholds. Throws Error.
+ToonRamp parse_ramp(const std::string& text);
+
+struct Light {
+    enum class Kind { Point, Directional };
+    Kind kind = Kind::Point;
+    Vec3f vector;            ///< point: position; directional: direction the light travels
+    float intensity = 1.0f;
+};
+
+/// Parses "x,y,z" or "point:x,y,z" (a point light) or "dir:x,y,z" (a directional light,
+/// shining along the vector), each optionally followed by "@intensity". Throws Error.
+Light parse_light(const std::string& text);
+
+/// Reads a lights file: one light per line, `point x y z [intensity]` or
+/// `directional dx dy dz [intensity]`, `#` comments. Throws Error("file:line: ...").
+std::vector<Light> load_lights(const std::filesystem::path& path);
+std::vector<Light> parse_lights(std::string_view text, const std::string& file);
+
+struct ShadingSettings {
+    ToonRamp ramp;
+    std::vector<Light> lights;  ///< empty: the default point light (see Renderer)
+    bool shadows = false;       ///< lights blocked by geometry do not count (toon shadows)
+    bool specular = false;      ///< hard highlight band from MTL Ks and Ns where given
+    float rim = 0.0f;           ///< rim band width in [0, 1) of (1 - n.v); 0 = off
+    float rim_strength = 0.35f; ///< how much the rim band brightens
+    bool textures = true;       ///< multiply Kd by map_Kd where a material has one
+};
+
+/// Textures of a scene's materials, decoded once (index = material). A texture that is missing
+/// or not a PNG is reported once as a warning and left out (the material keeps its Kd).
+class TextureSet {
+public:
+    void load(const Scene& scene, Warnings& warnings);
+    [[nodiscard]] const ImageRgb8* get(std::uint32_t material) const {
+        return material < textures_.size() ? textures_[material].get() : nullptr;
+    }
+
+private:
+    std::vector<std::shared_ptr<const ImageRgb8>> textures_;
+    std::map<std::string, std::shared_ptr<const ImageRgb8>> cache_;  ///< by path, kept across frames
+    std::map<std::string, bool> failed_;
+};
+
+/// Everything shading needs for one frame.
+struct ShadingContext {
+    const Scene& scene;
+    const TriangleAccel& accel;   ///< for shadow rays
+    const ShadingSettings& settings;
+    const std::vector<Light>& lights;  ///< resolved (never empty)
+    const TextureSet* textures = nullptr;
+};
+
+/// The shading normal at a hit: vertex normals interpolated when all three corners have one,
+/// else the geometric normal; turned to face the viewer (against `dir`).
+Vec3f shading_normal(const Scene& scene, const Hit& hit, const Vec3f& dir);
+/// The hit triangle's geometric normal, unit, facing the viewer.
+Vec3f geometric_normal(const Scene& scene, const Hit& hit, const Vec3f& dir);
+
+/// Toon colour of a hit seen along `dir` from `eye`, with shading normal `n`.
+Vec3f shade_hit(const ShadingContext& ctx, const Hit& hit, const Vec3f& eye, const Vec3f& dir, const Vec3f& n);
+
+}  // namespace toonray

@@ -1,0 +1,217 @@
+#include "toonray/render/shading.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include "toonray/io/png.h"
+#include "toonray/render/classic.h"
+#include "toonray/render/render_file.h"
+#include "toonray/render/renderer.h"
+
+using namespace toonray;
+namespace fs = std::filesystem;
+
+namespace {
+
+// A square in z = 0 facing +z, from (-a,-a) to (a,a), with texture coordinates 0..1.
+Scene square(float a, Vec3f kd = Vec3f(1.0f)) {
+    Scene s;
+    s.positions = {{-a, -a, 0}, {a, -a, 0}, {a, a, 0}, {-a, a, 0}};
+    s.texcoords = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+    Material m("paint");
+    m.kd = kd;
+    s.materials.push_back(m);
+    s.add_triangle({0, 1, 2}, 1, 0, {kNoIndex, kNoIndex, kNoIndex}, {0, 1, 2});
+    s.add_triangle({0, 2, 3}, 1, 0, {kNoIndex, kNoIndex, kNoIndex}, {0, 2, 3});
+    return s;
+}
+
+const Image<Vec3f>& colours(Renderer& r, const Scene& s, RenderSettings settings, const CameraSpec& cam,
+                            const TextureSet* textures = nullptr) {
+    static TriangleAccel accel;
+    accel.build(s.positions, s.tri_positions);
+    settings.edges = EdgeMode::Classic;  // one sample per pixel: colours are the shading's own
+    r.render(s, accel, cam, settings, textures);
+    return r.gbuffer().colour;
+}
+
+const CameraSpec kTopDown{{0, 0, 8}, {0, 0, 7}, {0, 1, 0}};  // sees x, y in [-8, 8]
+
+}  // namespace
+
+TEST(ToonRamp, DefaultIsTheSeedsSixteenLevelTable) {
+    ToonRamp ramp;
+    for (int i = -100; i <= 1100; ++i) {
+        float x = i / 1000.0f;
+        ASSERT_EQ(ramp.level(std::min(std::max(0.0f, x), 1.0f)), classic_cel_level(x)) << x;
+    }
+    for (float x : {0.25f, std::nextafter(0.25f, 0.0f), 0.5f, std::nextafter(0.5f, 0.0f)})
+        EXPECT_EQ(ramp.level(x), classic_cel_level(x)) << x;
+}
+
+TEST(ToonRamp, ParsesLevelsAndThresholds) {
+    ToonRamp r = parse_ramp("0.2,0.6,0.8,1@0.1,0.4,0.7");
+    EXPECT_EQ(r.level(0.05f), 0.2f);
+    EXPECT_EQ(r.level(0.1f), 0.6f);
+    EXPECT_EQ(r.level(0.69f), 0.8f);
+    EXPECT_EQ(r.level(0.9f), 1.0f);
+    EXPECT_EQ(parse_ramp("0.7").level(0.0f), 0.7f);  // one flat band
+    for (const char* bad : {"", "0.5,1@0.3,0.6", "0.5,1", "0.5,0.7,1@0.5,0.2", "a,1@0.5", "0.5,1@x"})
+        EXPECT_THROW(parse_ramp(bad), Error) << bad;
+}
+
+TEST(Lights, ParseFromOptionsAndFiles) {
+    Light p = parse_light("4,6,10");
+    EXPECT_EQ(p.kind, Light::Kind::Point);
+    EXPECT_EQ(p.vector, Vec3f(4, 6, 10));
+    Light d = parse_light("dir:0,-1,0@0.5");
+    EXPECT_EQ(d.kind, Light::Kind::Directional);
+    EXPECT_EQ(d.intensity, 0.5f);
+    EXPECT_THROW(parse_light("dir:0,0,0"), Error);
+    EXPECT_THROW(parse_light("1,2"), Error);
+    EXPECT_THROW(parse_light("1,2,3@-1"), Error);
+    auto lights = parse_lights("# key and fill\npoint 1 2 3\ndirectional 0 -1 0 0.25  # fill\n", "l.txt");
+    ASSERT_EQ(lights.size(), 2u);
+    EXPECT_EQ(lights[1].intensity, 0.25f);
+    try {
+        parse_lights("point 1 2 3\nspot 1 2 3\n", "l.txt");
+        FAIL();
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("l.txt:2: unknown light 'spot'"), std::string::npos) << e.what();
+    }
+    EXPECT_THROW(parse_lights("point 1 2\n", "l.txt"), Error);
+    EXPECT_THROW(parse_lights("# nothing\n", "l.txt"), Error);
+}
+
+TEST(Shading, DirectionalLightsAddUp) {
+    Scene s = square(10.0f);
+    RenderSettings settings;
+    settings.width = 32;
+    settings.height = 32;
+    Renderer r;
+    // One directional light at 70 degrees from the normal: l.n = cos 70 = 0.34 -> 0.75 band.
+    float a = 70.0f * 3.14159265f / 180.0f;
+    settings.shading.lights = {Light{Light::Kind::Directional, {std::sin(a), 0, -std::cos(a)}, 1.0f}};
+    EXPECT_EQ(colours(r, s, settings, kTopDown)(16, 16).x, 0.75f);
+    // Two of them: 0.68 -> the 1.0 band.
+    settings.shading.lights.push_back(Light{Light::Kind::Directional, {-std::sin(a), 0, -std::cos(a)}, 1.0f});
+    EXPECT_EQ(colours(r, s, settings, kTopDown)(16, 16).x, 1.0f);
+    // Dimmed to a quarter each: 0.17 -> 0.5 band.
+    for (Light& l : settings.shading.lights) l.intensity = 0.25f;
+    EXPECT_EQ(colours(r, s, settings, kTopDown)(16, 16).x, 0.5f);
+}
+
+TEST(Shading, ToonShadowsDarkenWhatIsBlocked) {
+    // A floor and a small square hovering above its middle, lit from straight above.
+    Scene s = square(10.0f);
+    auto base = static_cast<std::uint32_t>(s.positions.size());
+    for (Vec3f p : {Vec3f(-2, -2, 3), Vec3f(2, -2, 3), Vec3f(2, 2, 3), Vec3f(-2, 2, 3)}) s.positions.push_back(p);
+    s.add_triangle({base, base + 1, base + 2}, 1, 0);
+    s.add_triangle({base, base + 2, base + 3}, 1, 0);
+    RenderSettings settings;
+    settings.width = 64;
+    settings.height = 64;
+    settings.shading.lights = {Light{Light::Kind::Directional, {0, 0, -1}, 1.0f}};
+    // Look from the side so the floor under the hovering square shows.
+    CameraSpec cam{{0, -12, 9}, {0, -11.2f, 8.4f}, {0, 0.6f, 0.8f}};
+    Renderer r;
+    const Image<Vec3f>& lit = colours(r, s, settings, cam);
+    Image<Vec3f> without = lit;
+    settings.shading.shadows = true;
+    const Image<Vec3f>& shadowed = colours(r, s, settings, cam);
+    int darker = 0, same = 0;
+    for (int y = 0; y < 64; ++y)
+        for (int x = 0; x < 64; ++x) {
+            if (shadowed(x, y).x < without(x, y).x) ++darker;
+            else if (shadowed(x, y).x == without(x, y).x) ++same;
+            EXPECT_LE(shadowed(x, y).x, without(x, y).x);
+        }
+    EXPECT_GT(darker, 20);   // the shadow on the floor
+    EXPECT_GT(same, 1000);   // everything else unchanged
+}
+
+TEST(Shading, SpecularBandFromKsAndNs) {
+    Scene s = square(10.0f, Vec3f(0.5f));
+    s.materials[1].ks = Vec3f(0.3f);
+    s.materials[1].ns = 50.0f;
+    RenderSettings settings;
+    settings.width = 64;
+    settings.height = 64;
+    settings.shading.lights = {Light{Light::Kind::Point, {0, 0, 8}, 1.0f}};  // at the eye: highlight in the middle
+    Renderer r;
+    EXPECT_EQ(colours(r, s, settings, kTopDown)(32, 32).x, 0.5f);  // off by default
+    settings.shading.specular = true;
+    const Image<Vec3f>& c = colours(r, s, settings, kTopDown);
+    EXPECT_FLOAT_EQ(c(32, 32).x, 0.8f);  // Kd + Ks in the band
+    EXPECT_FLOAT_EQ(c(2, 2).x, 0.5f);  // far from it: no highlight (l.n = 0.58, the full band)
+}
+
+TEST(Shading, RimBandBrightensGrazingSurfaces) {
+    Scene s = square(10.0f, Vec3f(0.5f));
+    RenderSettings settings;
+    settings.width = 64;
+    settings.height = 64;
+    settings.shading.lights = {Light{Light::Kind::Directional, {0, 0, -1}, 1.0f}};
+    settings.shading.rim = 0.5f;  // where |n.v| < 0.5
+    // A steep view: the far part of the plane is seen at a grazing angle.
+    CameraSpec cam{{0, -3, 1.5f}, {0, -2.3f, 1.0f}, {0, 0.58f, 0.81f}};
+    Renderer r;
+    const Image<Vec3f>& c = colours(r, s, settings, cam);
+    int rim = 0;
+    for (int y = 0; y < 64; ++y)
+        for (int x = 0; x < 64; ++x)
+            if (std::abs(c(x, y).x - 0.5f * (1.0f + settings.shading.rim_strength)) < 1e-6f) ++rim;
+    EXPECT_GT(rim, 50);
+    settings.shading.rim = 0.0f;
+    const Image<Vec3f>& plain = colours(r, s, settings, cam);
+    for (int y = 0; y < 64; ++y)
+        for (int x = 0; x < 64; ++x)
+            if (r.gbuffer().material(x, y) != kNoIndex) EXPECT_LE(plain(x, y).x, 0.5f);
+}
+
+TEST(Shading, TexturesMultiplyKdAndBadOnesWarn) {
+    fs::path dir = fs::temp_directory_path() / ("toonray_tex_" + std::to_string(::getpid()));
+    fs::create_directories(dir);
+    // 16 x 16 texture of solid quadrants: red, green (top), blue, white (bottom). Bilinear
+    // filtering gives the exact colours away from the quadrant boundaries.
+    ImageRgb8 tex(16, 16);
+    for (int y = 0; y < 16; ++y)
+        for (int x = 0; x < 16; ++x)
+            tex(x, y) = y < 8 ? (x < 8 ? Rgb8{255, 0, 0} : Rgb8{0, 255, 0}) : (x < 8 ? Rgb8{0, 0, 255} : Rgb8{255, 255, 255});
+    write_png(dir / "tex.png", tex);
+    Scene s = square(8.0f);
+    s.materials[1].map_kd = (dir / "tex.png").string();
+    TextureSet textures;
+    Warnings w;
+    textures.load(s, w);
+    EXPECT_TRUE(w.empty());
+    RenderSettings settings;
+    settings.width = 64;
+    settings.height = 64;
+    settings.shading.lights = {Light{Light::Kind::Directional, {0, 0, -1}, 1.0f}};
+    Renderer r;
+    const Image<Vec3f>& c = colours(r, s, settings, kTopDown, &textures);
+    // Texture v = 0 is the bottom of the image (OBJ convention): the top-left quadrant is red.
+    EXPECT_EQ(c(16, 16), Vec3f(1, 0, 0));
+    EXPECT_EQ(c(48, 16), Vec3f(0, 1, 0));  // top right: green
+    EXPECT_EQ(c(16, 48), Vec3f(0, 0, 1));  // bottom left: blue
+    EXPECT_EQ(c(48, 48), Vec3f(1, 1, 1));  // bottom right: white
+
+    // Missing and not-an-image textures: a warning each, and Kd alone.
+    std::ofstream(dir / "fake.png") << "not a png";
+    for (const char* name : {"missing.png", "fake.png"}) {
+        Scene bad = square(8.0f, Vec3f(0.4f));
+        bad.materials[1].map_kd = (dir / name).string();
+        TextureSet t;
+        Warnings ww;
+        t.load(bad, ww);
+        ASSERT_EQ(ww.size(), 1u) << name;
+        EXPECT_NE(ww[0].find(name), std::string::npos) << ww[0];
+        const Image<Vec3f>& plain = colours(r, bad, settings, kTopDown, &t);
+        EXPECT_FLOAT_EQ(plain(10, 10).x, 0.4f);
+    }
+    fs::remove_all(dir);
+}
