@@ -14,6 +14,7 @@
 #include "toonray/media/audio.h"
 #include "toonray/anim/progress.h"
 #include "toonray/core/error.h"
+#include "toonray/core/limits.h"
 #include "toonray/core/parse.h"
 #include "toonray/media/encode.h"
 #include "toonray/score/score_io.h"
@@ -157,6 +158,43 @@ void print_warnings(const Warnings& warnings) {
     for (const auto& w : warnings) fmt::print(stderr, "toonray: warning: {}\n", w);
 }
 
+/// Limits on what inputs may ask for (docs/robustness.md), as text until validated.
+struct LimitArgs {
+    std::string triangles, vertices, pixels, memory, input_size;
+
+    void add_to(CLI::App& app) {
+        const Limits d;
+        app.add_option("--max-triangles", triangles,
+                       fmt::format("Largest scene, in triangles (default {}; k, M, G suffixes)", d.max_triangles))
+            ->group("Limits");
+        app.add_option("--max-vertices", vertices,
+                       fmt::format("Most OBJ v, vn and vt statements, each (default {})", d.max_vertices))
+            ->group("Limits");
+        app.add_option("--max-image-pixels", pixels,
+                       fmt::format("Largest image, width x height (default {} = 8192x8192)", d.max_image_pixels))
+            ->group("Limits");
+        app.add_option("--max-memory", memory,
+                       "Memory the estimate of a run may reach (frame buffers and scenes of all frames in "
+                       "flight), e.g. 4G (default: 3/4 of physical memory)")
+            ->group("Limits");
+        app.add_option("--max-input-size", input_size,
+                       fmt::format("Largest input file: OBJ, MTL, score, camera path (default {})",
+                                   format_bytes(d.max_input_bytes)))
+            ->group("Limits");
+    }
+
+    /// Sets the process-wide limits; call before any work.
+    void apply() const {
+        Limits l = limits();
+        if (!triangles.empty()) l.max_triangles = parse_count(triangles, "--max-triangles");
+        if (!vertices.empty()) l.max_vertices = parse_count(vertices, "--max-vertices");
+        if (!pixels.empty()) l.max_image_pixels = parse_count(pixels, "--max-image-pixels");
+        if (!memory.empty()) l.max_memory = parse_bytes(memory, "--max-memory");
+        if (!input_size.empty()) l.max_input_bytes = parse_bytes(input_size, "--max-input-size");
+        set_limits(l);
+    }
+};
+
 // Set by SIGINT/SIGTERM: long runs finish the frames in flight and stop.
 std::atomic<bool> g_stop{false};
 
@@ -253,11 +291,17 @@ PianoMovieReport run_piano_movie(const Score& score, const PianoArgs& args, Pian
     return report;
 }
 
-AudioOptions audio_options(const PianoArgs& args, std::optional<double> seconds) {
+AudioOptions audio_options(const Score& score, const PianoArgs& args, std::optional<double> seconds) {
     AudioOptions audio;
     audio.soundfont = args.soundfont;
     audio.start = args.start;
     audio.length = seconds;
+    // The soundtrack is synthesised in memory (16-bit stereo, then its WAV copy): a score that
+    // lasts for days must fail here, not in an allocation.
+    const double length = seconds ? *seconds : std::max(score.end_time, score.duration()) - args.start + 5.0;
+    const double bytes = std::max(0.0, length) * audio.sample_rate * 2 * 2 * 2;
+    check_memory(bytes < 1.8e19 ? static_cast<std::uint64_t>(bytes) : UINT64_MAX,
+                 fmt::format("the soundtrack ({:.0f} s)", length));
     return audio;
 }
 
@@ -274,6 +318,8 @@ int main(int argc, char** argv) {
         ->check(CLI::ExistingFile);
     render->add_option("-o,--output", render_output, "Output PNG file")->required();
     render_args.add_to(*render);
+    LimitArgs limit_args;  // one set, shared by the commands that read inputs
+    limit_args.add_to(*render);
 
     RenderArgs batch_render_args;
     BatchArgs batch_args;
@@ -281,6 +327,7 @@ int main(int argc, char** argv) {
         "batch", "Render numbered frames NAME FIRST LAST to a PNG sequence (all render options apply)");
     batch_args.add_to(*batch);
     batch_render_args.add_to(*batch);
+    limit_args.add_to(*batch);
 
     std::string encode_dir, encode_output, encode_audio;
     double encode_fps = 24.0;
@@ -308,6 +355,7 @@ int main(int argc, char** argv) {
         ->required()
         ->check(CLI::ExistingFile);
     convert->add_option("output", convert_output, "Score to write")->required();
+    limit_args.add_to(*convert);
 
     PianoArgs piano_args;
     RenderArgs piano_render_args;
@@ -326,6 +374,7 @@ int main(int argc, char** argv) {
     piano->add_option("--audio", piano_args.audio, "Also write the soundtrack of the same stretch to this WAV");
     piano_args.add_common(*piano);
     piano_render_args.add_to(*piano);
+    limit_args.add_to(*piano);
 
     PianoArgs demo_args;
     RenderArgs demo_render_args;
@@ -343,6 +392,7 @@ int main(int argc, char** argv) {
     demo->add_option("--score", demo_args.score, "Play another score (MIDI or note script)");
     demo_args.add_common(*demo);
     demo_render_args.add_to(*demo);
+    limit_args.add_to(*demo);
 
     try {
         app.parse(argc, argv);
@@ -351,8 +401,14 @@ int main(int argc, char** argv) {
     }
 
     try {
+        limit_args.apply();
         if (*render) {
             FileRenderOptions options = render_args.resolve();
+            {  // The frame buffers come first: the loader counts them in its memory estimate.
+                Limits l = limits();
+                l.reserved_memory = plan_frame_jobs(options.settings, 1, 1).frame_bytes;
+                set_limits(l);
+            }
             Warnings warnings;
             FileRenderer renderer;
             renderer.render(render_input, render_output, options, warnings);
@@ -393,11 +449,13 @@ int main(int argc, char** argv) {
             if (!piano_args.export_obj.empty()) options.export_obj_dir = piano_args.export_obj;
             if (piano_args.seconds > 0) options.seconds = piano_args.seconds;
             options.render = piano_render_args.resolve();
+            std::optional<AudioOptions> audio_opts;  // checked before the frames are rendered
+            if (!piano_args.audio.empty()) audio_opts = audio_options(score, piano_args, options.seconds);
             PianoMovieReport report = run_piano_movie(score, piano_args, options);
             if (report.batch.cancelled) return 130;
             if (report.batch.failed > 0) return 1;
-            if (!piano_args.audio.empty()) {
-                AudioResult audio = render_audio(score, piano_args.audio, audio_options(piano_args, options.seconds));
+            if (audio_opts) {
+                AudioResult audio = render_audio(score, piano_args.audio, *audio_opts);
                 print_warnings(audio.warnings);
             }
         } else if (*demo) {
@@ -413,17 +471,18 @@ int main(int argc, char** argv) {
             std::error_code ec;
             double seconds = options.seconds ? *options.seconds : score.duration() - demo_args.start;
             int frames = frame_count(seconds, demo_args.fps);
-            for (int f = frames + 1; fs::exists(options.output_dir / fmt::format("entertainer_{:06d}.png", f), ec); ++f)
+            for (long long f = frames + 1LL; fs::exists(options.output_dir / fmt::format("entertainer_{:06d}.png", f), ec); ++f)
                 fs::remove(options.output_dir / fmt::format("entertainer_{:06d}.png", f), ec);
             if (!demo_args.quiet)
                 fmt::print(stderr, "toonray: demo: {} frames at {}x{}, {} fps -> {}\n", frames,
                            options.render.settings.width, options.render.settings.height, demo_args.fps,
                            (dir / "entertainer.mp4").string());
+            const AudioOptions audio_opts = audio_options(score, demo_args, options.seconds);  // checked first
             PianoMovieReport report = run_piano_movie(score, demo_args, options);
             if (report.batch.cancelled) return 130;
             if (report.batch.failed > 0) return 1;
             if (!demo_args.quiet) fmt::print(stderr, "toonray: demo: synthesising the audio\n");
-            AudioResult audio = render_audio(score, dir / "entertainer.wav", audio_options(demo_args, options.seconds));
+            AudioResult audio = render_audio(score, dir / "entertainer.wav", audio_opts);
             print_warnings(audio.warnings);
             if (!demo_args.quiet) fmt::print(stderr, "toonray: demo: encoding the movie\n");
             EncodeOptions encode_options;

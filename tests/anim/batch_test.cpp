@@ -2,6 +2,15 @@
 
 #include <gtest/gtest.h>
 
+#if defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define TOONRAY_HAS_ASAN 1
+#endif
+#endif
+#ifndef TOONRAY_HAS_ASAN
+#define TOONRAY_HAS_ASAN 0
+#endif
+
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -292,6 +301,11 @@ struct PeakRss : BatchObserver {
 TEST(Batch, MemoryStaysFlatOverThousandsOfFrames) {
     // The seed leaked until it crashed after ~750 frames. Peak RSS after frame 2000 must be
     // within 2 MiB of the peak after frame 100.
+#if defined(__SANITIZE_ADDRESS__) || TOONRAY_HAS_ASAN
+    // AddressSanitizer keeps freed memory in quarantine (256 MB), so RSS grows by design; its
+    // leak checker covers this test's purpose in that build (scripts/sanitize.sh).
+    GTEST_SKIP() << "peak RSS is not meaningful under AddressSanitizer";
+#endif
     TempDir dir("memory");
     write_frames(dir.path / "in", 1, 2100);
     BatchOptions o = small_options(dir.path / "in", dir.path / "out");

@@ -11,6 +11,7 @@
 #include <thread>
 
 #include "toonray/core/error.h"
+#include "toonray/core/limits.h"
 #include "toonray/core/parallel.h"
 #include "toonray/io/png.h"
 #include "toonray/scene/obj_loader.h"
@@ -40,8 +41,12 @@ struct LoadedFrame {
 
 class Runner {
 public:
-    Runner(const BatchOptions& options, BatchObserver* observer, std::vector<int> frames)
-        : options_(options), observer_(observer), frames_(std::move(frames)) {
+    Runner(const BatchOptions& options, BatchObserver* observer, std::vector<int> frames,
+           const FramePlan& plan)
+        : options_(options), observer_(observer), frames_(std::move(frames)), jobs_(plan.jobs) {
+        // Each job keeps two scenes (one rendering, the next loading) and its frame buffers.
+        obj_.limits.reserved_memory = static_cast<std::uint64_t>(plan.jobs) * plan.frame_bytes;
+        obj_.limits.scenes_in_flight = static_cast<std::uint32_t>(2 * plan.jobs);
         if (options.input_pattern) {
             input_patterns_.emplace_back(*options.input_pattern);
         } else {
@@ -60,8 +65,7 @@ public:
 
     BatchReport run() {
         report_.total = static_cast<int>(frames_.size());
-        int jobs = options_.jobs > 0 ? options_.jobs : hardware_threads();
-        jobs = std::max(1, std::min(jobs, report_.total));
+        const int jobs = std::max(1, std::min(jobs_, report_.total));
         std::vector<std::thread> workers;
         for (int i = 1; i < jobs; ++i) workers.emplace_back([&] { work(jobs); });
         work(jobs);
@@ -85,12 +89,23 @@ private:
     }
 
     LoadedFrame load(int index, Scene& scene) {
+        // Runs on a worker thread: nothing may escape it (an exception would end the process).
         LoadedFrame f;
         f.frame = frames_[index];
+        try {
+            load_into(f, scene);
+        } catch (const std::exception& e) {
+            f.state = LoadedFrame::State::Fail;
+            f.error = fmt::format("frame {}: {}", f.frame, e.what());
+        }
+        return f;
+    }
+
+    void load_into(LoadedFrame& f, Scene& scene) {
         f.output = options_.output_dir / output_pattern_->format(f.frame);
         if (options_.resume && is_valid_png(f.output)) {
             f.state = LoadedFrame::State::Skip;
-            return f;
+            return;
         }
         auto input = find_frame_file(options_.input_dir, input_patterns_, f.frame);
         if (!input) {
@@ -99,15 +114,14 @@ private:
             f.state = LoadedFrame::State::Fail;
             f.error = fmt::format("{}: no input file for frame {} (tried {})",
                                   options_.input_dir.string(), f.frame, tried);
-            return f;
+            return;
         }
         try {
-            load_obj(*input, scene, f.warnings);
+            load_obj(*input, scene, f.warnings, obj_);
         } catch (const Error& e) {
             f.state = LoadedFrame::State::Fail;
             f.error = e.what();
         }
-        return f;
     }
 
     void work(int jobs) {
@@ -167,6 +181,8 @@ private:
     const BatchOptions& options_;
     BatchObserver* observer_;
     std::vector<int> frames_;
+    int jobs_;
+    ObjOptions obj_;
     std::vector<FramePattern> input_patterns_;
     std::optional<FramePattern> output_pattern_;
     std::atomic<int> next_{0};
@@ -205,10 +221,47 @@ std::optional<Shard> shard_from_environment() {
 }
 
 std::vector<int> shard_frames(int first, int last, const Shard& shard) {
+    if (first > last)
+        throw Error(fmt::format("frame range {} {}: the first frame is after the last", first, last));
+    if (shard.count < 1 || shard.index < 1 || shard.index > shard.count)
+        throw Error(fmt::format("shard {}/{}: expected K/N with 1 <= K <= N", shard.index, shard.count));
+    const long long span = static_cast<long long>(last) - first;  // >= 0
+    const long long count = span < shard.index - 1 ? 0 : (span - (shard.index - 1)) / shard.count + 1;
+    if (static_cast<unsigned long long>(count) > limits().max_frames)
+        throw Error(fmt::format("frame range {} {}: {} frames is more than the limit of {}", first, last,
+                                count, limits().max_frames));
     std::vector<int> frames;
+    frames.reserve(static_cast<std::size_t>(count));
     for (long long f = static_cast<long long>(first) + (shard.index - 1); f <= last; f += shard.count)
         frames.push_back(static_cast<int>(f));
     return frames;
+}
+
+FramePlan plan_frame_jobs(const RenderSettings& settings, int requested, std::size_t frames) {
+    const Limits& lim = limits();
+    if (settings.width < 1 || settings.height < 1)
+        throw Error(fmt::format("image size {}x{}: both must be at least 1", settings.width, settings.height));
+    const std::uint64_t pixels = static_cast<std::uint64_t>(settings.width) * static_cast<std::uint64_t>(settings.height);
+    if (pixels > lim.max_image_pixels)
+        throw Error(fmt::format("--size {}x{}: {} pixels, more than the limit of {} (--max-image-pixels "
+                                "raises it)",
+                                settings.width, settings.height, pixels, lim.max_image_pixels));
+    FramePlan plan;
+    plan.frame_bytes = frame_buffer_bytes(pixels, settings.edges == EdgeMode::Classic ? 1 : settings.samples);
+    const std::string size = fmt::format("a {}x{} frame", settings.width, settings.height);
+    check_memory(plan.frame_bytes, size);
+    const int wanted = requested > 0 ? requested : hardware_threads();
+    const int most = static_cast<int>(std::max<std::size_t>(1, std::min<std::size_t>(frames, 1 << 16)));
+    plan.jobs = std::max(1, std::min(wanted, most));
+    if (requested > 0) {
+        check_memory(plan.jobs * plan.frame_bytes, fmt::format("{} frames at once ({} each)", plan.jobs, size),
+                     "render fewer at once with --jobs");
+    } else {
+        // One per core, as many as fit.
+        const std::uint64_t fit = std::max<std::uint64_t>(1, lim.max_memory / std::max<std::uint64_t>(plan.frame_bytes, 1));
+        plan.jobs = static_cast<int>(std::min<std::uint64_t>(static_cast<std::uint64_t>(plan.jobs), fit));
+    }
+    return plan;
 }
 
 BatchReport run_batch(const BatchOptions& options, BatchObserver* observer) {
@@ -228,8 +281,10 @@ BatchReport run_batch(const BatchOptions& options, BatchObserver* observer) {
             throw Error(fmt::format("{}: AOV directory cannot be created or is not writable",
                                     options.render.aov_dir->string()));
     }
+    std::vector<int> frames = shard_frames(options.first, options.last, options.shard);
+    const FramePlan plan = plan_frame_jobs(options.render.settings, options.jobs, frames.size());
     auto start = std::chrono::steady_clock::now();
-    Runner runner(options, observer, shard_frames(options.first, options.last, options.shard));
+    Runner runner(options, observer, std::move(frames), plan);
     BatchReport report = runner.run();
     report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return report;

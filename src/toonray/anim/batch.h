@@ -2,6 +2,7 @@
 /// Batch rendering of numbered frames: `toonray batch keys 1 2229`.
 
 #include <atomic>
+#include <cstdint>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -28,8 +29,21 @@ Shard parse_shard(const std::string& text);
 /// Throws Error when the variables are present but inconsistent.
 std::optional<Shard> shard_from_environment();
 
-/// The frames of [first, last] that belong to `shard`, in order.
+/// The frames of [first, last] that belong to `shard`, in order. Throws Error when first > last
+/// or when there would be more than limits().max_frames (checked before allocating).
 std::vector<int> shard_frames(int first, int last, const Shard& shard);
+
+/// Frames rendered at once within the limits (docs/robustness.md).
+struct FramePlan {
+    int jobs = 1;                  ///< frames in flight
+    std::uint64_t frame_bytes = 0; ///< estimated frame buffers of one frame
+};
+
+/// Checks the image size against limits().max_image_pixels and the frame buffers of the frames
+/// in flight against limits().max_memory. `requested` jobs, 0 = one per core: then as many as
+/// fit (at least 1); an explicit number that does not fit is an Error, as is one frame that
+/// does not fit. Never more jobs than `frames`.
+FramePlan plan_frame_jobs(const RenderSettings& settings, int requested, std::size_t frames);
 
 struct BatchOptions {
     std::string name;  ///< animation name, e.g. "keys"

@@ -8,6 +8,7 @@
 #include <numbers>
 
 #include "toonray/core/error.h"
+#include "toonray/core/limits.h"
 #include "toonray/io/file.h"
 
 namespace toonray {
@@ -19,6 +20,11 @@ constexpr double kDegrees = std::numbers::pi / 180.0;
 /// Below this sine of the angle between up and the view direction a camera is unusable; the
 /// same threshold make_view_plane applies (about 0.06 degrees).
 constexpr double kParallelSine = 1e-3;
+
+/// Ranges that keep the spline's double arithmetic and the float camera finite.
+constexpr double kMaxKeyTime = 1e9;   // seconds, about 32 years
+constexpr double kMinKeyGap = 1e-6;   // seconds between keys
+constexpr double kMaxKeyValue = 1e15; // eye, target and up coordinates
 
 struct Vec3d {
     double x = 0, y = 0, z = 0;
@@ -93,12 +99,23 @@ CameraPath::CameraPath(std::vector<CameraKey> keys, std::optional<double> loop_p
         const CameraKey& k = keys_[i];
         auto fail = [&](const std::string& message) { throw_at(source_, k.line, message); };
         if (!std::isfinite(k.time)) fail("key time is not a finite number");
+        // Within these ranges the spline's arithmetic cannot overflow: tangents are differences
+        // over time gaps, so a gap of 1e-308 s or a span of 2e308 s would give infinities.
+        if (!(std::abs(k.time) <= kMaxKeyTime))
+            fail(fmt::format("key time {} s is outside -1e9..1e9 s", k.time));
         if (i > 0 && !(k.time > keys_[i - 1].time))
             fail(fmt::format("key times must increase: {} s comes after {} s{}", k.time,
                              keys_[i - 1].time,
                              keys_[i - 1].line ? fmt::format(" (line {})", keys_[i - 1].line) : ""));
+        if (i > 0 && !(k.time - keys_[i - 1].time >= kMinKeyGap))
+            fail(fmt::format("key times must be at least 1 microsecond apart: {} s comes {} s after {} s",
+                             k.time, k.time - keys_[i - 1].time, keys_[i - 1].time));
         if (!is_finite(k.eye) || !is_finite(k.target) || !is_finite(k.up) || !std::isfinite(k.fov))
             fail("key has a value that is not finite");
+        for (const Vec3f* v : {&k.eye, &k.target, &k.up})
+            for (int c = 0; c < 3; ++c)
+                if (!(std::abs((*v)[c]) <= kMaxKeyValue))
+                    fail(fmt::format("key value {} is outside -1e15..1e15", (*v)[c]));
         if (!(k.fov > 1.0f && k.fov < 179.0f))
             fail(fmt::format("fov {} degrees is outside (1, 179)", k.fov));
         const Frame f = make_frame(to_d(k.eye), to_d(k.target), to_d(k.up));
@@ -113,6 +130,11 @@ CameraPath::CameraPath(std::vector<CameraKey> keys, std::optional<double> loop_p
                                 fmt::format("loop period {} s must be longer than the keys' span "
                                             "{} s: after the last key the path returns to the "
                                             "first (leave out a closing key equal to the first)",
+                                            *period_, span)));
+        if (!(*period_ - span >= kMinKeyGap) || !(*period_ <= 2 * kMaxKeyTime))
+            throw Error(located(source_, 0,
+                                fmt::format("loop period {} s must exceed the keys' span {} s by at "
+                                            "least 1 microsecond and be at most 2e9 s",
                                             *period_, span)));
     }
 
@@ -286,6 +308,9 @@ private:
 }  // namespace
 
 CameraPath parse_camera_path(std::string_view text, std::string_view source) {
+    if (const std::size_t nul = text.find('\0'); nul != std::string_view::npos)
+        throw_at(source, 1 + static_cast<std::size_t>(std::count(text.begin(), text.begin() + nul, '\n')),
+                 "binary data (NUL byte): not a camera path file");
     std::vector<CameraKey> keys;
     std::optional<double> period;
     std::size_t loop_line = 0;
@@ -352,6 +377,8 @@ CameraPath parse_camera_path(std::string_view text, std::string_view source) {
                                                              : (!have_eye ? "an eye" : "a target")));
             up = key.up;
             fov = key.fov;
+            if (keys.size() >= limits().max_camera_keys)
+                p.fail(fmt::format("more than {} camera keys (the limit)", limits().max_camera_keys));
             keys.push_back(key);
         } else {
             p.fail(fmt::format("unknown word '{}' (a line is 'key ...' or 'loop PERIOD')", directive));

@@ -9,6 +9,7 @@
 #include <thread>
 
 #include "toonray/core/error.h"
+#include "toonray/core/limits.h"
 #include "toonray/core/parallel.h"
 #include "toonray/io/png.h"
 #include "toonray/piano/piano_animation.h"
@@ -33,8 +34,12 @@ CameraPath load_demo_camera_path() {
 
 int frame_count(double seconds, double fps) {
     // Frames whose start time lies before the end; the small epsilon keeps 30 s at 24 fps at
-    // exactly 720 despite rounding in seconds * fps.
-    return std::max(0, static_cast<int>(std::ceil(seconds * fps - 1e-9)));
+    // exactly 720 despite rounding in seconds * fps. Saturates at INT_MAX (a score may last
+    // 10^16 s), which every caller rejects as too many frames.
+    const double frames = std::ceil(seconds * fps - 1e-9);
+    if (!(frames > 0)) return 0;
+    if (frames >= 2147483647.0) return 2147483647;
+    return static_cast<int>(frames);
 }
 
 namespace {
@@ -52,6 +57,13 @@ public:
                 BatchObserver* observer)
         : playback_(score), path_(path), options_(options), observer_(observer),
           output_pattern_(options.name + "_%06d" + (options.export_obj_dir ? ".obj" : ".png")) {
+        // The roll's hole pool holds the most slots visible at once; a score can ask for
+        // millions (two triangles each). Check before building.
+        const std::uint64_t holes = playback_.hole_capacity();
+        if (2 * holes > limits().max_triangles)
+            throw Error(fmt::format("the score puts up to {} notes on the roll's window at once: {} "
+                                    "triangles, more than the limit of {} (--max-triangles raises it)",
+                                    holes, 2 * holes, limits().max_triangles));
         PianoOptions piano;
         piano.hole_capacity = std::max<std::uint32_t>(playback_.hole_capacity(), 1);
         model_ = build_piano(piano);
@@ -62,8 +74,23 @@ public:
         report.frame_count = frames;
         report.triangles = model_.scene.triangle_count();
         report_.total = frames;
-        int jobs = options_.jobs > 0 ? options_.jobs : hardware_threads();
-        jobs = std::max(1, std::min(jobs, frames));
+        // Each job poses its own copy of the scene with its own BVH, and (unless exporting)
+        // renders into its own frame buffers.
+        const bool exporting = options_.export_obj_dir.has_value();
+        FramePlan plan;
+        if (exporting) {
+            plan.jobs = std::max(1, std::min(options_.jobs > 0 ? options_.jobs : hardware_threads(), frames));
+        } else {
+            plan = plan_frame_jobs(options_.render.settings, options_.jobs, static_cast<std::size_t>(frames));
+        }
+        const std::uint64_t scene = scene_bytes(model_.scene.positions.size(), model_.scene.triangle_count());
+        if (options_.jobs <= 0)  // one per core, as many as fit
+            while (plan.jobs > 1 && plan.jobs * (plan.frame_bytes + scene) > limits().max_memory) --plan.jobs;
+        check_memory(plan.jobs * (plan.frame_bytes + scene),
+                     fmt::format("{} frame{} at once of the piano ({} triangles)", plan.jobs,
+                                 plan.jobs == 1 ? "" : "s", model_.scene.triangle_count()),
+                     "render fewer at once with --jobs");
+        int jobs = std::max(1, std::min(plan.jobs, frames));
         auto start = std::chrono::steady_clock::now();
         std::vector<std::thread> workers;
         for (int i = 1; i < jobs; ++i) workers.emplace_back([&] { work(jobs); });
@@ -162,7 +189,9 @@ PianoMovieReport render_piano_movie(const Score& score, const CameraPath& camera
     double seconds = options.seconds ? *options.seconds : std::max(0.0, music_end - options.start);
     if (!(seconds > 0.0)) throw Error("nothing to render: the length is zero (an empty score, or --start past its end)");
     int frames = frame_count(seconds, options.fps);
-    if (frames > 10'000'000) throw Error(fmt::format("{} frames is more than the limit of 10,000,000", frames));
+    if (static_cast<std::uint64_t>(frames) > limits().max_frames)
+        throw Error(fmt::format("{:.0f} s at {} fps: {}{} frames is more than the limit of {}", seconds, options.fps,
+                                frames == 2147483647 ? "over " : "", frames, limits().max_frames));
     if (options.export_obj_dir) {
         check_directory(*options.export_obj_dir, "OBJ export");
     } else {

@@ -8,6 +8,7 @@
 #include <memory>
 
 #include "toonray/core/error.h"
+#include "toonray/core/limits.h"
 #include "toonray/io/file.h"
 
 namespace toonray {
@@ -94,36 +95,48 @@ void write_png(const std::filesystem::path& path, const ImageGray8& image, const
     write_file_atomic(path, bytes);
 }
 
-DecodedPng read_png(const std::filesystem::path& path) {
-    std::string data = read_file(path);
+DecodedPng decode_png(std::span<const std::uint8_t> bytes, std::string_view name) {
     // libpng's reader stops after the image data, so a file cut just before its IEND chunk
     // would still decode: require the complete trailer.
-    static const char iend[12] = {0, 0, 0, 0, 'I', 'E', 'N', 'D', '\xAE', '\x42', '\x60', '\x82'};
-    if (data.size() < 12 || std::memcmp(data.data() + data.size() - 12, iend, 12) != 0)
-        throw Error(fmt::format("{}: truncated PNG (no IEND chunk at the end)", path.string()));
+    static const std::uint8_t iend[12] = {0, 0, 0, 0, 'I', 'E', 'N', 'D', 0xAE, 0x42, 0x60, 0x82};
+    if (bytes.size() < 12 || std::memcmp(bytes.data() + bytes.size() - 12, iend, 12) != 0)
+        throw Error(fmt::format("{}: truncated PNG (no IEND chunk at the end)", name));
     png_image img;
     std::memset(&img, 0, sizeof img);
     img.version = PNG_IMAGE_VERSION;
-    if (!png_image_begin_read_from_memory(&img, data.data(), data.size()))
-        throw Error(fmt::format("{}: not a PNG file: {}", path.string(), img.message));
+    if (!png_image_begin_read_from_memory(&img, bytes.data(), bytes.size()))
+        throw Error(fmt::format("{}: not a PNG file: {}", name, img.message));
+    struct Freer {
+        png_image* img;
+        ~Freer() { png_image_free(img); }
+    } freer{&img};
+    // The header may announce any size up to 2^31 - 1 squared: check before allocating.
+    const std::uint64_t pixels = std::uint64_t{img.width} * img.height;
+    if (img.width > 0x7FFFFFFFu || img.height > 0x7FFFFFFFu || pixels > limits().max_image_pixels)
+        throw Error(fmt::format("{}: a {}x{} PNG has more pixels than the limit of {} "
+                                "(--max-image-pixels raises it)",
+                                name, img.width, img.height, limits().max_image_pixels));
     img.format = PNG_FORMAT_RGB;
     DecodedPng result;
     result.width = static_cast<int>(img.width);
     result.height = static_cast<int>(img.height);
     result.rgb.resize(result.width, result.height);
-    if (!png_image_finish_read(&img, nullptr, result.rgb.data(), 0, nullptr)) {
-        std::string message = img.message;
-        png_image_free(&img);
-        throw Error(fmt::format("{}: corrupt PNG: {}", path.string(), message));
-    }
+    if (!png_image_finish_read(&img, nullptr, result.rgb.data(), 0, nullptr))
+        throw Error(fmt::format("{}: corrupt PNG: {}", name, img.message));
     return result;
+}
+
+DecodedPng read_png(const std::filesystem::path& path) {
+    std::string data = read_file(path);
+    return decode_png(std::span(reinterpret_cast<const std::uint8_t*>(data.data()), data.size()),
+                      path.string());
 }
 
 bool is_valid_png(const std::filesystem::path& path) {
     try {
         read_png(path);
         return true;
-    } catch (const Error&) {
+    } catch (const std::exception&) {
         return false;
     }
 }

@@ -8,6 +8,8 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <span>
+#include <string_view>
 #include <vector>
 
 #include "toonray/core/image.h"
@@ -32,8 +34,12 @@ struct DecodedPng {
     ImageRgb8 rgb;
 };
 
-/// Decodes a PNG file with libpng. Throws Error when the file is missing, truncated or corrupt.
+/// Decodes a PNG file with libpng. Throws Error when the file is missing, truncated or corrupt,
+/// or when its size exceeds limits().max_image_pixels (checked before any pixel is allocated).
 DecodedPng read_png(const std::filesystem::path& path);
+
+/// As read_png, from bytes in memory; `name` names them in messages.
+DecodedPng decode_png(std::span<const std::uint8_t> bytes, std::string_view name);
 
 /// True when `path` is a complete, decodable PNG (used by `batch --resume`).
 bool is_valid_png(const std::filesystem::path& path);

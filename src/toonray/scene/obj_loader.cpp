@@ -1,5 +1,6 @@
 #include "toonray/scene/obj_loader.h"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstring>
@@ -16,7 +17,8 @@ namespace {
 /// lines ending in a backslash, and counts physical lines for messages.
 class LineReader {
 public:
-    explicit LineReader(std::string_view text) : text_(text) {
+    LineReader(std::string_view text, std::string_view file, std::uint64_t max_line)
+        : text_(text), file_(file), max_line_(max_line) {
         if (text_.size() >= 3 && std::memcmp(text_.data(), "\xEF\xBB\xBF", 3) == 0)
             text_.remove_prefix(3);
     }
@@ -35,6 +37,7 @@ public:
         while (pos_ < text_.size()) {
             ++physical_;
             piece = take_physical();
+            if (joined_.size() + 1 + piece.size() > max_line_) too_long(line_number, true);
             joined_.push_back(' ');
             if (ends_with_backslash(piece)) {
                 joined_.append(piece.data(), piece.size() - 1);
@@ -59,12 +62,21 @@ private:
         const void* nl = std::memchr(begin, '\n', text_.size() - pos_);
         std::size_t len = nl ? static_cast<std::size_t>(static_cast<const char*>(nl) - begin)
                              : text_.size() - pos_;
+        if (len > max_line_) too_long(physical_, false);
         pos_ += len + (nl ? 1 : 0);
         if (len > 0 && begin[len - 1] == '\r') --len;
         return {begin, len};
     }
 
+    [[noreturn]] void too_long(std::size_t line, bool joined) const {
+        throw_at(file_, line,
+                 fmt::format("line{} longer than the limit of {}", joined ? " (with its continuations)" : "",
+                             format_bytes(max_line_)));
+    }
+
     std::string_view text_;
+    std::string_view file_;
+    std::uint64_t max_line_;
     std::size_t pos_ = 0;
     std::size_t physical_ = 0;
     std::string joined_;
@@ -161,8 +173,10 @@ inline bool resolve_index(long long idx, std::size_t count, std::uint32_t& out) 
         return true;
     }
     if (idx < 0) {
-        if (static_cast<unsigned long long>(-idx) > count) return false;
-        out = static_cast<std::uint32_t>(static_cast<long long>(count) + idx);
+        // -(idx + 1) cannot overflow, also for the most negative long long.
+        const auto back = static_cast<unsigned long long>(-(idx + 1)) + 1;
+        if (back > count) return false;
+        out = static_cast<std::uint32_t>(count - back);
         return true;
     }
     return false;
@@ -179,6 +193,31 @@ std::uint32_t intern(std::unordered_map<std::string, std::uint32_t>& ids,
     return it->second;
 }
 
+/// Bytes a material or an object name costs, for the memory estimate.
+constexpr std::uint64_t kNamedBytes = 160;
+
+/// Checks a count against its limit (never above what 32-bit indices can address).
+void check_count(const Parser& parse, std::uint64_t count, std::uint64_t limit, std::string_view what,
+                 std::string_view option) {
+    limit = std::min(limit, kMaxIndexable);
+    if (count > limit)
+        parse.fail(fmt::format("more than {} {} (the limit{})", limit, what,
+                               option.empty() ? std::string() : fmt::format("; {} raises it", option)));
+}
+
+/// Checks the memory estimate every time `count` doubles (so the cost is O(1) per element).
+class MemoryCheck {
+public:
+    bool due(std::uint64_t count) {
+        if (count < next_) return false;
+        next_ = count * 2;
+        return true;
+    }
+
+private:
+    std::uint64_t next_ = 1 << 16;
+};
+
 void load_mtl_file(const std::filesystem::path& path, std::vector<Material>& materials,
                    Warnings& warnings, std::string_view obj_file, std::size_t obj_line) {
     std::string text;
@@ -194,17 +233,77 @@ void load_mtl_file(const std::filesystem::path& path, std::vector<Material>& mat
     parse_mtl(text, path, materials, warnings);
 }
 
+/// The camera block's checks, in double precision so that large values cannot overflow into a
+/// camera that passes here and fails (or yields NaN rays) in the renderer. The thresholds are
+/// make_view_plane's: up must be at least ~0.06 degrees away from the view direction.
+void check_camera(const Parser& parse, const CameraSpec& cam) {
+    const double vx = double{cam.gaze.x} - cam.eye.x, vy = double{cam.gaze.y} - cam.eye.y,
+                 vz = double{cam.gaze.z} - cam.eye.z;
+    const double ux = cam.up.x, uy = cam.up.y, uz = cam.up.z;
+    const double view = std::sqrt(vx * vx + vy * vy + vz * vz);
+    const double up = std::sqrt(ux * ux + uy * uy + uz * uz);
+    if (!(view > 0)) parse.fail("invalid camera: eye and gaze point are the same point");
+    // |gaze - eye| sets the field of view (2 atan(1 / |gaze - eye|)) and up is a direction:
+    // beyond 1e6 neither means anything, and the renderer's float arithmetic overflows.
+    if (view > 1e6)
+        parse.fail(fmt::format("invalid camera: the gaze point is {:g} from the eye (at most 1e6; the "
+                               "distance sets the field of view, 1 gives 90 degrees)",
+                               view));
+    if (up > 1e6) parse.fail(fmt::format("invalid camera: up vector of length {:g} (at most 1e6)", up));
+    const double cx = vy * uz - vz * uy, cy = vz * ux - vx * uz, cz = vx * uy - vy * ux;
+    const double sine = std::sqrt(cx * cx + cy * cy + cz * cz) / (view * up);
+    if (!(up > 0) || !(sine > 1e-3))
+        parse.fail("invalid camera: up vector is zero or parallel to the view direction");
+}
+
+/// Text files hold no NUL bytes: one means a binary file (an image, an archive, a .blend) given
+/// where text was expected. Throws Error naming the line of the first.
+void refuse_binary(std::string_view text, std::string_view file, std::string_view what) {
+    const std::size_t nul = text.find('\0');
+    if (nul == std::string_view::npos) return;
+    const auto line = 1 + static_cast<std::size_t>(std::count(text.begin(), text.begin() + nul, '\n'));
+    throw_at(file, line, fmt::format("binary data (NUL byte): not {} text file", what));
+}
+
+/// Collects a file's warnings, at most kMaxWarnings of them: a hostile file could otherwise
+/// produce one per line.
+class WarningSink {
+public:
+    static constexpr std::size_t kMaxWarnings = 100;
+
+    WarningSink(Warnings& warnings, std::string_view file) : warnings_(warnings), file_(file) {}
+    ~WarningSink() {
+        if (dropped_ > 0)
+            warnings_.push_back(located(file_, 0, fmt::format("{} more warning{} not shown", dropped_,
+                                                              dropped_ == 1 ? "" : "s")));
+    }
+    void add(std::string message) {
+        if (count_++ < kMaxWarnings)
+            warnings_.push_back(std::move(message));
+        else
+            ++dropped_;
+    }
+
+private:
+    Warnings& warnings_;
+    std::string_view file_;
+    std::size_t count_ = 0, dropped_ = 0;
+};
+
 }  // namespace
 
 void parse_mtl(std::string_view text, const std::filesystem::path& path,
                std::vector<Material>& materials, Warnings& /*warnings*/) {
     const std::string file = path.string();
-    LineReader reader(text);
+    refuse_binary(text, file, "an MTL");
+    const Limits& lim = limits();
+    LineReader reader(text, file, lim.max_line_bytes);
     std::string_view line;
     std::size_t line_number = 0;
     Material* current = nullptr;
     std::unordered_map<std::string, std::size_t> index;
     for (std::size_t i = 0; i < materials.size(); ++i) index[materials[i].name] = i;
+    MemoryCheck memory;
 
     while (reader.next(line, line_number)) {
         Tokens t(line);
@@ -220,6 +319,10 @@ void parse_mtl(std::string_view text, const std::filesystem::path& path,
                 materials[it->second] = Material{key};
                 current = &materials[it->second];
             } else {
+                check_count(parse, materials.size() + 1, kMaxIndexable, "materials", "");
+                if (memory.due(materials.size()))
+                    check_memory(text.size() + materials.size() * kNamedBytes,
+                                 fmt::format("{}: {} materials", file, materials.size()));
                 index.emplace(key, materials.size());
                 materials.push_back(Material{key});
                 current = &materials.back();
@@ -253,7 +356,10 @@ void parse_mtl(std::string_view text, const std::filesystem::path& path,
         } else if (kw == "Tr") {
             current->d = 1.0f - parse.number(t, kw);
         } else if (kw == "illum") {
-            current->illum = static_cast<int>(parse.number(t, kw));
+            // The specification has models 0 to 10; any whole number that fits is kept.
+            const float v = parse.number(t, kw);
+            if (!(v >= -1e9f && v <= 1e9f)) parse.fail(fmt::format("illumination model {} out of range", v));
+            current->illum = static_cast<int>(v);
         } else if (kw == "map_Kd") {
             // Options (-s 1 1 1, -clamp on, ...) come first; the file name is the last token.
             std::string_view rest = t.rest();
@@ -269,15 +375,52 @@ void parse_obj(std::string_view text, const std::filesystem::path& path, Scene& 
                Warnings& warnings, const ObjOptions& options) {
     scene.clear();
     const std::string file = path.string();
-    LineReader reader(text);
+    refuse_binary(text, file, "an OBJ");
+    const Limits& lim = options.limits;
+    LineReader reader(text, file, lim.max_line_bytes);
     std::string_view line;
     std::size_t line_number = 0;
+    WarningSink warn(warnings, file);
 
     std::unordered_map<std::string, std::uint32_t> object_ids{{"(default)", 0}};
     std::unordered_map<std::string, std::uint32_t> warned_materials, warned_statements;
+    // Material names to indices, rebuilt after each mtllib (the last definition of a name wins).
+    std::unordered_map<std::string_view, std::uint32_t> material_ids;
+    auto index_materials = [&] {
+        material_ids.clear();
+        for (std::size_t i = 1; i < scene.materials.size(); ++i)
+            material_ids[scene.materials[i].name] = static_cast<std::uint32_t>(i);
+    };
+    std::unordered_map<std::string, bool> libraries;  // each MTL file is read once
     std::uint32_t material = 0, object = 0;
     std::vector<Corner> corners;
     corners.reserve(16);
+
+    // Memory: the text, the scene, its BVH, times the scenes loaded at once, plus what the
+    // caller has committed elsewhere (frame buffers).
+    MemoryCheck memory;
+    const std::uint64_t max_vertices = std::min(lim.max_vertices, kMaxIndexable);
+    const std::uint64_t max_triangles = std::min(lim.max_triangles, kMaxIndexable);
+    auto estimate = [&] {
+        const std::uint64_t vertices = scene.positions.size() + scene.normals.size() + scene.texcoords.size();
+        const std::uint64_t names = scene.objects.size() + scene.materials.size();
+        return lim.reserved_memory + text.size() +
+               std::max<std::uint64_t>(lim.scenes_in_flight, 1) *
+                   (scene_bytes(vertices, scene.triangle_count()) + names * kNamedBytes);
+    };
+    auto check_estimate = [&](const Parser& parse) {
+        const std::uint64_t bytes = estimate();
+        if (bytes > lim.max_memory)
+            parse.fail(fmt::format("the scene so far ({} vertices, {} triangles) needs about {} of memory, "
+                                   "more than the limit of {} (--max-memory raises it)",
+                                   scene.positions.size(), scene.triangle_count(), format_bytes(bytes),
+                                   format_bytes(lim.max_memory)));
+    };
+    auto grew = [&](const Parser& parse) {
+        if (memory.due(scene.positions.size() + scene.normals.size() + scene.texcoords.size() +
+                       scene.triangle_count() + scene.objects.size()))
+            check_estimate(parse);
+    };
 
     while (reader.next(line, line_number)) {
         Tokens t(line);
@@ -286,6 +429,8 @@ void parse_obj(std::string_view text, const std::filesystem::path& path, Scene& 
         Parser parse(file, line_number);
 
         if (kw == "v") {
+            check_count(parse, scene.positions.size() + 1, max_vertices, "vertices ('v')", "--max-vertices");
+            grew(parse);
             scene.positions.push_back(parse.vec3(t, kw));
             // Optional w (or vertex colour) values are accepted and ignored, but must be numbers.
             while (!t.at_end()) parse.number(t, kw);
@@ -300,6 +445,9 @@ void parse_obj(std::string_view text, const std::filesystem::path& path, Scene& 
                 for (int slot = 0; slot < 3; ++slot) {
                     if (p < e && *p != '/') {
                         auto [ptr, ec] = std::from_chars(p, e, idx[slot]);
+                        if (ec == std::errc::result_out_of_range && (ptr == e || *ptr == '/'))
+                            parse.fail(fmt::format("face {} index in '{}' out of range",
+                                                   slot == 0 ? "vertex" : slot == 1 ? "texture" : "normal", tok));
                         if (ec != std::errc() || (ptr != e && *ptr != '/'))
                             parse.fail(fmt::format("malformed face corner '{}'", tok));
                         present[slot] = true;
@@ -327,6 +475,10 @@ void parse_obj(std::string_view text, const std::filesystem::path& path, Scene& 
             }
             if (corners.size() < 3)
                 parse.fail(fmt::format("face needs at least 3 corners, has {}", corners.size()));
+            if (scene.triangle_count() + (corners.size() - 2) > max_triangles)
+                parse.fail(fmt::format("more than {} triangles (the limit; --max-triangles raises it)",
+                                       max_triangles));
+            grew(parse);
             for (std::size_t i = 1; i + 1 < corners.size(); ++i) {
                 const Corner& a = corners[0];
                 const Corner& b = corners[i];
@@ -334,8 +486,13 @@ void parse_obj(std::string_view text, const std::filesystem::path& path, Scene& 
                 scene.add_triangle({a.v, b.v, c.v}, material, object, {a.n, b.n, c.n}, {a.t, b.t, c.t});
             }
         } else if (kw == "vn") {
+            check_count(parse, scene.normals.size() + 1, max_vertices, "normals ('vn')", "--max-vertices");
+            grew(parse);
             scene.normals.push_back(parse.vec3(t, kw));
         } else if (kw == "vt") {
+            check_count(parse, scene.texcoords.size() + 1, max_vertices, "texture coordinates ('vt')",
+                        "--max-vertices");
+            grew(parse);
             Vec2f uv;
             uv.x = parse.number(t, kw);
             if (!t.at_end()) uv.y = parse.number(t, kw);
@@ -343,23 +500,32 @@ void parse_obj(std::string_view text, const std::filesystem::path& path, Scene& 
             scene.texcoords.push_back(uv);
         } else if (kw == "usemtl") {
             std::string_view name = t.rest();
-            material = 0;
-            for (std::size_t i = 1; i < scene.materials.size(); ++i)
-                if (scene.materials[i].name == name) material = static_cast<std::uint32_t>(i);
-            if (material == 0 && !name.empty() &&
+            auto it = material_ids.find(name);
+            material = it == material_ids.end() ? 0 : it->second;
+            if (material == 0 && !name.empty() && warned_materials.size() < 10'000 &&
                 warned_materials.emplace(std::string(name), 0).second)
-                warnings.push_back(located(file, line_number,
-                                           fmt::format("unknown material '{}'; using the default material", name)));
+                warn.add(located(file, line_number,
+                                 fmt::format("unknown material '{}'; using the default material", name)));
         } else if (kw == "o" || kw == "g") {
             std::string_view name = t.rest();
+            if (!name.empty() && scene.objects.size() >= kMaxIndexable && !object_ids.contains(std::string(name)))
+                check_count(parse, scene.objects.size() + 1, kMaxIndexable, "objects ('o' and 'g')", "");
             object = name.empty() ? 0 : intern(object_ids, scene.objects, name);
+            grew(parse);
         } else if (kw == "mtllib") {
             if (!options.load_materials) continue;
             while (!t.at_end()) {
                 std::string_view name = t.next();
-                load_mtl_file(path.parent_path() / std::string(name), scene.materials, warnings,
-                              file, line_number);
+                std::filesystem::path library = (path.parent_path() / std::string(name)).lexically_normal();
+                // Each library once: "mtllib a.mtl a.mtl ..." must not read a.mtl again and again.
+                if (!libraries.emplace(library.string(), true).second) continue;
+                Warnings library_warnings;
+                load_mtl_file(library, scene.materials, library_warnings, file, line_number);
+                for (std::string& w : library_warnings) warn.add(std::move(w));
+                check_count(parse, scene.materials.size(), kMaxIndexable, "materials", "");
+                check_estimate(parse);
             }
+            index_materials();
         } else if (kw == "c") {
             long long idx[3];
             for (long long& i : idx) {
@@ -380,9 +546,7 @@ void parse_obj(std::string_view text, const std::filesystem::path& path, Scene& 
                 parse.fail(fmt::format("camera up index {} out of range ({} normals defined so far)",
                                        idx[2], scene.normals.size()));
             CameraSpec cam{scene.positions[eye], scene.positions[gaze], scene.normals[up]};
-            if (cam.eye == cam.gaze) parse.fail("invalid camera: eye and gaze point are the same point");
-            if (!(length(cross(cam.gaze - cam.eye, cam.up)) > 0))
-                parse.fail("invalid camera: up vector is zero or parallel to the view direction");
+            check_camera(parse, cam);
             scene.camera = cam;
         } else if (kw == "s" || kw == "l" || kw == "p" || kw == "vp" || kw == "cstype" ||
                    kw == "deg" || kw == "curv" || kw == "curv2" || kw == "surf" || kw == "parm" ||
@@ -394,18 +558,20 @@ void parse_obj(std::string_view text, const std::filesystem::path& path, Scene& 
             // Accepted: smoothing groups are implied by vn; lines, points and free-form
             // geometry are not rendered.
         } else {
-            if (kw.find('\0') != std::string_view::npos)
-                parse.fail("binary data (NUL byte): not an OBJ text file");
-            if (warned_statements.emplace(std::string(kw), 0).second)
-                warnings.push_back(located(file, line_number,
-                                           fmt::format("unknown statement '{}' ignored", kw)));
+            if (warned_statements.size() < 10'000 && warned_statements.emplace(std::string(kw), 0).second)
+                warn.add(located(file, line_number, fmt::format("unknown statement '{}' ignored", kw)));
         }
     }
+    check_estimate(Parser(file, 0));
 }
 
 void load_obj(const std::filesystem::path& path, Scene& scene, Warnings& warnings,
               const ObjOptions& options) {
-    std::string text = read_file(path);
+    std::string text = read_file(path, options.limits.max_input_bytes);
+    // An empty file is a failed download or export, not a scene.
+    if (text.find_first_not_of(" \t\r\n\f\v") == std::string::npos)
+        throw Error(located(path.string(), 0, text.empty() ? "empty file: no OBJ statements"
+                                                            : "blank file: no OBJ statements"));
     parse_obj(text, path, scene, warnings, options);
 }
 

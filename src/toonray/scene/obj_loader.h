@@ -15,17 +15,22 @@
 #include <vector>
 
 #include "toonray/core/error.h"
+#include "toonray/core/limits.h"
 #include "toonray/scene/scene.h"
 
 namespace toonray {
 
 struct ObjOptions {
     bool load_materials = true;  ///< follow mtllib statements
+    /// Line length, vertex and triangle counts, the memory estimate (docs/robustness.md).
+    /// Default: the process-wide limits at the time the options are made.
+    Limits limits = toonray::limits();
 };
 
-/// Loads an OBJ file and the MTL files it names. Clears `scene` first but keeps its
+/// Loads an OBJ file and the MTL files it names (each once). Clears `scene` first but keeps its
 /// allocations, so a batch of frames reuses memory. Throws Error("file:line: reason") on
-/// malformed input; a missing MTL file or unknown material is a warning.
+/// malformed input or an exceeded limit; a missing MTL file or unknown material is a warning
+/// (at most 100 warnings per file, then a count of the rest).
 void load_obj(const std::filesystem::path& path, Scene& scene, Warnings& warnings,
               const ObjOptions& options = {});
 

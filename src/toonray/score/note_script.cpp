@@ -10,6 +10,7 @@
 #include <utility>
 #include <vector>
 
+#include "toonray/core/limits.h"
 #include "toonray/score/piano_keys.h"
 
 namespace toonray {
@@ -82,6 +83,10 @@ public:
     TimedScore parse(std::string_view text) {
         if (text.size() >= 3 && std::memcmp(text.data(), "\xEF\xBB\xBF", 3) == 0)
             text.remove_prefix(3);
+        if (const std::size_t nul = text.find('\0'); nul != std::string_view::npos) {
+            line_ = 1 + static_cast<std::size_t>(std::count(text.begin(), text.begin() + nul, '\n'));
+            fail("binary data (NUL byte): neither a note script nor a MIDI file (no \"MThd\" header)");
+        }
         while (!text.empty()) {
             ++line_;
             std::size_t nl = text.find('\n');
@@ -312,6 +317,8 @@ private:
                         fail(fmt::format("bad velocity in '{}': expected 1..127 after '@'", token));
                     token = trim(token.substr(0, at));
                 }
+                if (score_.notes.size() >= limits().max_notes)
+                    fail(fmt::format("more than {} notes (the limit)", limits().max_notes));
                 score_.notes.push_back(
                     TimedNote{start, start + length, key(token), velocity, track_, channel_});
             }
