@@ -1,154 +1,537 @@
 #include "toonray/accel/bvh.h"
 
+#include <smmintrin.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_group.h>
+
 #include <algorithm>
-#include <array>
+#include <cstddef>
+#include <atomic>
 #include <limits>
-#include <numeric>
+#include <memory>
 
 namespace toonray {
 namespace {
 
+// A primitive while building: its box, with the primitive id in the w lane of `lo`. The centre
+// used for binning is lo + hi (twice the box centre; the factor does not matter).
+struct alignas(32) PrimRef {
+    __m128 lo;
+    __m128 hi;
+};
+
+constexpr int kMaxBins = 64;
+constexpr int kMaxLeaf = 128;
+// Nodes with at least this many primitives are binned and partitioned by several tasks, in
+// chunks of kChunk; subtrees of at least kTaskSize primitives become tasks of their own. These
+// are fixed numbers, so the tree never depends on the thread count.
+constexpr std::size_t kParallelSplit = 1u << 15;
+constexpr std::size_t kChunk = 1u << 13;
+constexpr std::size_t kTaskSize = 1u << 11;
+
+const __m128 kPosInf = _mm_set1_ps(std::numeric_limits<float>::infinity());
+const __m128 kNegInf = _mm_set1_ps(-std::numeric_limits<float>::infinity());
+
+struct Box4 {
+    __m128 lo = kPosInf;
+    __m128 hi = kNegInf;
+    void extend(__m128 l, __m128 h) {
+        lo = _mm_min_ps(lo, l);
+        hi = _mm_max_ps(hi, h);
+    }
+    void extend(const Box4& b) { extend(b.lo, b.hi); }
+    void extend_point(__m128 p) { extend(p, p); }
+    [[nodiscard]] float half_area() const {
+        alignas(16) float e[4];
+        _mm_store_ps(e, _mm_sub_ps(hi, lo));
+        return e[0] * e[1] + e[1] * e[2] + e[2] * e[0];
+    }
+    [[nodiscard]] BBox bbox() const {
+        alignas(16) float l[4], h[4];
+        _mm_store_ps(l, lo);
+        _mm_store_ps(h, hi);
+        return BBox{Vec3f(l[0], l[1], l[2]), Vec3f(h[0], h[1], h[2])};
+    }
+};
+
+struct Bins {
+    Box4 box[3][kMaxBins];              // [axis][bin]: 32 bytes each
+    std::uint32_t count[3][kMaxBins];   // at a byte offset 1/8 of its box's
+    void clear(int n) {
+        for (int a = 0; a < 3; ++a)
+            for (int b = 0; b < n; ++b) {
+                box[a][b] = Box4{};
+                count[a][b] = 0;
+            }
+    }
+    void merge(const Bins& o, int n) {
+        for (int a = 0; a < 3; ++a)
+            for (int b = 0; b < n; ++b) {
+                box[a][b].extend(o.box[a][b]);
+                count[a][b] += o.count[a][b];
+            }
+    }
+    [[nodiscard]] __m128i counts(int b) const {
+        return _mm_setr_epi32(static_cast<int>(count[0][b]), static_cast<int>(count[1][b]),
+                              static_cast<int>(count[2][b]), 0);
+    }
+};
+static_assert(sizeof(Box4) == 32 && offsetof(Bins, count) == 3 * kMaxBins * 32);
+
+// Half areas of three boxes at once (lanes 0-2).
+inline __m128 half_areas(const Box4& a, const Box4& b, const Box4& c) {
+    __m128 x = _mm_sub_ps(a.hi, a.lo), y = _mm_sub_ps(b.hi, b.lo), z = _mm_sub_ps(c.hi, c.lo), w = _mm_setzero_ps();
+    _MM_TRANSPOSE4_PS(x, y, z, w);  // now x = extents along x of the three boxes, etc.
+    return _mm_add_ps(_mm_add_ps(_mm_mul_ps(x, y), _mm_mul_ps(y, z)), _mm_mul_ps(z, x));
+}
+
+// Maps centres (lo + hi) to bin indices on all three axes at once.
+struct Binner {
+    __m128 base, scale;
+    __m128i max_bin;
+    Binner(const Box4& centres, int bins) {
+        alignas(16) float lo[4], hi[4], s[4];
+        _mm_store_ps(lo, centres.lo);
+        _mm_store_ps(hi, centres.hi);
+        for (int a = 0; a < 4; ++a) {
+            float extent = hi[a] - lo[a];
+            // Slightly under `bins` so the largest centre lands in the last bin, not past it.
+            s[a] = a < 3 && extent > 0.0f ? static_cast<float>(bins) * 0.99999f / extent : 0.0f;
+            if (!(s[a] < std::numeric_limits<float>::infinity())) s[a] = 0.0f;  // denormal extents
+        }
+        base = centres.lo;
+        scale = _mm_load_ps(s);
+        max_bin = _mm_set1_epi32(bins - 1);
+    }
+    [[nodiscard]] __m128i bin(const PrimRef& r) const {
+        __m128 c = _mm_add_ps(r.lo, r.hi);
+        __m128i i = _mm_cvttps_epi32(_mm_mul_ps(_mm_sub_ps(c, base), scale));
+        return _mm_max_epi32(_mm_min_epi32(i, max_bin), _mm_setzero_si128());
+    }
+};
+
+
+// Adds one primitive to the bin of its centre on each axis; `off` holds the byte offsets of
+// those bins' boxes (the counts are at 1/8 of them).
+inline void bin_add(Bins& bins, const PrimRef& r, __m128i off) {
+    char* boxes = reinterpret_cast<char*>(&bins.box[0][0]);
+    char* counts = reinterpret_cast<char*>(&bins.count[0][0]);
+    const int o[3] = {_mm_cvtsi128_si32(off), _mm_extract_epi32(off, 1), _mm_extract_epi32(off, 2)};
+    for (int a = 0; a < 3; ++a) {
+        Box4& b = *reinterpret_cast<Box4*>(boxes + o[a]);
+        b.lo = _mm_min_ps(b.lo, r.lo);
+        b.hi = _mm_max_ps(b.hi, r.hi);
+        ++*reinterpret_cast<std::uint32_t*>(counts + (o[a] >> 3));
+    }
+}
+
+void bin_range(const PrimRef* refs, std::size_t begin, std::size_t end, const Binner& binner, Bins& bins) {
+    const __m128i axis_off = _mm_setr_epi32(0, kMaxBins * 32, 2 * kMaxBins * 32, 0);
+    std::size_t i = begin;
+    for (; i < end; ++i) bin_add(bins, refs[i], _mm_add_epi32(_mm_slli_epi32(binner.bin(refs[i]), 5), axis_off));
+}
+
+// The same into two bin sets, even and odd primitives apart: neighbours in memory are
+// neighbours in space and usually share bins, and one set would chain every update on the
+// previous one through memory.
+void bin_range2(const PrimRef* refs, std::size_t begin, std::size_t end, const Binner& binner, Bins& a, Bins& b) {
+    const __m128i axis_off = _mm_setr_epi32(0, kMaxBins * 32, 2 * kMaxBins * 32, 0);
+    std::size_t i = begin;
+    for (; i + 1 < end; i += 2) {
+        const PrimRef& r0 = refs[i];
+        const PrimRef& r1 = refs[i + 1];
+        const __m128i o0 = _mm_add_epi32(_mm_slli_epi32(binner.bin(r0), 5), axis_off);
+        const __m128i o1 = _mm_add_epi32(_mm_slli_epi32(binner.bin(r1), 5), axis_off);
+        bin_add(a, r0, o0);
+        bin_add(b, r1, o1);
+    }
+    if (i < end) bin_add(a, refs[i], _mm_add_epi32(_mm_slli_epi32(binner.bin(refs[i]), 5), axis_off));
+}
+
+struct Task {
+    std::uint32_t node;  // index in the temporary node array
+    std::uint32_t buffer;  // which of the two PrimRef arrays holds the range
+    std::size_t begin, end;
+    Box4 bounds, centres;
+};
+
+struct Split {
+    int axis = -1;
+    int bin = 0;  // primitives in bins [0, bin) go left
+    float cost = std::numeric_limits<float>::infinity();
+    Box4 left, right;
+};
+
+// Whether a primitive goes left: its bin on axis A is below the split. The same float
+// operations as Binner::bin (the clamp does not change the comparison, as 1 <= split < bins).
+template <int A>
+struct GoesLeft {
+    __m128 base, scale;
+    int split;
+    [[nodiscard]] bool operator()(__m128 centre) const {
+        __m128i i = _mm_cvttps_epi32(_mm_mul_ps(_mm_sub_ps(centre, base), scale));
+        return _mm_extract_epi32(i, A) < split;
+    }
+};
+
 struct Builder {
-    std::span<const BBox> boxes;
-    std::span<const Vec3f> centers;
     const Bvh::Config& config;
-    Bvh& bvh;
-
-    static constexpr int kMaxBins = 64;
-
-    struct Bin {
-        BBox box;
-        std::uint32_t count = 0;
+    int bins;
+    int max_leaf;
+    int block_shift;  // log2 of the block size
+    PrimRef* buffers[2];  // the primitives, and scratch space for parallel partitions (ping-pong)
+    // Nodes in allocation order (which depends on scheduling). Plain data, left uninitialised:
+    // room for 2n - 1 nodes is reserved but far fewer are used, and untouched pages cost nothing.
+    struct TmpNode {
+        float lo[3], hi[3];
+        std::uint32_t first, count;
     };
+    std::unique_ptr<TmpNode[]> tmp;
+    void set_node(std::uint32_t i, const Box4& box, std::uint32_t first, std::uint32_t count) {
+        alignas(16) float l[4], h[4];
+        _mm_store_ps(l, box.lo);
+        _mm_store_ps(h, box.hi);
+        tmp[i] = TmpNode{{l[0], l[1], l[2]}, {h[0], h[1], h[2]}, first, count};
+    }
+    std::atomic<std::uint32_t> next_node{1};
+    tbb::task_group tasks;
 
-    BBox range_bounds(std::uint32_t first, std::uint32_t count, BBox* centroid_bounds) const {
-        BBox box, cbox;
-        for (std::uint32_t i = first; i < first + count; ++i) {
-            std::uint32_t p = bvh.prim_indices[i];
-            box.extend(boxes[p]);
-            cbox.extend(centers[p]);
-        }
-        *centroid_bounds = cbox;
-        return box;
+    Builder(const Bvh::Config& c, PrimRef* refs, PrimRef* scratch)
+        : config(c),
+          bins(std::clamp(c.bin_count, 2, kMaxBins)),
+          max_leaf(std::clamp(c.max_leaf_size, 1, kMaxLeaf)),
+          block_shift(0),
+          buffers{refs, scratch} {
+        while ((1 << block_shift) < std::clamp(c.block_size, 1, 64)) ++block_shift;
     }
 
-    // Finds the cheapest binned SAH split. Returns false when no split beats a leaf (and the
-    // leaf is allowed), or all centroids coincide.
-    bool find_split(const BvhNode& node, const BBox& cbox, int& best_axis, float& best_pos,
-                    float& best_cost) const {
-        const int bins = std::clamp(config.bin_count, 2, kMaxBins);
-        best_cost = std::numeric_limits<float>::infinity();
-        best_axis = -1;
-        std::array<Bin, kMaxBins> bin;
-        std::array<float, kMaxBins> right_area;
-        std::array<std::uint32_t, kMaxBins> right_count;
-        for (int axis = 0; axis < 3; ++axis) {
-            float lo = cbox.lo[axis], hi = cbox.hi[axis];
-            if (!(hi > lo)) continue;
-            float scale = bins / (hi - lo);
-            std::fill(bin.begin(), bin.begin() + bins, Bin{});
-            for (std::uint32_t i = node.first; i < node.first + node.count; ++i) {
-                std::uint32_t p = bvh.prim_indices[i];
-                int b = std::min(bins - 1, static_cast<int>((centers[p][axis] - lo) * scale));
-                bin[b].box.extend(boxes[p]);
-                bin[b].count++;
+    [[nodiscard]] float blocks(std::uint32_t n) const {
+        return static_cast<float>((n + (1u << block_shift) - 1) >> block_shift);
+    }
+
+    void bin(const Task& t, const Binner& binner, int bins, Bins& out) const {
+        const std::size_t n = t.end - t.begin;
+        const PrimRef* refs = buffers[t.buffer];
+        out.clear(bins);
+        if (n < kParallelSplit) {
+            if (n < 128) {
+                bin_range(refs, t.begin, t.end, binner, out);
+            } else {
+                Bins other;
+                other.clear(bins);
+                bin_range2(refs, t.begin, t.end, binner, out, other);
+                out.merge(other, bins);
             }
-            // Sweep from the right to get the cost of each right side, then from the left.
-            BBox acc;
-            std::uint32_t n = 0;
-            for (int b = bins - 1; b > 0; --b) {
-                acc.extend(bin[b].box);
-                n += bin[b].count;
-                right_area[b] = acc.empty() ? 0.0f : acc.half_area();
-                right_count[b] = n;
+            return;
+        }
+        const std::size_t chunks = (n + kChunk - 1) / kChunk;
+        std::vector<Bins> partial(chunks);
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks, 1), [&](const auto& r) {
+            for (std::size_t c = r.begin(); c != r.end(); ++c) {
+                partial[c].clear(bins);
+                Bins other;
+                other.clear(bins);
+                std::size_t b = t.begin + c * kChunk;
+                bin_range2(refs, b, std::min(b + kChunk, t.end), binner, partial[c], other);
+                partial[c].merge(other, bins);
             }
-            acc = BBox{};
-            n = 0;
-            for (int b = 0; b < bins - 1; ++b) {
-                acc.extend(bin[b].box);
-                n += bin[b].count;
-                if (n == 0 || right_count[b + 1] == 0) continue;
-                float cost = acc.half_area() * n + right_area[b + 1] * right_count[b + 1];
-                if (cost < best_cost) {
-                    best_cost = cost;
-                    best_axis = axis;
-                    best_pos = lo + (b + 1) / scale;
+        });
+        // min/max and integer sums are exact: the merge order cannot change the result.
+        for (const Bins& p : partial) out.merge(p, bins);
+    }
+
+    [[nodiscard]] __m128 blocks4(__m128i n) const {
+        return _mm_cvtepi32_ps(_mm_srli_epi32(_mm_add_epi32(n, _mm_set1_epi32((1 << block_shift) - 1)), block_shift));
+    }
+
+    // Binned SAH on all three axes at once (lanes 0-2).
+    [[nodiscard]] Split find_split(const Bins& b, int bins, std::uint32_t n) const {
+        alignas(16) __m128 right_area[kMaxBins];
+        alignas(16) __m128i right_count[kMaxBins];
+        Box4 acc[3];
+        __m128i cnt = _mm_setzero_si128();
+        for (int i = bins - 1; i > 0; --i) {
+            for (int a = 0; a < 3; ++a) acc[a].extend(b.box[a][i]);
+            cnt = _mm_add_epi32(cnt, b.counts(i));
+            right_area[i] = half_areas(acc[0], acc[1], acc[2]);
+            right_count[i] = cnt;
+        }
+        for (auto& a : acc) a = Box4{};
+        cnt = _mm_setzero_si128();
+        const __m128i total = _mm_set1_epi32(static_cast<int>(n));
+        __m128 best_cost = _mm_set1_ps(std::numeric_limits<float>::infinity());
+        __m128i best_bin = _mm_setzero_si128();
+        for (int i = 0; i < bins - 1; ++i) {
+            for (int a = 0; a < 3; ++a) acc[a].extend(b.box[a][i]);
+            cnt = _mm_add_epi32(cnt, b.counts(i));
+            __m128 cost = _mm_add_ps(_mm_mul_ps(half_areas(acc[0], acc[1], acc[2]), blocks4(cnt)),
+                                     _mm_mul_ps(right_area[i + 1], blocks4(right_count[i + 1])));
+            // Both sides must be non-empty.
+            __m128 valid = _mm_castsi128_ps(_mm_andnot_si128(
+                _mm_or_si128(_mm_cmpeq_epi32(cnt, _mm_setzero_si128()), _mm_cmpeq_epi32(cnt, total)),
+                _mm_set1_epi32(-1)));
+            __m128 better = _mm_and_ps(valid, _mm_cmplt_ps(cost, best_cost));
+            best_cost = _mm_blendv_ps(best_cost, cost, better);
+            best_bin = _mm_castps_si128(
+                _mm_blendv_ps(_mm_castsi128_ps(best_bin), _mm_castsi128_ps(_mm_set1_epi32(i + 1)), better));
+        }
+        alignas(16) float costs[4];
+        alignas(16) int bin_of[4];
+        _mm_store_ps(costs, best_cost);
+        _mm_store_si128(reinterpret_cast<__m128i*>(bin_of), best_bin);
+        Split best;
+        for (int axis = 0; axis < 3; ++axis)
+            if (costs[axis] < best.cost) {
+                best.cost = costs[axis];
+                best.axis = axis;
+                best.bin = bin_of[axis];
+            }
+        if (best.axis >= 0)
+            for (int i = 0; i < bins; ++i) (i < best.bin ? best.left : best.right).extend(b.box[best.axis][i]);
+        return best;
+    }
+
+    // In place: [begin, mid) go left. Returns mid.
+    template <int A>
+    static std::size_t partition_serial(PrimRef* refs, std::size_t begin, std::size_t end, GoesLeft<A> left,
+                                        Box4& lc, Box4& rc) {
+        std::size_t i = begin, j = end;
+        while (true) {
+            while (i < j) {
+                __m128 c = _mm_add_ps(refs[i].lo, refs[i].hi);
+                if (!left(c)) break;
+                lc.extend_point(c);
+                ++i;
+            }
+            while (i < j) {
+                __m128 c = _mm_add_ps(refs[j - 1].lo, refs[j - 1].hi);
+                if (left(c)) break;
+                rc.extend_point(c);
+                --j;
+            }
+            if (i >= j) break;
+            std::swap(refs[i], refs[j - 1]);  // both are now on their side: the loops take them
+        }
+        return i;
+    }
+
+    // Stable, several tasks: from `src` into `dst`, left side first. Returns mid.
+    template <int A>
+    static std::size_t partition_parallel(const PrimRef* src, PrimRef* dst, std::size_t begin, std::size_t end,
+                                          GoesLeft<A> left, Box4& lc, Box4& rc) {
+        const std::size_t n = end - begin;
+        const std::size_t chunks = (n + kChunk - 1) / kChunk;
+        std::vector<std::size_t> left_count(chunks);
+        std::vector<Box4> lcs(chunks), rcs(chunks);
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks, 1), [&](const auto& r) {
+            for (std::size_t c = r.begin(); c != r.end(); ++c) {
+                std::size_t b = begin + c * kChunk, e = std::min(b + kChunk, end), k = 0;
+                for (std::size_t i = b; i < e; ++i) k += left(_mm_add_ps(src[i].lo, src[i].hi));
+                left_count[c] = k;
+            }
+        });
+        std::vector<std::size_t> left_at(chunks), right_at(chunks);
+        std::size_t nl = 0;
+        for (std::size_t c = 0; c < chunks; ++c) {
+            left_at[c] = nl;
+            nl += left_count[c];
+        }
+        std::size_t nr = 0;
+        for (std::size_t c = 0; c < chunks; ++c) {
+            right_at[c] = nl + nr;
+            nr += std::min(kChunk, n - c * kChunk) - left_count[c];
+        }
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks, 1), [&](const auto& r) {
+            for (std::size_t c = r.begin(); c != r.end(); ++c) {
+                std::size_t b = begin + c * kChunk, e = std::min(b + kChunk, end);
+                std::size_t li = begin + left_at[c], ri = begin + right_at[c];
+                Box4 l, rr;
+                for (std::size_t i = b; i < e; ++i) {
+                    const PrimRef& p = src[i];
+                    __m128 cen = _mm_add_ps(p.lo, p.hi);
+                    if (left(cen)) {
+                        dst[li++] = p;
+                        l.extend_point(cen);
+                    } else {
+                        dst[ri++] = p;
+                        rr.extend_point(cen);
+                    }
                 }
+                lcs[c] = l;
+                rcs[c] = rr;
             }
+        });
+        for (std::size_t c = 0; c < chunks; ++c) {
+            lc.extend(lcs[c]);
+            rc.extend(rcs[c]);
         }
-        return best_axis >= 0;
+        return begin + nl;
     }
 
-    // Builds the subtree at `index`, iteratively: a degenerate mesh could otherwise recurse
-    // as deep as it has triangles.
-    void build(std::uint32_t root) {
-        std::vector<std::uint32_t> todo{root};
+    // Splits t's range; sets the children's buffer, returns the middle.
+    template <int A>
+    std::size_t partition_axis(const Task& t, const Binner& binner, int split, Task& l, Task& r) {
+        GoesLeft<A> left{binner.base, binner.scale, split};
+        if (t.end - t.begin < kParallelSplit) {
+            l.buffer = r.buffer = t.buffer;
+            return partition_serial(buffers[t.buffer], t.begin, t.end, left, l.centres, r.centres);
+        }
+        l.buffer = r.buffer = 1 - t.buffer;
+        return partition_parallel(buffers[t.buffer], buffers[1 - t.buffer], t.begin, t.end, left, l.centres,
+                                  r.centres);
+    }
+
+    std::size_t partition(const Task& t, const Binner& binner, const Split& s, Task& l, Task& r) {
+        switch (s.axis) {
+            case 0: return partition_axis<0>(t, binner, s.bin, l, r);
+            case 1: return partition_axis<1>(t, binner, s.bin, l, r);
+            default: return partition_axis<2>(t, binner, s.bin, l, r);
+        }
+    }
+
+    void range_bounds(const PrimRef* refs, std::size_t begin, std::size_t end, Box4& bounds, Box4& centres) const {
+        for (std::size_t i = begin; i < end; ++i) {
+            bounds.extend(refs[i].lo, refs[i].hi);
+            centres.extend_point(_mm_add_ps(refs[i].lo, refs[i].hi));
+        }
+    }
+
+    void make_leaf(const Task& t) {
+        if (t.buffer != 0) std::copy(buffers[1] + t.begin, buffers[1] + t.end, buffers[0] + t.begin);
+        set_node(t.node, t.bounds, static_cast<std::uint32_t>(t.begin), static_cast<std::uint32_t>(t.end - t.begin));
+    }
+
+    // Builds the subtree of `root` with an explicit stack (a degenerate mesh could otherwise
+    // recurse as deep as it has primitives). Large second children become tasks.
+    void build(Task root) {
+        std::vector<Task> todo{root};
+        Bins bins_storage;
         while (!todo.empty()) {
-            std::uint32_t index = todo.back();
+            Task t = todo.back();
             todo.pop_back();
-            if (split_node(index)) {
-                std::uint32_t left = bvh.nodes[index].first;
-                todo.push_back(left + 1);
-                todo.push_back(left);
+            const auto n = static_cast<std::uint32_t>(t.end - t.begin);
+            // A node that fits one block is cheaper as a leaf than any split could be when a
+            // traversal step costs at least a block test.
+            if (n <= 1 || (n <= static_cast<std::uint32_t>(max_leaf) &&
+                           config.intersection_cost * blocks(n) <= config.traversal_cost)) {
+                make_leaf(t);
+                continue;
             }
+            // Small nodes get fewer bins: n bins already separate up to n distinct centres.
+            const int node_bins = static_cast<int>(std::min<std::uint32_t>(n, static_cast<std::uint32_t>(bins)));
+            Binner binner(t.centres, node_bins);
+            bin(t, binner, node_bins, bins_storage);
+            Split s = find_split(bins_storage, node_bins, n);
+            const float leaf_cost = config.intersection_cost * blocks(n);
+            std::size_t mid;
+            Task left{0, t.buffer, t.begin, 0, {}, {}}, right{0, t.buffer, 0, t.end, {}, {}};
+            if (s.axis >= 0) {
+                float split_cost =
+                    config.traversal_cost + config.intersection_cost * s.cost / t.bounds.half_area();
+                if (!(split_cost < leaf_cost) && n <= static_cast<std::uint32_t>(max_leaf)) {
+                    make_leaf(t);
+                    continue;
+                }
+                mid = partition(t, binner, s, left, right);
+                left.bounds = s.left;
+                right.bounds = s.right;
+            } else {
+                if (n <= static_cast<std::uint32_t>(max_leaf)) {
+                    make_leaf(t);
+                    continue;
+                }
+                mid = t.begin + n / 2;  // identical centres: split the list in two
+                range_bounds(buffers[t.buffer], t.begin, mid, left.bounds, left.centres);
+                range_bounds(buffers[t.buffer], mid, t.end, right.bounds, right.centres);
+            }
+            left.end = mid;
+            right.begin = mid;
+            std::uint32_t pair = next_node.fetch_add(2, std::memory_order_relaxed);
+            set_node(t.node, t.bounds, pair, 0);
+            left.node = pair;
+            right.node = pair + 1;
+            if (right.end - right.begin >= kTaskSize && left.end - left.begin >= kTaskSize) {
+                tasks.run([this, right] { build(right); });
+            } else {
+                todo.push_back(right);
+            }
+            todo.push_back(left);
         }
-    }
-
-    // Computes the node's bounds and splits it into two new children when that pays.
-    // Returns true when it split.
-    bool split_node(std::uint32_t index) {
-        BvhNode& node = bvh.nodes[index];
-        BBox cbox;
-        node.bounds = range_bounds(node.first, node.count, &cbox);
-        if (node.count <= 1) return false;
-
-        int axis;
-        float pos, split_cost;
-        bool found = find_split(node, cbox, axis, pos, split_cost);
-        const float leaf_cost = config.intersection_cost * node.count;
-        std::uint32_t mid;
-        if (found) {
-            float cost = config.traversal_cost +
-                         config.intersection_cost * split_cost / node.bounds.half_area();
-            if (cost >= leaf_cost && node.count <= static_cast<std::uint32_t>(config.max_leaf_size))
-                return false;
-            auto begin = bvh.prim_indices.begin() + node.first;
-            auto it = std::partition(begin, begin + node.count,
-                                     [&](std::uint32_t p) { return centers[p][axis] < pos; });
-            mid = static_cast<std::uint32_t>(it - bvh.prim_indices.begin());
-            if (mid == node.first || mid == node.first + node.count)
-                mid = node.first + node.count / 2;  // float edge case: fall back to a median cut
-        } else {
-            if (node.count <= static_cast<std::uint32_t>(config.max_leaf_size)) return false;
-            mid = node.first + node.count / 2;  // identical centroids: split the list in two
-        }
-
-        std::uint32_t left = static_cast<std::uint32_t>(bvh.nodes.size());
-        std::uint32_t first = node.first, count = node.count;
-        bvh.nodes.emplace_back();
-        bvh.nodes.emplace_back();
-        // `node` may dangle after emplace_back: index again.
-        bvh.nodes[left] = BvhNode{BBox{}, first, mid - first};
-        bvh.nodes[left + 1] = BvhNode{BBox{}, mid, first + count - mid};
-        bvh.nodes[index].first = left;
-        bvh.nodes[index].count = 0;
-        return true;
     }
 };
 
 }  // namespace
 
-Bvh Bvh::build(std::span<const BBox> boxes, std::span<const Vec3f> centers, const Config& config) {
+Bvh Bvh::build(std::span<const BBox> boxes, const Config& config) {
     Bvh bvh;
-    const auto n = static_cast<std::uint32_t>(boxes.size());
+    const std::size_t n = boxes.size();
     if (n == 0) return bvh;  // no nodes at all: a zero-count node would read as an inner node
+
+    // Not value-initialised: every element is written before it is read (pages are touched
+    // only when used).
+    auto refs = std::make_unique_for_overwrite<PrimRef[]>(n);
+    Box4 bounds, centres;
+    {
+        const std::size_t chunks = (n + kChunk - 1) / kChunk;
+        std::vector<Box4> b(chunks), c(chunks);
+        auto fill = [&](std::size_t chunk) {
+            Box4 bb, cc;
+            std::size_t e = std::min(n, (chunk + 1) * kChunk);
+            for (std::size_t i = chunk * kChunk; i < e; ++i) {
+                const BBox& box = boxes[i];
+                __m128 lo = _mm_setr_ps(box.lo.x, box.lo.y, box.lo.z, 0.0f);
+                __m128 hi = _mm_setr_ps(box.hi.x, box.hi.y, box.hi.z, 0.0f);
+                bb.extend(lo, hi);
+                cc.extend_point(_mm_add_ps(lo, hi));
+                refs[i].lo = _mm_castsi128_ps(_mm_insert_epi32(_mm_castps_si128(lo), static_cast<int>(i), 3));
+                refs[i].hi = hi;
+            }
+            b[chunk] = bb;
+            c[chunk] = cc;
+        };
+        if (n >= kParallelSplit) {
+            tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks, 1), [&](const auto& r) {
+                for (std::size_t k = r.begin(); k != r.end(); ++k) fill(k);
+            });
+        } else {
+            for (std::size_t k = 0; k < chunks; ++k) fill(k);
+        }
+        for (std::size_t k = 0; k < chunks; ++k) {
+            bounds.extend(b[k]);
+            centres.extend(c[k]);
+        }
+    }
+
+    auto scratch = std::make_unique_for_overwrite<PrimRef[]>(n >= kParallelSplit ? n : 0);
+    Builder builder(config, refs.get(), scratch.get());
+    builder.tmp = std::make_unique_for_overwrite<Builder::TmpNode[]>(2 * n - 1);
+    builder.build(Task{0, 0, 0, n, bounds, centres});
+    builder.tasks.wait();
+
+    // Number the nodes depth-first (children pairs after their parent), independently of the
+    // order tasks allocated them in.
+    const Builder::TmpNode* tmp = builder.tmp.get();
+    bvh.nodes.resize(builder.next_node.load());
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> stack{{0u, 0u}};
+    std::uint32_t next = 1;
+    while (!stack.empty()) {
+        auto [from, to] = stack.back();
+        stack.pop_back();
+        const Builder::TmpNode& t = tmp[from];
+        BvhNode node{BBox{Vec3f(t.lo[0], t.lo[1], t.lo[2]), Vec3f(t.hi[0], t.hi[1], t.hi[2])}, t.first, t.count};
+        if (!node.is_leaf()) {
+            std::uint32_t pair = next;
+            next += 2;
+            stack.push_back({node.first + 1, pair + 1});
+            stack.push_back({node.first, pair});
+            node.first = pair;
+        }
+        bvh.nodes[to] = node;
+    }
     bvh.prim_indices.resize(n);
-    std::iota(bvh.prim_indices.begin(), bvh.prim_indices.end(), 0u);
-    bvh.nodes.reserve(2 * n);
-    bvh.nodes.push_back(BvhNode{BBox{}, 0, n});
-    Builder builder{boxes, centers, config, bvh};
-    builder.build(0);
-    bvh.nodes.shrink_to_fit();
+    for (std::size_t i = 0; i < n; ++i)
+        bvh.prim_indices[i] = static_cast<std::uint32_t>(_mm_extract_epi32(_mm_castps_si128(refs[i].lo), 3));
     return bvh;
 }
 

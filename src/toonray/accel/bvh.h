@@ -1,6 +1,7 @@
 #pragma once
 /// A binary bounding volume hierarchy that knows nothing about triangles: it is built from
-/// boxes and centres, and traversal is left to the caller (see triangle_accel.h).
+/// boxes, and traversal is left to the caller (see triangle_accel.h, which collapses it into an
+/// 8-wide tree for SIMD traversal).
 
 #include <cstdint>
 #include <span>
@@ -21,23 +22,25 @@ struct BvhNode {
 };
 
 struct Bvh {
-    /// Build settings; defaults suit triangle meshes.
+    /// Build settings; defaults suit triangle meshes traced with SIMD leaf tests.
     struct Config {
-        int max_leaf_size = 8;      ///< leaves never hold more (the seed used 10)
-        int bin_count = 16;         ///< SAH bins per axis
+        int max_leaf_size = 8;      ///< leaves never hold more (clamped to [1, 128])
+        int bin_count = 16;         ///< SAH bins per axis (clamped to [2, 64])
         float traversal_cost = 1.0f;  ///< cost of visiting a node, relative to...
-        float intersection_cost = 1.0f;  ///< ...testing one primitive
+        float intersection_cost = 1.0f;  ///< ...testing one block of `block_size` primitives
+        int block_size = 2;  ///< primitives tested together (the leaf test's SIMD width; a power of two)
     };
 
     std::vector<BvhNode> nodes;  ///< nodes[0] is the root; children follow parents; empty if no primitives
     std::vector<std::uint32_t> prim_indices;  ///< primitive ids in leaf order
 
-    /// Builds with binned SAH. Deterministic: the same input gives the same tree.
-    [[nodiscard]] static Bvh build(std::span<const BBox> boxes, std::span<const Vec3f> centers,
-                                   const Config& config);
-    [[nodiscard]] static Bvh build(std::span<const BBox> boxes, std::span<const Vec3f> centers) {
-        return build(boxes, centers, Config{});
-    }
+    /// Builds with binned SAH on the boxes' centres: all three axes binned in one pass over the
+    /// primitives, the large top levels binned and partitioned in parallel (TBB) and subtrees
+    /// built as parallel tasks. Deterministic: the same input gives the same tree for any thread
+    /// count (work is cut at fixed sizes, merges are exact min/max and sums, and nodes are
+    /// numbered in a final depth-first pass).
+    [[nodiscard]] static Bvh build(std::span<const BBox> boxes, const Config& config);
+    [[nodiscard]] static Bvh build(std::span<const BBox> boxes) { return build(boxes, Config{}); }
 
     /// Recomputes node bounds for moved primitives, keeping the topology (for animation where
     /// only poses change).

@@ -29,9 +29,10 @@ void trace_primary(const TriangleAccel& accel, const ViewPlane& view, int width,
                     Vec3f target = sub == 1 ? view.pixel_point(x + 0.5f, y + 0.5f)
                                             : view.pixel_point((x + 0.5f) * inv_sub, (y + 0.5f) * inv_sub);
                     dirs[i] = normalize(target - view.eye);
-                    hits[i] = Hit{};
-                    found[i] = accel.intersect(Ray{view.eye, dirs[i]}, hits[i]);
                 }
+            // The whole tile at once: a frustum of ray packets, with exactly the hits that
+            // accel.intersect gives ray by ray.
+            accel.intersect_tile(view.eye, dirs.data(), t.x1 - t.x0, t.y1 - t.y0, hits.data(), found.data());
             t.dirs = dirs.data();
             t.hits = hits.data();
             t.found = found.data();

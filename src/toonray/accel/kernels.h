@@ -1,0 +1,35 @@
+#pragma once
+/// The traversal kernels per instruction set (internal to the accel module): kernels_sse.cpp
+/// (the portable build, SSE4.2) and kernels_avx2.cpp (AVX2, compiled with a target pragma and
+/// chosen at run time when the CPU has it). Both compute bit-identical results.
+
+#include <cstdint>
+
+#include "toonray/accel/triangle_accel.h"
+#include "toonray/accel/wide_bvh.h"
+
+namespace toonray::accel {
+
+/// A pending subtree of tile traversal: the groups of rays that may hit it.
+struct TileEntry {
+    std::uint32_t ref;
+    std::uint32_t groups;
+    float tnear;
+};
+
+struct KernelTable {
+    const char* name;
+    /// Closest hit of one ray; `stack` holds WideBvh::max_stack entries.
+    bool (*intersect1)(const WideBvh& w, const Ray& ray, Hit& hit, std::uint64_t* stack);
+    /// Closest hits of a width x height (<= 16 x 16) row-major tile of rays from one origin.
+    void (*intersect_tile)(const WideBvh& w, const Vec3f& origin, const Vec3f* dirs, int width, int height,
+                           float tmax, Hit* hits, bool* found, TileEntry* stack, std::uint64_t* stack1);
+};
+
+const KernelTable& kernels_sse();
+/// Null when this build has no AVX2 kernels.
+const KernelTable* kernels_avx2();
+/// Null when this build has no AVX-512 kernels.
+const KernelTable* kernels_avx512();
+
+}  // namespace toonray::accel

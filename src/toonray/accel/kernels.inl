@@ -1,0 +1,656 @@
+// The traversal kernels (internal to the accel module), written once against the vf8/vm8/vi8
+// types of simd8.inl and compiled twice: kernels_sse.cpp (the portable x86-64-v2 build) and
+// kernels_avx2.cpp (AVX2, chosen at run time when the CPU has it). Included inside
+// `namespace toonray::accel::<isa>`, after simd8.inl, with all headers already included.
+//
+// Exactness: every lane of the triangle tests does the float operations of watertight_test()
+// in its order; lanes whose edge functions hit an exact zero (which the scalar test redoes in
+// double) are handed to watertight_test() itself. A hit is taken by BestHit's rule, so the
+// result is the lowest (t, triangle index) over the triangles whose test passes, which does not
+// depend on traversal order. Box culling is conservative: the far distance is widened by
+// kBoxSlack as before, interval (frustum) tests bound the per-ray slab distances exactly (float
+// multiplication is monotonic), and NaN distances never cull.
+
+constexpr int kNearLo[3] = {0, 8, 16};   // offsets of lo[axis] in a WideNode, in floats
+constexpr int kNearHi[3] = {24, 32, 40};  // offsets of hi[axis]
+
+template <class V, class M>
+struct LaneResultT {
+    M ok;    // hit with 0 < t <= tmax (and no exact zero edge function)
+    M zero;  // an edge function is exactly zero: redo in scalar
+    V t, u, v;
+};
+using LaneResult = LaneResultT<vf8, vm8>;
+
+// The first half of watertight_test() on 4 or 8 lanes: the sheared corners and the edge
+// functions, from the corners relative to the ray origin (a = v0 - origin etc., components in
+// the ray's kx, ky, kz order). `live` has the lanes the sign test does not reject, and those
+// with an exact zero (which the scalar test re-evaluates in double before its sign test).
+template <class V, class M>
+struct EdgesT {
+    V e0, e1, e2;
+    M zero, live;
+};
+using Edges = EdgesT<vf8, vm8>;
+
+template <class V, class M>
+TR_INLINE EdgesT<V, M> edges(V akx, V aky, V akz, V bkx, V bky, V bkz, V ckx, V cky, V ckz, V sx, V sy) {
+    const V zero = splat<V>(0.0f);
+    const V ax = akx - sx * akz, ay = aky - sy * akz;
+    const V bx = bkx - sx * bkz, by = bky - sy * bkz;
+    const V cx = ckx - sx * ckz, cy = cky - sy * ckz;
+    EdgesT<V, M> e;
+    e.e0 = cx * by - cy * bx;
+    e.e1 = ax * cy - ay * cx;
+    e.e2 = bx * ay - by * ax;
+    e.zero = (e.e0 == zero) | (e.e1 == zero) | (e.e2 == zero);
+    // The scalar test rejects when some edge function is < 0 and another > 0. Without zeros
+    // that is "the sign bits differ"; lanes with a zero go to the scalar test whatever their
+    // signs, and NaN lanes fail the final t test however they are classified here.
+    const M s0 = as_mask(e.e0), s1 = as_mask(e.e1), s2 = as_mask(e.e2);
+    e.live = (s0 & s1 & s2) | not_mask(s0 | s1 | s2) | e.zero;
+    return e;
+}
+TR_INLINE Edges edges8(vf8 akx, vf8 aky, vf8 akz, vf8 bkx, vf8 bky, vf8 bkz, vf8 ckx, vf8 cky, vf8 ckz, vf8 sx,
+                       vf8 sy) {
+    return edges<vf8, vm8>(akx, aky, akz, bkx, bky, bkz, ckx, cky, ckz, sx, sy);
+}
+
+// The rest of watertight_test(), for lanes the edges leave live.
+template <class V, class M>
+TR_INLINE LaneResultT<V, M> finish(const EdgesT<V, M>& e, V akz, V bkz, V ckz, V sz, V tmax) {
+    const V zero = splat<V>(0.0f);
+    const V det = e.e0 + e.e1 + e.e2;
+    const V az = sz * akz, bz = sz * bkz, cz = sz * ckz;
+    const V st = e.e0 * az + e.e1 * bz + e.e2 * cz;
+    const V bound = tmax * det * splat<V>(kTmaxSlack);
+    // On live lanes without a zero, det is nonzero with the edges' sign; flipping st and bound
+    // by it turns the scalar test's det < 0 case into its det > 0 case exactly.
+    const V sign = sign_bits(det);
+    const V st1 = flip_sign(st, sign), bound1 = flip_sign(bound, sign);
+    const M rej = (st1 <= zero) | (st1 > bound1);
+    const V inv = splat<V>(1.0f) / det;
+    const V t = st * inv;
+    const M ok = andnot(e.zero | (det == zero) | rej, (t > zero) & (t <= tmax) & e.live);
+    return {ok, e.zero, t, e.e1 * inv, e.e2 * inv};
+}
+TR_INLINE LaneResult finish8(const Edges& e, vf8 akz, vf8 bkz, vf8 ckz, vf8 sz, vf8 tmax) {
+    return finish<vf8, vm8>(e, akz, bkz, ckz, sz, tmax);
+}
+
+inline float as_float(std::uint32_t u) {
+    float f;
+    std::memcpy(&f, &u, 4);
+    return f;
+}
+inline std::uint32_t as_bits(float f) {
+    std::uint32_t u;
+    std::memcpy(&u, &f, 4);
+    return u;
+}
+
+// ---------------------------------------------------------------------------------------------
+// One ray: 8 child boxes per step, leaf blocks two at a time (8 triangles).
+
+// What the single-ray leaf test needs of the ray, computed once per ray.
+struct LeafRay {
+    ShearedRay sr;
+    int ox, oy, oz;  // offsets of the kx, ky, kz rows in a TriBlock corner, in floats
+    float o[3];      // origin[kx], origin[ky], origin[kz]
+};
+
+constexpr std::uint32_t kPrimMask = ~kLeafEnd;
+
+// The scalar test for lanes with an exact zero edge function.
+TR_INLINE void leaf_zero_lanes(int zero, const TriBlock& b0, const TriBlock& b1, const ShearedRay& sr,
+                               BestHit& best) {
+    while (zero) {
+        int i = __builtin_ctz(static_cast<unsigned>(zero));
+        zero &= zero - 1;
+        const TriBlock& b = i < 4 ? b0 : b1;
+        int l = i & 3;
+        const std::uint32_t prim = b.prim[l] & kPrimMask;
+        float t, u, v;
+        if (watertight_test(sr, Vec3f(b.v[0][0][l], b.v[0][1][l], b.v[0][2][l]),
+                            Vec3f(b.v[1][0][l], b.v[1][1][l], b.v[1][2][l]),
+                            Vec3f(b.v[2][0][l], b.v[2][1][l], b.v[2][2][l]), best.t, t, u, v) &&
+            best.takes(t, prim))
+            best.take(t, prim, u, v);
+    }
+}
+
+template <class V, class M>
+TR_INLINE void take_lanes(int ok, const LaneResultT<V, M>& r, const TriBlock& b0, const TriBlock& b1,
+                          BestHit& best) {
+    alignas(32) float ts[8], us[8], vs[8];
+    if constexpr (sizeof(V) == sizeof(vf8)) {
+        store8(ts, r.t);
+        store8(us, r.u);
+        store8(vs, r.v);
+    } else {
+        store4(ts, r.t);
+        store4(us, r.u);
+        store4(vs, r.v);
+    }
+    do {
+        int i = __builtin_ctz(static_cast<unsigned>(ok));
+        ok &= ok - 1;
+        std::uint32_t prim = (i < 4 ? b0.prim[i] : b1.prim[i - 4]) & kPrimMask;
+        if (best.takes(ts[i], prim)) best.take(ts[i], prim, us[i], vs[i]);
+    } while (ok);
+}
+
+// Sign bits of the prims of two blocks: which slots end their leaf.
+TR_INLINE int leaf_ends(const TriBlock& b0, const TriBlock& b1) {
+    return _mm_movemask_ps(_mm_load_ps(reinterpret_cast<const float*>(b0.prim))) |
+           (_mm_movemask_ps(_mm_load_ps(reinterpret_cast<const float*>(b1.prim))) << 4);
+}
+
+// Not inlined: the traversal loop keeps its registers for the node tests.
+__attribute__((noinline)) void leaf1(const WideBvh& w, std::uint32_t ref, const LeafRay& lr, BestHit& best) {
+    const std::uint32_t first = leaf_first(ref);
+    const TriBlock* blk = &w.blocks[first / 4];
+    int start = static_cast<int>(first % 4);
+    int left = static_cast<int>(leaf_count(ref));  // 0: a long leaf, ended by kLeafEnd
+    const int kx = lr.ox, ky = lr.oy, kz = lr.oz;
+    while (true) {
+        // A window of up to 8 slots (two blocks) from the leaf's start.
+        const TriBlock& b0 = blk[0];
+        const TriBlock& b1 = blk[1];
+        const int from = 0xff << start;
+        int valid;
+        bool done;
+        if (left) {
+            const int n = std::min(left, 8 - start);
+            valid = ((1 << n) - 1) << start;
+            left -= n;
+            done = left == 0;
+        } else {
+            const int ends = leaf_ends(b0, b1) & from;
+            valid = ends ? from & ((2 << __builtin_ctz(static_cast<unsigned>(ends))) - 1) : from;
+            done = ends != 0;
+        }
+        if ((valid & 0xf0) == 0) {
+            // Within the first block: 4 lanes.
+            const float* v0 = b0.v[0][0];
+            const float* v1 = b0.v[1][0];
+            const float* v2 = b0.v[2][0];
+            const vf4 okx = set1_4(lr.o[0]), oky = set1_4(lr.o[1]), okz = set1_4(lr.o[2]);
+            const vf4 akz = load4(v0 + kz) - okz, bkz = load4(v1 + kz) - okz, ckz = load4(v2 + kz) - okz;
+            const EdgesT<vf4, vm4> e =
+                edges<vf4, vm4>(load4(v0 + kx) - okx, load4(v0 + ky) - oky, akz, load4(v1 + kx) - okx,
+                                load4(v1 + ky) - oky, bkz, load4(v2 + kx) - okx, load4(v2 + ky) - oky, ckz,
+                                set1_4(lr.sr.sx), set1_4(lr.sr.sy));
+            if (movemask(e.live) & valid) {
+                const LaneResultT<vf4, vm4> r =
+                    finish<vf4, vm4>(e, akz, bkz, ckz, set1_4(lr.sr.sz), set1_4(best.t));
+                const int ok = movemask(r.ok) & valid;
+                const int zero = movemask(r.zero) & valid;
+                if (ok) take_lanes(ok, r, b0, b0, best);
+                if (zero) leaf_zero_lanes(zero, b0, b0, lr.sr, best);
+            }
+        } else {
+            const float* p0 = &b0.v[0][0][0];
+            const float* p1 = &b1.v[0][0][0];
+            auto ld = [&](int corner, int row) { return load4x2(p0 + corner * 12 + row, p1 + corner * 12 + row); };
+            const vf8 o8[3] = {bcast(&lr.o[0]), bcast(&lr.o[1]), bcast(&lr.o[2])};
+            const vf8 s8[3] = {bcast(&lr.sr.sx), bcast(&lr.sr.sy), bcast(&lr.sr.sz)};
+            const vf8 akz = ld(0, kz) - o8[2], bkz = ld(1, kz) - o8[2], ckz = ld(2, kz) - o8[2];
+            const Edges e = edges8(ld(0, kx) - o8[0], ld(0, ky) - o8[1], akz, ld(1, kx) - o8[0], ld(1, ky) - o8[1],
+                                   bkz, ld(2, kx) - o8[0], ld(2, ky) - o8[1], ckz, s8[0], s8[1]);
+            if (movemask(e.live) & valid) {
+                const LaneResult r = finish8(e, akz, bkz, ckz, s8[2], set1(best.t));
+                const int ok = movemask(r.ok) & valid;
+                const int zero = movemask(r.zero) & valid;
+                if (ok) take_lanes(ok, r, b0, b1, best);
+                if (zero) leaf_zero_lanes(zero, b0, b1, lr.sr, best);
+            }
+        }
+        if (done) return;
+        blk += 2;
+        start = 0;
+    }
+}
+
+TR_INLINE std::uint64_t stack_key(float tnear, std::uint32_t ref) {
+    return (static_cast<std::uint64_t>(as_bits(tnear)) << 32) | ref;  // tnear >= +0: bits order like floats
+}
+
+bool intersect1(const WideBvh& w, const Ray& ray, Hit& hit, std::uint64_t* stack) {
+    if (w.root == kEmptyChild) return false;
+    // The shear is set up at the first leaf: many rays (those that miss) never need it.
+    LeafRay lr;
+    bool have_lr = false;
+    const float inv[3] = {1.0f / ray.dir.x, 1.0f / ray.dir.y, 1.0f / ray.dir.z};
+    // Near planes: lo for a positive direction, hi for a negative one (by the sign bit, so that
+    // -0 picks hi like -inf would).
+    // (Six scalars rather than a loop over arrays, which GCC would vectorise and then unpack
+    // at every node.)
+    const std::size_t nx = as_bits(inv[0]) >> 31, ny = as_bits(inv[1]) >> 31, nz = as_bits(inv[2]) >> 31;
+    const std::size_t nr[3] = {0 + 24 * nx, 8 + 24 * ny, 16 + 24 * nz};
+    const std::size_t fr[3] = {24 - 24 * nx, 32 - 24 * ny, 40 - 24 * nz};
+    const vf8 zero = set1(0.0f);
+    BestHit best{ray.tmax};
+    float cull = best.t * kBoxSlack;  // boxes entered beyond this cannot hold a hit
+#ifdef TOONRAY_ACCEL_FMA
+    // Slab distances as one fused multiply-add per plane, t = p * inv + c with c = -o * inv,
+    // made conservative in the constants: c's rounding error is at most |c| 2^-24, so near
+    // planes use c - |c| 2^-21 and far planes c + |c| 2^-21; the far distance is then widened
+    // by kBoxSlack as in the plain test. (Infinite or NaN terms give NaN, which never culls.)
+    vf8 in8[3], cn8[3], cf8[3];
+    for (int a = 0; a < 3; ++a) {
+        const float c = -(ray.origin[a] * inv[a]);
+        const float margin = std::abs(c) * (1.0f / (1 << 21));
+        in8[a] = set1(inv[a]);
+        cn8[a] = set1(c - margin);
+        cf8[a] = set1(c + margin);
+    }
+    vf8 tmax8 = set1(best.t);
+#else
+    const vf8 ox = set1(ray.origin.x), oy = set1(ray.origin.y), oz = set1(ray.origin.z);
+    const vf8 ix = set1(inv[0]), iy = set1(inv[1]), iz = set1(inv[2]);
+    const vf8 slack = set1(kBoxSlack);
+#endif
+    std::uint32_t ref = w.root;
+    std::size_t sp = 0;
+    while (true) {
+        while (!is_leaf(ref)) {
+            const WideNode& node = w.nodes[ref];
+            const float* b = &node.lo[0][0];
+#ifdef TOONRAY_ACCEL_FMA
+            vf8 tn = vmax(fmadd(load8(b + nr[0]), in8[0], cn8[0]), zero);
+            tn = vmax(fmadd(load8(b + nr[1]), in8[1], cn8[1]), tn);
+            tn = vmax(fmadd(load8(b + nr[2]), in8[2], cn8[2]), tn);
+            vf8 tf = vmin(fmadd(load8(b + fr[0]), in8[0], cf8[0]), tmax8);
+            tf = vmin(fmadd(load8(b + fr[1]), in8[1], cf8[1]), tf);
+            tf = vmin(fmadd(load8(b + fr[2]), in8[2], cf8[2]), tf);
+            // Empty slots have empty boxes, but NaN distances (degenerate rays) cull nothing.
+            unsigned mask = static_cast<unsigned>(movemask(tn <= tf * set1(kBoxSlack))) & node.pad[0];
+#else
+            vf8 tn = vmax((load8(b + nr[0]) - ox) * ix, zero);
+            tn = vmax((load8(b + nr[1]) - oy) * iy, tn);
+            tn = vmax((load8(b + nr[2]) - oz) * iz, tn);
+            vf8 tf = vmin((load8(b + fr[0]) - ox) * ix, set1(best.t));
+            tf = vmin((load8(b + fr[1]) - oy) * iy, tf);
+            tf = vmin((load8(b + fr[2]) - oz) * iz, tf);
+            unsigned mask = static_cast<unsigned>(movemask(tn <= tf * slack)) & node.pad[0];
+#endif
+            if (mask == 0) goto pop;
+            const unsigned first = __builtin_ctz(mask);
+            mask &= mask - 1;
+            if (mask == 0) {
+                ref = node.child[first];
+                continue;
+            }
+            alignas(32) float tns[8];
+            store8(tns, tn);
+            const unsigned second = __builtin_ctz(mask);
+            mask &= mask - 1;
+            if (mask == 0) {
+                // Two: go to the nearer, keep the farther.
+                const bool swap = tns[second] < tns[first];
+                const unsigned n = swap ? second : first, f = swap ? first : second;
+                stack[sp++] = stack_key(tns[f], node.child[f]);
+                ref = node.child[n];
+                continue;
+            }
+            // More: push them all sorted, nearest last, and continue with the nearest.
+            const std::size_t base = sp;
+            std::uint64_t k0 = stack_key(tns[first], node.child[first]);
+            std::uint64_t k1 = stack_key(tns[second], node.child[second]);
+            stack[sp++] = k0 > k1 ? k0 : k1;
+            stack[sp++] = k0 > k1 ? k1 : k0;
+            do {
+                const unsigned i = __builtin_ctz(mask);
+                mask &= mask - 1;
+                const std::uint64_t key = stack_key(tns[i], node.child[i]);
+                std::size_t j = sp++;
+                while (j > base && stack[j - 1] < key) {
+                    stack[j] = stack[j - 1];
+                    --j;
+                }
+                stack[j] = key;
+            } while (mask);
+            ref = static_cast<std::uint32_t>(stack[--sp]);
+        }
+        {
+            const std::uint32_t before = best.prim;
+            const float before_t = best.t;
+            if (!have_lr) {
+                lr.sr = ShearedRay(ray);
+                lr.ox = lr.sr.kx * 4;
+                lr.oy = lr.sr.ky * 4;
+                lr.oz = lr.sr.kz * 4;
+                lr.o[0] = ray.origin[lr.sr.kx];
+                lr.o[1] = ray.origin[lr.sr.ky];
+                lr.o[2] = ray.origin[lr.sr.kz];
+                have_lr = true;
+            }
+            leaf1(w, ref, lr, best);
+            if (best.prim != before || best.t != before_t) {
+                cull = best.t * kBoxSlack;
+#ifdef TOONRAY_ACCEL_FMA
+                tmax8 = set1(best.t);
+#endif
+            }
+        }
+    pop:
+        while (true) {
+            if (sp == 0) goto done;
+            const std::uint64_t e = stack[--sp];
+            if (as_float(static_cast<std::uint32_t>(e >> 32)) <= cull) {
+                ref = static_cast<std::uint32_t>(e);
+                break;
+            }
+        }
+    }
+done:
+    if (best.prim == kNoPrim) return false;
+    hit.t = best.t;
+    hit.prim = best.prim;
+    hit.u = best.u;
+    hit.v = best.v;
+    return true;
+}
+
+// ---------------------------------------------------------------------------------------------
+// A tile of up to 16 x 16 rays from one origin, as groups of 4 x 2 rays (one vector each).
+// Each group keeps the interval of its rays' inverse directions; a node's children are culled
+// for the whole tile at once, then for each group (8 groups per vector), and leaves are tested
+// one triangle against a group's 8 rays at a time. Groups whose rays do not share the shear
+// permutation, or have a zero, infinite or sign-changing direction component, are traced ray
+// by ray instead.
+
+constexpr int kMaxGroups = 32;
+
+struct alignas(32) TileState {
+    float sx[kMaxGroups][8], sy[kMaxGroups][8], sz[kMaxGroups][8];
+    float tmax[kMaxGroups][8], u[kMaxGroups][8], v[kMaxGroups][8];
+    std::uint32_t prim[kMaxGroups][8];
+    float ilo[3][kMaxGroups], ihi[3][kMaxGroups];  // per group, per axis: range of 1 / dir
+    float gtmax[kMaxGroups];                       // largest tmax of the group's rays
+    int k[kMaxGroups][3];                          // kx, ky, kz
+    int cls[kMaxGroups];                           // the permutation as one number
+    int pix[kMaxGroups][8];
+    int lanes[kMaxGroups];  // lanes that are real rays (others repeat lane 0)
+};
+
+// Lanes with an exact zero edge function go through the scalar test.
+TR_INLINE void group_zero_lanes(int zero, TileState& s, int g, const Vec3f& origin, const TriBlock& b, int j,
+                                std::uint32_t p) {
+    const Vec3f v0(b.v[0][0][j], b.v[0][1][j], b.v[0][2][j]);
+    const Vec3f v1(b.v[1][0][j], b.v[1][1][j], b.v[1][2][j]);
+    const Vec3f v2(b.v[2][0][j], b.v[2][1][j], b.v[2][2][j]);
+    do {
+        int i = __builtin_ctz(static_cast<unsigned>(zero));
+        zero &= zero - 1;
+        ShearedRay sr;
+        sr.kx = s.k[g][0];
+        sr.ky = s.k[g][1];
+        sr.kz = s.k[g][2];
+        sr.sx = s.sx[g][i];
+        sr.sy = s.sy[g][i];
+        sr.sz = s.sz[g][i];
+        sr.origin = origin;
+        const BestHit bh{s.tmax[g][i], s.prim[g][i], s.u[g][i], s.v[g][i]};
+        float t, u, v;
+        if (watertight_test(sr, v0, v1, v2, bh.t, t, u, v) && bh.takes(t, p)) {
+            s.tmax[g][i] = t;
+            s.prim[g][i] = p;
+            s.u[g][i] = u;
+            s.v[g][i] = v;
+        }
+    } while (zero);
+}
+
+// Tests the rays of `groups` against every triangle of a leaf, triangle by triangle: the
+// triangle's corners relative to the origin, in a permutation's order, are shared by all groups
+// of that permutation (usually all of them).
+TR_INLINE void leaf_groups(const WideBvh& w, std::uint32_t ref, TileState& s, std::uint32_t groups,
+                           const Vec3f& origin) {
+    const vi8 none = seti1(kNoPrim);
+    std::uint32_t touched = 0;
+    for (std::uint32_t slot = leaf_first(ref);; ++slot) {
+        const TriBlock& b = w.blocks[slot / 4];
+        const int j = static_cast<int>(slot % 4);
+        const std::uint32_t p = b.prim[j] & kPrimMask;
+        const bool last = (b.prim[j] & kLeafEnd) != 0;
+        vf8 a[3][3];  // [corner][kx, ky, kz]
+        int cls = 0;
+        auto prepare = [&](int g) {
+            cls = s.cls[g];
+            for (int c = 0; c < 3; ++c)
+                for (int r = 0; r < 3; ++r) a[c][r] = set1(b.v[c][s.k[g][r]][j] - origin[s.k[g][r]]);
+        };
+        prepare(__builtin_ctz(groups));
+        std::uint32_t gm = groups;
+        do {
+            const int g = __builtin_ctz(gm);
+            gm &= gm - 1;
+            if (s.cls[g] != cls) prepare(g);
+            const Edges e = edges8(a[0][0], a[0][1], a[0][2], a[1][0], a[1][1], a[1][2], a[2][0], a[2][1], a[2][2],
+                                   load8(s.sx[g]), load8(s.sy[g]));
+            if (!movemask(e.live)) continue;
+            const vf8 tmax = load8(s.tmax[g]);
+            const LaneResult r = finish8(e, a[0][2], a[1][2], a[2][2], load8(s.sz[g]), tmax);
+            const vi8 prim = loadi8(s.prim[g]), pv = seti1(p);
+            const vm8 take = r.ok & ((r.t < tmax) | andnot(eqi(prim, none), lt_signed(pv, prim)));
+            if (movemask(take)) {
+                store8(s.tmax[g], select(take, r.t, tmax));
+                store8(s.u[g], select(take, r.u, load8(s.u[g])));
+                store8(s.v[g], select(take, r.v, load8(s.v[g])));
+                storei8(s.prim[g], selecti(take, pv, prim));
+                touched |= 1u << g;
+            }
+            if (const int zero = movemask(r.zero)) {
+                group_zero_lanes(zero, s, g, origin, b, j, p);
+                touched |= 1u << g;
+            }
+        } while (gm);
+        if (last) break;
+    }
+    while (touched) {
+        const int g = __builtin_ctz(touched);
+        touched &= touched - 1;
+        s.gtmax[g] = hmax(load8(s.tmax[g]));
+    }
+}
+
+void intersect_tile(const WideBvh& w, const Vec3f& origin, const Vec3f* dirs, int width, int height, float tmax_in,
+                    Hit* hits, bool* found, TileEntry* stack, std::uint64_t* stack1) {
+    const int gw = (width + 3) / 4, gh = (height + 1) / 2, ng = gw * gh;
+    TileState s;
+    std::uint32_t regular = 0, irregular = 0;
+    const float inf = std::numeric_limits<float>::infinity();
+    int sign_pos[3] = {0, 0, 0}, sign_neg[3] = {0, 0, 0};
+    for (int g = 0; g < kMaxGroups; ++g) {
+        for (int a = 0; a < 3; ++a) s.ilo[a][g] = s.ihi[a][g] = 1.0f;
+        s.gtmax[g] = -inf;
+    }
+    // Set up the groups.
+    for (int g = 0; g < ng; ++g) {
+        const int gx = (g % gw) * 4, gy = (g / gw) * 2;
+        alignas(32) float d[3][8];
+        int lanes = 0;
+        for (int l = 0; l < 8; ++l) {
+            int x = gx + (l & 3), y = gy + (l >> 2);
+            if (x < width && y < height) {
+                lanes |= 1 << l;
+            } else {
+                x = gx;
+                y = gy;
+            }
+            const int p = y * width + x;
+            s.pix[g][l] = p;
+            d[0][l] = dirs[p].x;
+            d[1][l] = dirs[p].y;
+            d[2][l] = dirs[p].z;
+        }
+        s.lanes[g] = lanes;
+        const vf8 dv[3] = {load8(d[0]), load8(d[1]), load8(d[2])};
+        const vf8 adx = vabs(dv[0]), ady = vabs(dv[1]), adz = vabs(dv[2]);
+        // kz = ax > ay ? (ax > az ? 0 : 2) : (ay > az ? 1 : 2), as ShearedRay does per ray.
+        const vm8 xy = adx > ady;
+        const int m0 = movemask(xy & (adx > adz)), m1 = movemask(andnot(xy, ady > adz));
+        int kz = m0 == 0xff ? 0 : m1 == 0xff ? 1 : (m0 | m1) == 0 ? 2 : -1;
+        bool ok = kz >= 0;
+        vf8 iv[3];
+        int neg[3];
+        for (int a = 0; a < 3 && ok; ++a) {
+            iv[a] = set1(1.0f) / dv[a];
+            neg[a] = movemask(iv[a] < set1(0.0f));
+            ok = movemask(vabs(iv[a]) < set1(inf)) == 0xff && (neg[a] == 0 || neg[a] == 0xff);
+        }
+        if (!ok) {
+            irregular |= 1u << g;
+            continue;
+        }
+        int kx = (kz + 1) % 3, ky = (kx + 1) % 3;
+        if (neg[kz]) std::swap(kx, ky);  // dir[kz] < 0 on every lane
+        s.k[g][0] = kx;
+        s.k[g][1] = ky;
+        s.k[g][2] = kz;
+        s.cls[g] = kz * 2 + (neg[kz] ? 1 : 0);
+        store8(s.sx[g], dv[kx] / dv[kz]);
+        store8(s.sy[g], dv[ky] / dv[kz]);
+        store8(s.sz[g], set1(1.0f) / dv[kz]);
+        store8(s.tmax[g], set1(tmax_in));
+        store8(s.u[g], set1(0.0f));
+        store8(s.v[g], set1(0.0f));
+        storei8(s.prim[g], seti1(kNoPrim));
+        s.gtmax[g] = tmax_in;
+        for (int a = 0; a < 3; ++a) {
+            s.ilo[a][g] = hmin(iv[a]);
+            s.ihi[a][g] = hmax(iv[a]);
+            (neg[a] ? sign_neg : sign_pos)[a] = 1;
+        }
+        regular |= 1u << g;
+    }
+
+    if (regular && w.root != kEmptyChild) {
+        // The tile's interval per axis, over its regular groups; an axis on which the groups'
+        // signs differ gives no bound ("free").
+        float tlo[3] = {inf, inf, inf}, thi[3] = {-inf, -inf, -inf};
+        bool free_axis[3];
+        int tn_off[3], tf_off[3];
+        for (int a = 0; a < 3; ++a) {
+            for (int g = 0; g < ng; ++g)
+                if (regular >> g & 1) {
+                    tlo[a] = std::min(tlo[a], s.ilo[a][g]);
+                    thi[a] = std::max(thi[a], s.ihi[a][g]);
+                }
+            free_axis[a] = sign_pos[a] && sign_neg[a];
+            tn_off[a] = sign_neg[a] ? kNearHi[a] : kNearLo[a];
+            tf_off[a] = sign_neg[a] ? kNearLo[a] : kNearHi[a];
+        }
+        const float o[3] = {origin.x, origin.y, origin.z};
+        const vf8 zero = set1(0.0f), slack = set1(kBoxSlack);
+        auto tile_tmax = [&] {
+            vf8 m = vmax(load8(s.gtmax), load8(s.gtmax + 8));
+            m = vmax(m, vmax(load8(s.gtmax + 16), load8(s.gtmax + 24)));
+            return hmax(m);
+        };
+        float ttmax = tile_tmax();
+
+        std::uint32_t ref = w.root, groups = regular;
+        std::size_t sp = 0;
+        while (true) {
+            while (!is_leaf(ref)) {
+                const WideNode& n = w.nodes[ref];
+                const float* b = &n.lo[0][0];
+                // Whole tile against the 8 children.
+                vf8 tn = zero, tf = set1(ttmax);
+                for (int a = 0; a < 3; ++a) {
+                    if (free_axis[a]) continue;
+                    const vf8 lo = set1(tlo[a]), hi = set1(thi[a]), oa = set1(o[a]);
+                    const vf8 dn = load8(b + tn_off[a]) - oa, df = load8(b + tf_off[a]) - oa;
+                    tn = vmax(vmin(dn * lo, dn * hi), tn);
+                    tf = vmin(vmax(df * lo, df * hi), tf);
+                }
+                int cmask = movemask(tn <= tf * slack) & static_cast<int>(n.pad[0]);
+                if (cmask == 0) goto pop;
+                alignas(32) float tns[8], dlo[3][8], dhi[3][8];
+                store8(tns, tn);
+                for (int a = 0; a < 3; ++a) {
+                    store8(dlo[a], load8(b + kNearLo[a]) - set1(o[a]));
+                    store8(dhi[a], load8(b + kNearHi[a]) - set1(o[a]));
+                }
+                // Each child against the groups.
+                std::size_t base = sp;
+                do {
+                    int c = __builtin_ctz(static_cast<unsigned>(cmask));
+                    cmask &= cmask - 1;
+                    std::uint32_t gm = 0;
+                    for (int q = 0; q < 4; ++q) {
+                        const std::uint32_t qm = (groups >> (8 * q)) & 0xff;
+                        if (!qm) continue;
+                        vf8 gtn = zero, gtf = load8(s.gtmax + 8 * q);
+                        for (int a = 0; a < 3; ++a) {
+                            const vf8 il = load8(s.ilo[a] + 8 * q), ih = load8(s.ihi[a] + 8 * q);
+                            const vf8 l = bcast(&dlo[a][c]), h = bcast(&dhi[a][c]);
+                            if (free_axis[a]) {
+                                const vf8 p1 = l * il, p2 = l * ih, p3 = h * il, p4 = h * ih;
+                                gtn = vmax(vmin(vmin(p1, p2), vmin(p3, p4)), gtn);
+                                gtf = vmin(vmax(vmax(p1, p2), vmax(p3, p4)), gtf);
+                            } else {
+                                const vf8 nn = sign_neg[a] ? h : l, ff = sign_neg[a] ? l : h;
+                                gtn = vmax(vmin(nn * il, nn * ih), gtn);
+                                gtf = vmin(vmax(ff * il, ff * ih), gtf);
+                            }
+                        }
+                        gm |= static_cast<std::uint32_t>(movemask(gtn <= gtf * slack) & static_cast<int>(qm)) << (8 * q);
+                    }
+                    if (!gm) continue;
+                    TileEntry e{n.child[c], gm, tns[c]};
+                    std::size_t j = sp++;
+                    while (j > base && stack[j - 1].tnear < e.tnear) {
+                        stack[j] = stack[j - 1];
+                        --j;
+                    }
+                    stack[j] = e;
+                } while (cmask);
+                if (sp == base) goto pop;
+                --sp;
+                ref = stack[sp].ref;
+                groups = stack[sp].groups;
+            }
+            // Leaf: its triangles against the groups.
+            leaf_groups(w, ref, s, groups, origin);
+            ttmax = tile_tmax();
+        pop:
+            while (true) {
+                if (sp == 0) goto done;
+                const TileEntry& e = stack[--sp];
+                if (e.tnear <= ttmax * kBoxSlack) {
+                    ref = e.ref;
+                    groups = e.groups;
+                    break;
+                }
+            }
+        }
+    done:;
+    }
+
+    // Write the results.
+    for (int g = 0; g < ng; ++g) {
+        int lanes = s.lanes[g];
+        if (irregular >> g & 1) {
+            do {
+                int l = __builtin_ctz(static_cast<unsigned>(lanes));
+                lanes &= lanes - 1;
+                const int p = s.pix[g][l];
+                hits[p] = Hit{};
+                found[p] = intersect1(w, Ray{origin, dirs[p], tmax_in}, hits[p], stack1);
+            } while (lanes);
+            continue;
+        }
+        do {
+            int l = __builtin_ctz(static_cast<unsigned>(lanes));
+            lanes &= lanes - 1;
+            const int p = s.pix[g][l];
+            const bool f = s.prim[g][l] != kNoPrim;
+            found[p] = f;
+            hits[p] = f ? Hit{s.tmax[g][l], s.prim[g][l], s.u[g][l], s.v[g][l]} : Hit{};
+        } while (lanes);
+    }
+}

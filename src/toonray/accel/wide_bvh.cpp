@@ -1,0 +1,216 @@
+#include "toonray/accel/wide_bvh.h"
+
+#include <algorithm>
+#include <limits>
+#include <memory>
+
+#include "toonray/core/error.h"
+
+namespace toonray::accel {
+
+void WideBvh::build(const Bvh& bvh, std::span<const BBox> boxes, std::span<const Vec3f> positions,
+                    std::span<const std::array<std::uint32_t, 3>> tris, const CollapseCosts& costs) {
+    nodes.clear();
+    blocks.clear();
+    root = kEmptyChild;
+    depth = 0;
+    max_stack = 8;
+    if (bvh.nodes.empty()) return;
+
+    std::size_t leaves = 0;
+    for (const BvhNode& n : bvh.nodes) leaves += n.is_leaf();
+    const std::size_t tri_count = bvh.prim_indices.size();
+    if (tri_count >= kMaxSlots) throw Error("too many triangles for the BVH (at most 134,217,727)");
+    blocks.clear();
+    blocks.reserve((tri_count + 3) / 4 + 2);
+    nodes.reserve(leaves / 4 + 1);
+    TriBlock empty;
+    {
+        const float nan = std::numeric_limits<float>::quiet_NaN();
+        for (auto& corner : empty.v)
+            for (auto& axis : corner) std::fill(std::begin(axis), std::end(axis), nan);
+        std::fill(std::begin(empty.prim), std::end(empty.prim), kNoPrim);
+    }
+    std::uint32_t next_slot = 0;
+    // Leaves are packed in the order they are made (depth-first through the wide tree).
+    auto make_leaf = [&](const BvhNode& leaf) {
+        const std::uint32_t first = next_slot;
+        for (std::uint32_t i = 0; i < leaf.count; ++i, ++next_slot) {
+            const std::uint32_t l = next_slot % 4;
+            if (l == 0) blocks.push_back(empty);
+            TriBlock& b = blocks.back();
+            const std::uint32_t p = bvh.prim_indices[leaf.first + i];
+            for (int c = 0; c < 3; ++c) {
+                const Vec3f& v = positions[tris[p][c]];
+                b.v[c][0][l] = v.x;
+                b.v[c][1][l] = v.y;
+                b.v[c][2][l] = v.z;
+            }
+            b.prim[l] = p | (i + 1 == leaf.count ? kLeafEnd : 0u);
+        }
+        return kLeafBit | ((leaf.count <= 15 ? leaf.count : 0u) << kLeafCountShift) | first;
+    };
+
+    if (bvh.nodes[0].is_leaf()) {
+        root = make_leaf(bvh.nodes[0]);
+        blocks.push_back(empty);
+        blocks.push_back(empty);
+        return;
+    }
+
+    // Collapse by dynamic programming over the binary tree (Ylitie, Karras and Laine 2017):
+    // cost[n][i - 1] is the least SAH cost of representing binary node n's subtree as at most
+    // i subtrees side by side (i slots of a wide node), where a wide node costs `node_cost`
+    // times its area and a leaf `block_cost` times its area per block of 4 triangles. The
+    // greedy alternative (open the largest child until 8) leaves many wide nodes near the
+    // leaves with only 2 or 3 children.
+    const std::size_t count = bvh.nodes.size();
+    // Scratch, every entry written before it is read.
+    auto cost = std::make_unique_for_overwrite<std::array<float, 8>[]>(count);
+    auto split = std::make_unique_for_overwrite<std::array<std::int8_t, 8>[]>(count);
+    // Subtrees cover contiguous ranges of prim_indices; small ones may become one leaf.
+    auto first_prim = std::make_unique_for_overwrite<std::uint32_t[]>(count);
+    auto prim_count = std::make_unique_for_overwrite<std::uint32_t[]>(count);
+    auto flags = std::make_unique_for_overwrite<std::uint8_t[]>(count);  // kAsLeaf, kSpread
+    constexpr std::uint8_t kAsLeaf = 1, kSpread = 2;
+    auto range = [&](std::uint32_t n) { return BvhNode{bvh.nodes[n].bounds, first_prim[n], prim_count[n]}; };
+    auto tri_box = [&](std::uint32_t p) { return boxes[p]; };
+    for (std::size_t n = count; n-- > 0;) {
+        const BvhNode& b = bvh.nodes[n];
+        const float area = b.bounds.half_area();
+        if (b.is_leaf()) {
+            first_prim[n] = b.first;
+            prim_count[n] = b.count;
+            flags[n] = kAsLeaf;
+            cost[n].fill(costs.block * area * static_cast<float>((b.count + costs.leaf_width - 1) / costs.leaf_width));
+            // With as many slots as it has triangles, a small leaf may rather spread them
+            // over the slots, one leaf each, so that boxes cull them one by one.
+            if (b.count >= 2 && b.count <= 8) {
+                float singles = 0.0f;
+                for (std::uint32_t i = 0; i < b.count; ++i)
+                    singles += costs.block * tri_box(bvh.prim_indices[b.first + i]).half_area();
+                if (singles < cost[n][0]) {
+                    flags[n] |= kSpread;
+                    for (std::uint32_t i = b.count; i <= 8; ++i) cost[n][i - 1] = singles;
+                }
+            }
+            continue;
+        }
+        first_prim[n] = first_prim[b.first];
+        prim_count[n] = prim_count[b.first] + prim_count[b.first + 1];
+        flags[n] = 0;
+        const auto& cl = cost[b.first];
+        const auto& cr = cost[b.first + 1];
+        float best = std::numeric_limits<float>::infinity();
+        int best_k = 1;
+        for (int k = 1; k < 8; ++k) {
+            float c = cl[k - 1] + cr[7 - k];
+            if (c < best) {
+                best = c;
+                best_k = k;
+            }
+        }
+        cost[n][0] = costs.node * area + best;
+        split[n][0] = static_cast<std::int8_t>(best_k);
+        if (prim_count[n] <= costs.merge_leaf) {
+            float leaf = costs.block * area * static_cast<float>((prim_count[n] + costs.leaf_width - 1) / costs.leaf_width);
+            if (leaf <= cost[n][0]) {
+                cost[n][0] = leaf;
+                flags[n] |= kAsLeaf;
+            }
+        }
+        for (int i = 2; i <= 8; ++i) {
+            float c = cost[n][i - 2];
+            int s = 0;
+            for (int k = 1; k < i; ++k) {
+                float v = cl[k - 1] + cr[i - k - 1];
+                if (v < c) {
+                    c = v;
+                    s = k;
+                }
+            }
+            cost[n][i - 1] = c;
+            split[n][i - 1] = static_cast<std::int8_t>(s);
+        }
+    }
+    // The children that binary node n becomes with at most i slots: leaves (triangle ranges)
+    // and inner nodes (binary node ids).
+    struct Slot {
+        BvhNode leaf;
+        std::uint32_t inner;  // binary node, or kEmptyChild for a leaf
+    };
+    auto gather = [&](auto&& self, std::uint32_t n, int i, Slot* out, int& len) -> void {
+        const BvhNode& b = bvh.nodes[n];
+        if (b.is_leaf()) {
+            if ((flags[n] & kSpread) && static_cast<std::uint32_t>(i) >= b.count) {
+                for (std::uint32_t k = 0; k < b.count; ++k)
+                    out[len++] = {BvhNode{tri_box(bvh.prim_indices[b.first + k]), b.first + k, 1}, kEmptyChild};
+            } else {
+                out[len++] = {b, kEmptyChild};
+            }
+            return;
+        }
+        while (i > 1 && split[n][i - 1] == 0) --i;
+        if (i <= 1) {
+            out[len++] = {range(n), (flags[n] & kAsLeaf) ? kEmptyChild : n};
+            return;
+        }
+        const int k = split[n][i - 1];
+        self(self, b.first, k, out, len);
+        self(self, b.first + 1, i - k, out, len);
+    };
+
+    if (flags[0] & kAsLeaf) {
+        root = make_leaf(range(0));
+        blocks.push_back(empty);
+        blocks.push_back(empty);
+        return;
+    }
+    struct Item {
+        std::uint32_t binary, wide;
+        int level;
+    };
+    std::vector<Item> todo{{0, 0, 1}};
+    nodes.emplace_back();
+    root = 0;
+    while (!todo.empty()) {
+        Item item = todo.back();
+        todo.pop_back();
+        depth = std::max(depth, item.level);
+        Slot ch[8];
+        int n = 0;
+        const std::uint32_t first = bvh.nodes[item.binary].first;
+        const int k = split[item.binary][0];
+        gather(gather, first, k, ch, n);
+        gather(gather, first + 1, 8 - k, ch, n);
+        WideNode w;
+        for (int a = 0; a < 3; ++a) {
+            std::fill(std::begin(w.lo[a]), std::end(w.lo[a]), std::numeric_limits<float>::infinity());
+            std::fill(std::begin(w.hi[a]), std::end(w.hi[a]), -std::numeric_limits<float>::infinity());
+        }
+        std::fill(std::begin(w.child), std::end(w.child), kEmptyChild);
+        std::fill(std::begin(w.pad), std::end(w.pad), 0u);
+        for (int i = 0; i < n; ++i) {
+            const BBox& box = ch[i].leaf.bounds;
+            for (int a = 0; a < 3; ++a) {
+                w.lo[a][i] = box.lo[a];
+                w.hi[a][i] = box.hi[a];
+            }
+            if (ch[i].inner == kEmptyChild) {
+                w.child[i] = make_leaf(ch[i].leaf);
+            } else {
+                w.child[i] = static_cast<std::uint32_t>(nodes.size());
+                nodes.emplace_back();
+                todo.push_back({ch[i].inner, w.child[i], item.level + 1});
+            }
+            w.pad[0] |= 1u << i;  // valid children
+        }
+        nodes[item.wide] = w;
+    }
+    // Traversal pushes at most 7 entries per level.
+    blocks.push_back(empty);  // 8-wide loads may read up to two blocks past a leaf
+    blocks.push_back(empty);
+    max_stack = 8 * static_cast<std::size_t>(depth) + 8;
+}
+
+}  // namespace toonray::accel

@@ -1,0 +1,71 @@
+#pragma once
+/// The traversal structure of TriangleAccel (internal to the accel module): the binary BVH
+/// collapsed into 8-wide nodes whose child boxes are tested together with SIMD, over triangles
+/// stored four to a block, structure-of-arrays, in leaf order.
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "toonray/accel/bvh.h"
+#include "toonray/core/math.h"
+
+namespace toonray::accel {
+
+/// Child references: kEmptyChild, an inner node index, or a leaf (kLeafBit set) whose
+/// triangles start at slot leaf_first(ref) of the packed triangle array (slot t is lane t % 4 of
+/// block t / 4): leaf_count(ref) of them, or when that is 0 (more than 15), up to the first slot
+/// whose prim has kLeafEnd set (which every leaf's last slot has).
+inline constexpr std::uint32_t kLeafBit = 0x80000000u;
+inline constexpr std::uint32_t kLeafCountShift = 27;
+inline constexpr std::uint32_t kMaxSlots = 1u << kLeafCountShift;  ///< 134 million triangles
+inline constexpr std::uint32_t kLeafEnd = 0x80000000u;  ///< in TriBlock::prim: last triangle of its leaf
+inline constexpr std::uint32_t kEmptyChild = 0xffffffffu;
+inline constexpr std::uint32_t kNoPrim = 0xffffffffu;
+
+[[nodiscard]] inline bool is_leaf(std::uint32_t ref) { return (ref & kLeafBit) != 0; }
+[[nodiscard]] inline std::uint32_t leaf_first(std::uint32_t ref) { return ref & (kMaxSlots - 1); }
+[[nodiscard]] inline std::uint32_t leaf_count(std::uint32_t ref) { return (ref >> kLeafCountShift) & 15u; }
+
+/// 256 bytes, cache-line aligned. Unused slots have empty boxes (lo = +inf, hi = -inf), which
+/// no ray enters.
+struct alignas(64) WideNode {
+    float lo[3][8];  ///< [axis][child]
+    float hi[3][8];
+    std::uint32_t child[8];
+    std::uint32_t pad[8];  ///< pad[0]: bit i set when child[i] is a child
+};
+static_assert(sizeof(WideNode) == 256);
+
+/// Four triangle slots, structure of arrays. Leaves are packed one after another with no gaps;
+/// the slots after the last leaf (and two whole blocks after it, which 8-wide loads may touch)
+/// have NaN corners, which fail every test, and prim == kNoPrim.
+struct alignas(16) TriBlock {
+    float v[3][3][4];         ///< [corner][axis][lane]
+    std::uint32_t prim[4];    ///< triangle index in the input order, | kLeafEnd on a leaf's last
+};
+static_assert(sizeof(TriBlock) == 160);
+
+/// Everything traversal reads.
+struct WideBvh {
+    std::vector<WideNode> nodes;
+    std::vector<TriBlock> blocks;
+    std::uint32_t root = kEmptyChild;  ///< inner node 0, or a single leaf, or empty
+    int depth = 0;                     ///< wide levels (a leaf root counts 0)
+    std::size_t max_stack = 0;         ///< stack entries traversal can need
+
+    /// SAH weights of the collapse: a wide node visit, and a leaf's test per block of 4.
+    struct CollapseCosts {
+        float node = 1.0f;
+        float block = 1.0f;
+        std::uint32_t merge_leaf = 8;  ///< subtrees of at most this many triangles may become one leaf
+        std::uint32_t leaf_width = 4;  ///< triangles a leaf test takes at once
+    };
+
+    /// Collapses `bvh` (built over `tris`, whose boxes are `boxes`) and packs the triangles.
+    void build(const Bvh& bvh, std::span<const BBox> boxes, std::span<const Vec3f> positions,
+               std::span<const std::array<std::uint32_t, 3>> tris, const CollapseCosts& costs);
+};
+
+}  // namespace toonray::accel
