@@ -2,6 +2,11 @@
 
 #include <gtest/gtest.h>
 
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <random>
+
 #include <filesystem>
 #include <fstream>
 
@@ -245,4 +250,41 @@ TEST(CameraBlock, InvalidBlocksAreErrors) {
     EXPECT_NE(error_of("v 0 0 5\nv 0 0 5\nvn 0 1 0\nc 1 2 1\n").find("test.obj:4: invalid camera: eye and gaze"), std::string::npos);
     EXPECT_NE(error_of("v 0 0 5\nv 0 0 4\nvn 0 0 1\nc 1 2 1\n").find("test.obj:4: invalid camera: up vector"), std::string::npos);
     EXPECT_NE(error_of("v 0 0 5\nv 0 0 4\nvn 0 1 0\nc 1 2\n").find("test.obj:4: camera statement needs three"), std::string::npos);
+}
+
+TEST(ObjLoader, FastNumberPathEqualsFromCharsBitForBit) {
+    // The loader parses short decimals without from_chars (see short_decimal); every number
+    // must still read back exactly as from_chars<float> reads it.
+    std::mt19937_64 rng(7);
+    int checked = 0;
+    for (int i = 0; i < 100000; ++i) {
+        std::string texts[2];
+        float f;
+        std::uint32_t bits = static_cast<std::uint32_t>(rng());
+        std::memcpy(&f, &bits, 4);
+        char buf[64];
+        if (std::isfinite(f) && std::abs(f) < 1e6f && std::abs(f) > 1e-6f) {
+            auto r = std::to_chars(buf, buf + 64, f, std::chars_format::fixed);
+            texts[0].assign(buf, r.ptr);
+        }
+        int digits = 1 + static_cast<int>(rng() % 16), decimals = static_cast<int>(rng() % (digits + 1));
+        for (int k = 0; k < digits; ++k) texts[1] += static_cast<char>('0' + rng() % 10);
+        if (decimals) texts[1].insert(texts[1].size() - decimals, ".");
+        if (rng() & 1) texts[1] = "-" + texts[1];
+        for (const std::string& t : texts) {
+            if (t.empty()) continue;
+            float expect;
+            if (std::from_chars(t.data(), t.data() + t.size(), expect).ec != std::errc()) continue;
+            Scene s = parse("v " + t + " 0 0\n");
+            ASSERT_EQ(0, std::memcmp(&expect, &s.positions[0].x, 4)) << t;
+            ++checked;
+        }
+    }
+    EXPECT_GT(checked, 100000);
+}
+
+TEST(ObjLoader, PlusSignedFaceIndices) {
+    Scene s = parse(std::string(kQuad) + "f +1 +2 +3\n");
+    ASSERT_EQ(s.triangle_count(), 1u);
+    EXPECT_EQ(s.tri_positions[0], (std::array<std::uint32_t, 3>{0, 1, 2}));
 }

@@ -117,6 +117,60 @@ struct Tokens {
     }
 };
 
+/// The common case of OBJ numbers, "[-]ddd.ddd" with up to 15 significant digits and at most
+/// 15 decimals, parsed without from_chars. The mantissa m < 10^15 and 10^k are exact doubles,
+/// so m / 10^k rounds once to double; rounding that to float gives the correctly rounded float
+/// of the decimal because double rounding is innocuous for division when 53 >= 2 * 24 + 2
+/// (Figueroa, "When is double rounding innocuous?", 1995). So the result is bit for bit what
+/// from_chars<float> gives. Anything else (exponents, longer numbers) returns false.
+inline bool short_decimal(const char* p, const char* e, float& out) {
+    static constexpr double kPow10[16] = {1e0, 1e1, 1e2,  1e3,  1e4,  1e5,  1e6,  1e7,
+                                          1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15};
+    bool negative = false;
+    if (p < e && *p == '-') {
+        negative = true;
+        ++p;
+    }
+    std::uint64_t m = 0;
+    int digits = 0, decimals = 0;
+    bool point = false;
+    for (; p < e; ++p) {
+        char c = *p;
+        if (c >= '0' && c <= '9') {
+            m = m * 10 + static_cast<std::uint64_t>(c - '0');
+            if (++digits > 15) return false;
+            decimals += point;
+        } else if (c == '.' && !point) {
+            point = true;
+        } else {
+            return false;
+        }
+    }
+    if (digits == 0) return false;
+    float v = static_cast<float>(static_cast<double>(m) / kPow10[decimals]);
+    out = negative ? -v : v;
+    return true;
+}
+
+/// A face or camera index "[+-]digits" (up to 18 digits); false when malformed.
+inline bool parse_index(const char*& p, const char* e, long long& out) {
+    bool negative = false;
+    if (p < e && (*p == '-' || *p == '+')) {
+        negative = *p == '-';
+        ++p;
+    }
+    const char* start = p;
+    long long v = 0;
+    while (p < e && *p >= '0' && *p <= '9') {
+        if (p - start >= 18) return false;
+        v = v * 10 + (*p - '0');
+        ++p;
+    }
+    if (p == start) return false;
+    out = negative ? -v : v;
+    return true;
+}
+
 class Parser {
 public:
     Parser(std::string_view file, std::size_t line) : file_(file), line_(line) {}
@@ -128,8 +182,9 @@ public:
         if (tok.empty()) fail(fmt::format("missing number in '{}' statement", what));
         const char* b = tok.data();
         const char* e = b + tok.size();
-        if (*b == '+') ++b;
         float v;
+        if (short_decimal(b, e, v)) return v;
+        if (*b == '+') ++b;
         auto [ptr, ec] = std::from_chars(b, e, v);
         if (ec == std::errc::result_out_of_range && ptr == e) {
             // Too small for a float reads as zero (as strtof and other readers do: exporters
@@ -371,6 +426,41 @@ void parse_mtl(std::string_view text, const std::filesystem::path& path,
     }
 }
 
+namespace {
+
+// Counts the statements that add vertices and faces (a cheap pass over line starts) and
+// reserves for them: growing the arrays by doubling costs more than the count. Faces are
+// counted as one triangle each, the common case; polygons simply grow the arrays.
+void reserve_for(std::string_view text, Scene& scene) {
+    std::size_t v = 0, vn = 0, vt = 0, f = 0;
+    const char* p = text.data();
+    const char* end = p + text.size();
+    while (p < end) {
+        if (end - p >= 2) {
+            if (p[0] == 'v') {
+                if (p[1] == ' ' || p[1] == '\t') ++v;
+                else if (p[1] == 'n') ++vn;
+                else if (p[1] == 't') ++vt;
+            } else if (p[0] == 'f' && (p[1] == ' ' || p[1] == '\t')) {
+                ++f;
+            }
+        }
+        const void* nl = std::memchr(p, '\n', static_cast<std::size_t>(end - p));
+        if (!nl) break;
+        p = static_cast<const char*>(nl) + 1;
+    }
+    scene.positions.reserve(v);
+    scene.normals.reserve(vn);
+    scene.texcoords.reserve(vt);
+    scene.tri_positions.reserve(f);
+    scene.tri_normals.reserve(f);
+    scene.tri_texcoords.reserve(f);
+    scene.tri_material.reserve(f);
+    scene.tri_object.reserve(f);
+}
+
+}  // namespace
+
 void parse_obj(std::string_view text, const std::filesystem::path& path, Scene& scene,
                Warnings& warnings, const ObjOptions& options) {
     scene.clear();
@@ -381,6 +471,7 @@ void parse_obj(std::string_view text, const std::filesystem::path& path, Scene& 
     std::string_view line;
     std::size_t line_number = 0;
     WarningSink warn(warnings, file);
+    reserve_for(text, scene);
 
     std::unordered_map<std::string, std::uint32_t> object_ids{{"(default)", 0}};
     std::unordered_map<std::string, std::uint32_t> warned_materials, warned_statements;
@@ -444,6 +535,17 @@ void parse_obj(std::string_view text, const std::filesystem::path& path, Scene& 
                 bool present[3] = {false, false, false};
                 for (int slot = 0; slot < 3; ++slot) {
                     if (p < e && *p != '/') {
+                        const char* q = p;
+                        if (parse_index(q, e, idx[slot]) && (q == e || *q == '/')) {
+                            present[slot] = true;
+                            p = q;
+                            if (p < e) {
+                                if (slot == 2) parse.fail(fmt::format("malformed face corner '{}'", tok));
+                                ++p;
+                            }
+                            continue;
+                        }
+                        // Slow path, for its precise messages.
                         auto [ptr, ec] = std::from_chars(p, e, idx[slot]);
                         if (ec == std::errc::result_out_of_range && (ptr == e || *ptr == '/'))
                             parse.fail(fmt::format("face {} index in '{}' out of range",
