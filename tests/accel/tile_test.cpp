@@ -1,0 +1,313 @@
+// The SIMD traversal paths against each other and against brute force: single rays and tiles,
+// on every instruction set this machine runs; and the builder's determinism.
+
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "toonray/accel/triangle_accel.h"
+#include "toonray/scene/camera.h"
+#include "toonray/scene/obj_loader.h"
+
+using namespace toonray;
+
+namespace {
+
+struct Soup {
+    std::vector<Vec3f> positions;
+    std::vector<std::array<std::uint32_t, 3>> tris;
+};
+
+Soup random_soup(int count, unsigned seed, float size = 0.2f) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<float> pos(-1.0f, 1.0f), off(-size, size);
+    Soup s;
+    for (int i = 0; i < count; ++i) {
+        Vec3f c(pos(rng), pos(rng), pos(rng));
+        auto base = static_cast<std::uint32_t>(s.positions.size());
+        for (int k = 0; k < 3; ++k) s.positions.push_back(c + Vec3f(off(rng), off(rng), off(rng)));
+        s.tris.push_back({base, base + 1, base + 2});
+    }
+    return s;
+}
+
+Soup from_obj(const std::string& name) {
+    Scene scene;
+    Warnings w;
+    load_obj(std::string(TOONRAY_TEST_DATA_DIR) + "/" + name, scene, w);
+    return {scene.positions, scene.tri_positions};
+}
+
+// An axis-aligned grid of unit squares in the plane z = 0 (two triangles each): rays from a
+// camera looking straight down hit shared edges and corners exactly.
+Soup grid(int n) {
+    Soup s;
+    for (int y = 0; y <= n; ++y)
+        for (int x = 0; x <= n; ++x)
+            s.positions.push_back(Vec3f(static_cast<float>(x), static_cast<float>(y), 0.0f));
+    for (int y = 0; y < n; ++y)
+        for (int x = 0; x < n; ++x) {
+            std::uint32_t a = y * (n + 1) + x, b = a + 1, c = a + n + 1, d = c + 1;
+            s.tris.push_back({a, b, d});
+            s.tris.push_back({a, d, c});
+        }
+    return s;
+}
+
+std::uint32_t bits(float f) {
+    std::uint32_t u;
+    std::memcpy(&u, &f, 4);
+    return u;
+}
+
+Hit brute_force(const Soup& s, const Ray& ray) {
+    Hit best;
+    for (std::uint32_t i = 0; i < s.tris.size(); ++i) {
+        float t, u, v;
+        Ray r = ray;
+        r.tmax = std::min(best.t, ray.tmax);
+        if (intersect_triangle(r, s.positions[s.tris[i][0]], s.positions[s.tris[i][1]], s.positions[s.tris[i][2]],
+                               t, u, v)) {
+            best.t = t;
+            best.prim = i;
+            best.u = u;
+            best.v = v;
+        }
+    }
+    return best;
+}
+
+// The instruction sets to test: the portable one, and AVX2 when this CPU has it.
+std::vector<std::string> isas() {
+    std::vector<std::string> out{"sse4.2"};
+    if (set_accel_isa("avx2")) out.push_back("avx2");
+    set_accel_isa("auto");
+    return out;
+}
+
+struct IsaGuard {
+    explicit IsaGuard(const std::string& isa) { EXPECT_TRUE(set_accel_isa(isa)); }
+    ~IsaGuard() { set_accel_isa("auto"); }
+};
+
+// Traces width x height pinhole rays through view (as trace_primary makes them) in tiles of
+// tw x th, and checks every ray: the tile result equals the single-ray result bit for bit, and
+// every `stride`-th equals brute force.
+void check_view(const Soup& s, const TriangleAccel& accel, const ViewPlane& view, int width, int height, int tw,
+                int th, int stride, int* hits_out = nullptr) {
+    int hits = 0;
+    for (int y0 = 0; y0 < height; y0 += th)
+        for (int x0 = 0; x0 < width; x0 += tw) {
+            const int w = std::min(tw, width - x0), h = std::min(th, height - y0);
+            std::vector<Vec3f> dirs(static_cast<std::size_t>(w * h));
+            for (int y = 0; y < h; ++y)
+                for (int x = 0; x < w; ++x)
+                    dirs[y * w + x] = normalize(view.pixel_point(x0 + x + 0.5f, y0 + y + 0.5f) - view.eye);
+            std::vector<Hit> tile(dirs.size());
+            std::unique_ptr<bool[]> found(new bool[dirs.size()]);
+            accel.intersect_tile(view.eye, dirs.data(), w, h, tile.data(), found.get());
+            for (int i = 0; i < w * h; ++i) {
+                Hit single;
+                const Ray ray{view.eye, dirs[i]};
+                const bool f = accel.intersect(ray, single);
+                ASSERT_EQ(found[i], f) << "pixel " << x0 + i % w << "," << y0 + i / w;
+                ASSERT_EQ(tile[i].prim, single.prim);
+                ASSERT_EQ(bits(tile[i].t), bits(single.t));
+                ASSERT_EQ(bits(tile[i].u), bits(single.u));
+                ASSERT_EQ(bits(tile[i].v), bits(single.v));
+                hits += f;
+                if ((x0 + i % w) % stride == 0 && (y0 + i / w) % stride == 0) {
+                    const Hit expected = brute_force(s, ray);
+                    ASSERT_EQ(f, expected.valid());
+                    if (f) {
+                        ASSERT_EQ(bits(single.t), bits(expected.t));
+                        ASSERT_EQ(single.prim, expected.prim);
+                        ASSERT_EQ(bits(single.u), bits(expected.u));
+                        ASSERT_EQ(bits(single.v), bits(expected.v));
+                    }
+                }
+            }
+        }
+    if (hits_out) *hits_out = hits;
+}
+
+CameraSpec framing(const Soup& s, int w, int h) {
+    std::vector<Vec3f> used;
+    for (const auto& t : s.tris)
+        for (std::uint32_t v : t) used.push_back(s.positions[v]);
+    return auto_camera(used, w, h);
+}
+
+}  // namespace
+
+TEST(Tile, MatchesSingleRaysAndBruteForceOnMeshes) {
+    for (const std::string& isa : isas()) {
+        IsaGuard guard(isa);
+        for (const char* name : {"teapot.obj", "spot.obj"}) {
+            SCOPED_TRACE(std::string(name) + " " + isa);
+            Soup s = from_obj(name);
+            TriangleAccel accel;
+            accel.build(s.positions, s.tris);
+            const ViewPlane view = make_view_plane(framing(s, 160, 90), 160, 90);
+            int hits = 0;
+            check_view(s, accel, view, 160, 90, 16, 16, 7, &hits);
+            EXPECT_GT(hits, 160 * 90 / 10);
+            // Partial tiles, odd sizes.
+            check_view(s, accel, view, 61, 37, 13, 5, 9);
+            check_view(s, accel, view, 20, 20, 1, 1, 5);
+        }
+    }
+}
+
+TEST(Tile, RandomCamerasOnASoup) {
+    Soup s = random_soup(3000, 17);
+    TriangleAccel accel;
+    accel.build(s.positions, s.tris);
+    std::mt19937 rng(5);
+    std::normal_distribution<float> n(0.0f, 1.0f);
+    for (const std::string& isa : isas()) {
+        IsaGuard guard(isa);
+        for (int c = 0; c < 6; ++c) {
+            SCOPED_TRACE("camera " + std::to_string(c) + " " + isa);
+            CameraSpec cam;
+            cam.eye = normalize(Vec3f(n(rng), n(rng), n(rng))) * 3.0f;
+            cam.gaze = cam.eye + normalize(Vec3f(0.0f) - cam.eye) * 1.5f;
+            Vec3f right = normalize(cross(cam.gaze - cam.eye, Vec3f(0.0f, 1.0f, 0.0f)));
+            cam.up = normalize(cross(right, cam.gaze - cam.eye));
+            const ViewPlane view = make_view_plane(cam, 96, 64);
+            check_view(s, accel, view, 96, 64, 16, 16, 6);
+        }
+    }
+}
+
+TEST(Tile, AxisAlignedViewOfAGridHitsEdgesExactly) {
+    // Looking straight down the z axis: the view's centre row and column have direction
+    // components that change sign inside a tile and rays along the grid's shared edges and
+    // corners, where ties between triangles are decided by index.
+    Soup s = grid(12);
+    TriangleAccel accel;
+    accel.build(s.positions, s.tris);
+    CameraSpec cam{Vec3f(6.0f, 6.0f, 10.0f), Vec3f(6.0f, 6.0f, 9.0f), Vec3f(0.0f, 1.0f, 0.0f)};
+    for (const std::string& isa : isas()) {
+        IsaGuard guard(isa);
+        SCOPED_TRACE(isa);
+        for (int size : {48, 47, 60}) {
+            const ViewPlane view = make_view_plane(cam, size, size);
+            check_view(s, accel, view, size, size, 16, 16, 1);
+        }
+    }
+}
+
+TEST(Tile, DegenerateDirectionsAgreeWithSingleRays) {
+    Soup s = random_soup(500, 3);
+    TriangleAccel accel;
+    accel.build(s.positions, s.tris);
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    const float inf = std::numeric_limits<float>::infinity();
+    std::vector<Vec3f> dirs = {
+        {0, 0, 1},   {0, 0, -1},   {1, 0, 0},     {-1, 0, 0},     {0, 1, 0},    {0, -1, 0},  {0, 0, 0},
+        {nan, 0, 1}, {inf, 0, 0},  {0.0f, -0.0f, -1.0f}, {1e-30f, 0, 1}, {1, 1, 1},   {-1, 1, -1}, {1e-40f, 1, 0},
+        {0.3f, 0.3f, 0.3f}, {-0.0f, 1, 0}};
+    for (const std::string& isa : isas()) {
+        IsaGuard guard(isa);
+        for (const Vec3f& origin : {Vec3f(0.0f), Vec3f(0.1f, -0.2f, -3.0f)}) {
+            std::vector<Hit> hits(dirs.size());
+            std::unique_ptr<bool[]> found(new bool[dirs.size()]);
+            accel.intersect_tile(origin, dirs.data(), 4, 4, hits.data(), found.get());
+            for (std::size_t i = 0; i < dirs.size(); ++i) {
+                Hit single;
+                const bool f = accel.intersect(Ray{origin, dirs[i]}, single);
+                ASSERT_EQ(found[i], f) << isa << " ray " << i;
+                ASSERT_EQ(hits[i].prim, single.prim) << isa << " ray " << i;
+                ASSERT_EQ(bits(hits[i].t), bits(single.t)) << isa << " ray " << i;
+            }
+        }
+    }
+}
+
+TEST(Tile, TmaxAndEmptyAccelerator) {
+    Soup one;
+    one.positions = {{-1, -1, 5}, {1, -1, 5}, {0, 1, 5}};
+    one.tris = {{0, 1, 2}};
+    TriangleAccel accel;
+    accel.build(one.positions, one.tris);
+    const Vec3f dirs[2] = {{0, 0, 1}, {0, 0, -1}};
+    Hit hits[2];
+    bool found[2];
+    accel.intersect_tile(Vec3f(0.0f), dirs, 2, 1, hits, found);
+    EXPECT_TRUE(found[0]);
+    EXPECT_FLOAT_EQ(hits[0].t, 5.0f);
+    EXPECT_FALSE(found[1]);
+    accel.intersect_tile(Vec3f(0.0f), dirs, 2, 1, hits, found, 4.0f);
+    EXPECT_FALSE(found[0]);
+    accel.intersect_tile(Vec3f(0.0f), dirs, 2, 1, hits, found, 5.0f);  // hits must be strictly inside tmax
+    EXPECT_FALSE(found[0]);
+    TriangleAccel empty;
+    empty.build({}, {});
+    accel = empty;
+    accel.intersect_tile(Vec3f(0.0f), dirs, 2, 1, hits, found);
+    EXPECT_FALSE(found[0]);
+    EXPECT_FALSE(hits[0].valid());
+}
+
+TEST(Tile, LargeLeavesAndLargeTiles) {
+    // Leaves of more than 15 triangles are ended by a flag rather than a count.
+    Soup s = random_soup(400, 8, 0.05f);
+    for (int i = 0; i < 200; ++i) s.tris.push_back(s.tris[static_cast<std::size_t>(i) * 2]);  // exact duplicates
+    Bvh::Config config;
+    config.max_leaf_size = 64;
+    config.traversal_cost = 100.0f;  // leaves as large as allowed
+    TriangleAccel accel;
+    accel.build(s.positions, s.tris, config);
+    const ViewPlane view = make_view_plane(framing(s, 50, 40), 50, 40);
+    for (const std::string& isa : isas()) {
+        IsaGuard guard(isa);
+        SCOPED_TRACE(isa);
+        check_view(s, accel, view, 50, 40, 16, 16, 3);
+        // A tile larger than kTileSize is cut into tiles.
+        check_view(s, accel, view, 50, 40, 50, 40, 4);
+    }
+}
+
+TEST(Tile, AfterRefit) {
+    Soup s = from_obj("teapot.obj");
+    TriangleAccel accel;
+    accel.build(s.positions, s.tris);
+    for (Vec3f& p : s.positions) p = Vec3f(p.x + 0.3f * p.y, p.y * 1.2f, p.z - 0.1f * p.x);
+    accel.refit(s.positions, s.tris);
+    const ViewPlane view = make_view_plane(framing(s, 80, 60), 80, 60);
+    for (const std::string& isa : isas()) {
+        IsaGuard guard(isa);
+        SCOPED_TRACE(isa);
+        check_view(s, accel, view, 80, 60, 16, 16, 3);
+    }
+}
+
+TEST(Build, SameTreeForAnyThreadCount) {
+    // Large enough for the parallel top levels (binning and partitioning in chunks) and for
+    // subtrees as tasks.
+    Soup s = random_soup(150000, 99, 0.01f);
+    std::vector<BBox> boxes(s.tris.size());
+    for (std::size_t i = 0; i < s.tris.size(); ++i)
+        for (std::uint32_t v : s.tris[i]) boxes[i].extend(s.positions[v]);
+    Bvh one, many;
+    {
+        tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
+        one = Bvh::build(boxes);
+    }
+    {
+        tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 8);
+        many = Bvh::build(boxes);
+    }
+    ASSERT_EQ(one.nodes.size(), many.nodes.size());
+    ASSERT_EQ(one.prim_indices, many.prim_indices);
+    for (std::size_t i = 0; i < one.nodes.size(); ++i) {
+        ASSERT_EQ(std::memcmp(&one.nodes[i], &many.nodes[i], sizeof(BvhNode)), 0) << "node " << i;
+    }
+}
