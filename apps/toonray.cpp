@@ -10,6 +10,7 @@
 #include <csignal>
 
 #include "toonray/anim/batch.h"
+#include "toonray/anim/demo.h"
 #include "toonray/anim/piano_movie.h"
 #include "toonray/media/audio.h"
 #include "toonray/anim/progress.h"
@@ -241,6 +242,24 @@ struct BatchArgs {
 
 }  // namespace
 
+/// Progress of `toonray demo`: the frame bar, and a line per stage.
+class DemoProgress : public DemoObserver {
+public:
+    DemoProgress(int frames, bool quiet) : frames_(frames, stderr, quiet), quiet_(quiet) {}
+    void frame_done(int frame, FrameStatus status, const std::string& message) override {
+        frames_.frame_done(frame, status, message);
+    }
+    void warning(int frame, const std::string& message) override { frames_.warning(frame, message); }
+    void stage(const std::string& what) override {
+        if (!quiet_) fmt::print(stderr, "toonray: demo: {}\n", what);
+    }
+    void finish(const BatchReport& report) { frames_.finish(report); }
+
+private:
+    ProgressReporter frames_;
+    bool quiet_;
+};
+
 /// Options of `piano` and `demo`.
 struct PianoArgs {
     std::string score, camera_path, soundfont, export_obj, audio;
@@ -459,41 +478,30 @@ int main(int argc, char** argv) {
                 print_warnings(audio.warnings);
             }
         } else if (*demo) {
-            namespace fs = std::filesystem;
             Score score = load_score_or_demo(demo_args.score);
-            fs::path dir = demo_output;
-            PianoMovieOptions options;
-            options.name = "entertainer";
-            options.output_dir = dir / "frames";
-            if (!demo_full) options.seconds = demo_args.seconds;
-            options.render = demo_render_args.resolve();
-            // Frames left from a longer earlier run would join the movie: remove them.
-            std::error_code ec;
-            double seconds = options.seconds ? *options.seconds : score.duration() - demo_args.start;
-            int frames = frame_count(seconds, demo_args.fps);
-            for (long long f = frames + 1LL; fs::exists(options.output_dir / fmt::format("entertainer_{:06d}.png", f), ec); ++f)
-                fs::remove(options.output_dir / fmt::format("entertainer_{:06d}.png", f), ec);
-            if (!demo_args.quiet)
-                fmt::print(stderr, "toonray: demo: {} frames at {}x{}, {} fps -> {}\n", frames,
-                           options.render.settings.width, options.render.settings.height, demo_args.fps,
-                           (dir / "entertainer.mp4").string());
-            const AudioOptions audio_opts = audio_options(score, demo_args, options.seconds);  // checked first
-            PianoMovieReport report = run_piano_movie(score, demo_args, options);
-            if (report.batch.cancelled) return 130;
-            if (report.batch.failed > 0) return 1;
-            if (!demo_args.quiet) fmt::print(stderr, "toonray: demo: synthesising the audio\n");
-            AudioResult audio = render_audio(score, dir / "entertainer.wav", audio_opts);
-            print_warnings(audio.warnings);
-            if (!demo_args.quiet) fmt::print(stderr, "toonray: demo: encoding the movie\n");
-            EncodeOptions encode_options;
-            encode_options.frames_dir = options.output_dir;
-            encode_options.output = dir / "entertainer.mp4";
-            encode_options.fps = demo_args.fps;
-            encode_options.audio = dir / "entertainer.wav";
-            encode_options.start_number = 1;
-            EncodeResult result = encode_video(encode_options);
+            CameraPath path = demo_args.camera_path.empty() ? load_demo_camera_path()
+                                                            : load_camera_path(demo_args.camera_path);
+            DemoOptions options;
+            options.output_dir = demo_output;
+            options.seconds = demo_full ? std::optional<double>() : std::optional<double>(demo_args.seconds);
+            options.soundfont = demo_args.soundfont;
+            options.movie.render = demo_render_args.resolve();
+            options.movie.start = demo_args.start;
+            options.movie.fps = demo_args.fps;
+            options.movie.jobs = demo_args.jobs;
+            options.movie.resume = demo_args.resume;
+            install_stop_handlers();
+            options.movie.cancel = &g_stop;
+            double seconds = options.seconds ? *options.seconds : std::max(0.0, score.duration() - demo_args.start);
+            DemoProgress progress(frame_count(seconds, demo_args.fps), demo_args.quiet);
+            DemoReport report = run_demo(score, path, options, &progress);
+            progress.finish(report.movie.batch);
+            if (report.movie.batch.cancelled) return 130;
+            if (!report.completed) return 1;
+            print_warnings(report.audio.warnings);
             fmt::print(stderr, "toonray: demo: wrote {} ({} frames, {:.1f} s, {} triangles)\n",
-                       encode_options.output.string(), result.frames.count, result.duration, report.triangles);
+                       report.movie_path.string(), report.encode.frames.count, report.encode.duration,
+                       report.movie.triangles);
         } else if (*convert) {
             Warnings warnings;
             convert_score(convert_input, convert_output, &warnings);
