@@ -149,12 +149,20 @@ void for_each_tile_ray(const ViewPlane& view, int w, int h, F&& f) {
                 }
 }
 
+std::uint32_t bits(float f) {
+    std::uint32_t u;
+    std::memcpy(&u, &f, 4);
+    return u;
+}
+
 struct Hits {
     std::vector<Hit> hit;
     std::vector<char> found;
+    std::vector<Vec3f> dir;  // trace_primary's sample directions (ours tile only)
     void reset(size_t n) {
         hit.assign(n, Hit{});
         found.assign(n, 0);
+        dir.assign(n, Vec3f(0.0f));
     }
 };
 
@@ -215,6 +223,7 @@ void trace_ours_tile(const TriangleAccel& accel, const ViewPlane& view, int w, i
                 size_t i = static_cast<size_t>(y) * w + x;
                 out.hit[i] = t.hits[k];
                 out.found[i] = t.found[k];
+                out.dir[i] = t.dirs[k];
             }
     });
 }
@@ -290,11 +299,6 @@ void trace_embree8(RTCScene scene, const ViewPlane& view, int w, int h, Hits& ou
                 }
 }
 
-std::uint32_t bits(float f) {
-    std::uint32_t u;
-    std::memcpy(&u, &f, 4);
-    return u;
-}
 
 // Bit-exact comparison (t, prim, u, v). Returns the number of differing rays.
 size_t exact_diff(const Hits& a, const Hits& b, const char* what) {
@@ -435,6 +439,16 @@ int main(int argc, char** argv) {
         trace_embree1(emb.scene(), view, w, h, e1);
         trace_embree8(emb.scene(), view, w, h, e8);
         size_t hits = std::count(single.found.begin(), single.found.end(), 1);
+        {
+            // trace_primary's directions are the scalar normalize(pixel_point - eye), bit for bit.
+            size_t bad = 0;
+            for_each_tile_ray(view, w, h, [&](int x, int y, const Vec3f& dir) {
+                const Vec3f& d = tile.dir[static_cast<size_t>(y) * w + x];
+                bad += bits(d.x) != bits(dir.x) || bits(d.y) != bits(dir.y) || bits(d.z) != bits(dir.z);
+            });
+            std::printf("  trace_primary directions: %zu differ from the scalar ones\n", bad);
+            failed |= bad != 0;
+        }
         std::printf("  %zu of %zu rays hit\n", hits, n);
         if (opt.legacy) {
             legacy::TriangleAccel old;
