@@ -83,10 +83,11 @@ Hit brute_force(const Soup& s, const Ray& ray) {
     return best;
 }
 
-// The instruction sets to test: the portable one, and AVX2 when this CPU has it.
+// The instruction sets to test: the portable one, and AVX2 and AVX-512 when this CPU has them.
 std::vector<std::string> isas() {
     std::vector<std::string> out{"sse4.2"};
-    if (set_accel_isa("avx2")) out.push_back("avx2");
+    for (const char* isa : {"avx2", "avx512"})
+        if (set_accel_isa(isa)) out.push_back(isa);
     set_accel_isa("auto");
     return out;
 }

@@ -1,15 +1,18 @@
 // The traversal kernels (internal to the accel module), written once against the vf8/vm8/vi8
-// types of simd8.inl and compiled twice: kernels_sse.cpp (the portable x86-64-v2 build) and
-// kernels_avx2.cpp (AVX2, chosen at run time when the CPU has it). Included inside
-// `namespace toonray::accel::<isa>`, after simd8.inl, with all headers already included.
+// types of simd8.inl and compiled three times: kernels_sse.cpp (the portable x86-64-v2 build,
+// 8-wide as pairs of SSE registers), kernels_avx2.cpp and kernels_avx512.cpp (target pragmas,
+// chosen at run time when the CPU has them). Included inside an anonymous namespace in
+// `toonray::accel::<isa>`, after simd8.inl, with all headers already included.
 //
 // Exactness: every lane of the triangle tests does the float operations of watertight_test()
-// in its order; lanes whose edge functions hit an exact zero (which the scalar test redoes in
-// double) are handed to watertight_test() itself. A hit is taken by BestHit's rule, so the
-// result is the lowest (t, triangle index) over the triangles whose test passes, which does not
-// depend on traversal order. Box culling is conservative: the far distance is widened by
-// kBoxSlack as before, interval (frustum) tests bound the per-ray slab distances exactly (float
-// multiplication is monotonic), and NaN distances never cull.
+// in its order (no FMA: the translation units turn contraction off); lanes whose edge
+// functions hit an exact zero (which the scalar test redoes in double) are handed to
+// watertight_test() itself. A hit is taken by BestHit's rule, so the result is the lowest
+// (t, triangle index) over the triangles whose test passes, which does not depend on traversal
+// order. Box culling is conservative: the far distance is widened by kBoxSlack as before; the
+// AVX2/AVX-512 single-ray box test uses FMA with its rounding error folded into the constants;
+// interval (frustum) tests bound the per-ray slab distances exactly (float multiplication is
+// monotonic); and NaN distances never cull.
 
 constexpr int kNearLo[3] = {0, 8, 16};   // offsets of lo[axis] in a WideNode, in floats
 constexpr int kNearHi[3] = {24, 32, 40};  // offsets of hi[axis]

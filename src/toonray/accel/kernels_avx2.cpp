@@ -25,7 +25,7 @@
 
 namespace toonray::accel {
 namespace avx2 {
-namespace {  // internal linkage: the two instruction sets' copies must never be merged
+namespace {  // internal linkage: the instruction sets' copies must never be merged
 #include "toonray/accel/simd8.inl"
 #include "toonray/accel/kernels.inl"
 }  // namespace

@@ -1,6 +1,6 @@
 // The traversal kernels compiled for AVX-512 (F, VL, BW, DQ): the same 8-wide code as
 // kernels_avx2.cpp, which the compiler can then write with mask registers and three-input
-// logic. Chosen at run time when the CPU has it. No FMA, as everywhere.
+// logic. Chosen at run time when the CPU has it. FMA only in the box tests (see kernels.inl).
 //
 // Everything is included before the pragma, so inline functions from headers keep the default
 // target (they could otherwise be merged, AVX-512 code and all, into other translation units).
@@ -25,7 +25,7 @@
 
 namespace toonray::accel {
 namespace avx512 {
-namespace {  // internal linkage: the two instruction sets' copies must never be merged
+namespace {  // internal linkage: the instruction sets' copies must never be merged
 #include "toonray/accel/simd8.inl"
 #include "toonray/accel/kernels.inl"
 }  // namespace

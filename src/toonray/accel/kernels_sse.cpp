@@ -14,7 +14,7 @@
 
 namespace toonray::accel {
 namespace sse {
-namespace {  // internal linkage: the two instruction sets' copies must never be merged
+namespace {  // internal linkage: the instruction sets' copies must never be merged
 #include "toonray/accel/simd8.inl"
 #include "toonray/accel/kernels.inl"
 }  // namespace

@@ -50,11 +50,11 @@ public:
     /// Among hits at the same distance the lowest triangle index wins, whatever the tree.
     bool intersect(const Ray& ray, Hit& hit) const;
 
-    /// The closest hits of a tile of rays from one origin: `dirs` holds width x height
-    /// directions row by row (width, height <= kTileSize), and hits/found receive, for each,
-    /// exactly what intersect(Ray{origin, dir, tmax}, hit) gives (misses get Hit{} and false).
-    /// Neighbouring rays should be coherent (a pinhole camera's): the tile is traversed as a
-    /// frustum of 4 x 2 ray packets.
+    /// The closest hits of a grid of rays from one origin: `dirs` holds width x height
+    /// directions row by row, and hits/found receive, for each, exactly what
+    /// intersect(Ray{origin, dir, tmax}, hit) gives (misses get Hit{} and false). Neighbouring
+    /// rays should be coherent (a pinhole camera's): each kTileSize x kTileSize tile is
+    /// traversed once, as a frustum of 4 x 2 ray packets (larger grids are cut into tiles).
     void intersect_tile(const Vec3f& origin, const Vec3f* dirs, int width, int height, Hit* hits, bool* found,
                         float tmax = std::numeric_limits<float>::infinity()) const;
 
