@@ -493,7 +493,11 @@ int main(int argc, char** argv) {
             install_stop_handlers();
             options.movie.cancel = &g_stop;
             double seconds = options.seconds ? *options.seconds : std::max(0.0, score.duration() - demo_args.start);
-            DemoProgress progress(frame_count(seconds, demo_args.fps), demo_args.quiet);
+            // Checked before run_demo starts: the frame count (a score may last centuries) and
+            // the soundtrack's memory.
+            const int frames = checked_frame_count(seconds, demo_args.fps);
+            (void)audio_options(score, demo_args, options.seconds);
+            DemoProgress progress(frames, demo_args.quiet);
             DemoReport report = run_demo(score, path, options, &progress);
             progress.finish(report.movie.batch);
             if (report.movie.batch.cancelled) return 130;

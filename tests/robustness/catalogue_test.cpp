@@ -103,6 +103,12 @@ std::vector<BadInput> catalogue() {
          "--size 64x48 --quiet",
          "the soundtrack (400000 s) needs about 131 GiB of memory, more than the limit of 1.0 GiB (--max-memory "
          "raises it)"},
+        {"DemoScoreLastingCenturies", "demo --score {data}/long.notes -o {out} --full --size 64x48 --quiet",
+         "36028794871 s at 24 fps: over 2147483647 frames is more than the limit of 10000000"},
+        {"DemoSoundtrackOverMemory",
+         "demo --score {data}/good.mid -o {out} --seconds 400000 --fps 0.001 --max-memory 1G --size 64x48 --quiet",
+         "the soundtrack (400000 s) needs about 131 GiB of memory, more than the limit of 1.0 GiB (--max-memory "
+         "raises it)"},
         // --- camera paths ---
         {"CameraPathTimesDecrease",
          "piano --camera-path {data}/times_decrease.campath -o {out} --seconds 1 --size 64x48 --quiet",

@@ -32,8 +32,11 @@ inline std::vector<std::string> files_under(const fs::path& dir) {
     std::vector<std::string> out;
     std::error_code ec;
     if (!fs::exists(dir, ec)) return out;
-    for (auto it = fs::recursive_directory_iterator(dir, ec); it != fs::recursive_directory_iterator(); ++it)
-        if (it->is_regular_file()) out.push_back(fs::relative(it->path(), dir).string());
+    // Files may come and go while a run is in progress (temporary files being renamed): no
+    // call here may touch the filesystem beyond the listing itself.
+    for (auto it = fs::recursive_directory_iterator(dir, ec); !ec && it != fs::recursive_directory_iterator();
+         it.increment(ec))
+        if (it->is_regular_file(ec)) out.push_back(it->path().lexically_relative(dir).string());
     return out;
 }
 

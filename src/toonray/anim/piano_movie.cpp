@@ -42,6 +42,14 @@ int frame_count(double seconds, double fps) {
     return static_cast<int>(frames);
 }
 
+int checked_frame_count(double seconds, double fps) {
+    const int frames = frame_count(seconds, fps);
+    if (static_cast<std::uint64_t>(frames) > limits().max_frames)
+        throw Error(fmt::format("{:.0f} s at {} fps: {}{} frames is more than the limit of {}", seconds, fps,
+                                frames == 2147483647 ? "over " : "", frames, limits().max_frames));
+    return frames;
+}
+
 namespace {
 
 void check_directory(const std::filesystem::path& dir, const char* what) {
@@ -188,10 +196,7 @@ PianoMovieReport render_piano_movie(const Score& score, const CameraPath& camera
     double music_end = score.notes.empty() ? 0.0 : score.duration();
     double seconds = options.seconds ? *options.seconds : std::max(0.0, music_end - options.start);
     if (!(seconds > 0.0)) throw Error("nothing to render: the length is zero (an empty score, or --start past its end)");
-    int frames = frame_count(seconds, options.fps);
-    if (static_cast<std::uint64_t>(frames) > limits().max_frames)
-        throw Error(fmt::format("{:.0f} s at {} fps: {}{} frames is more than the limit of {}", seconds, options.fps,
-                                frames == 2147483647 ? "over " : "", frames, limits().max_frames));
+    const int frames = checked_frame_count(seconds, options.fps);
     if (options.export_obj_dir) {
         check_directory(*options.export_obj_dir, "OBJ export");
     } else {

@@ -49,7 +49,12 @@ struct PianoMovieReport {
 };
 
 /// Number of frames for `seconds` of animation at `fps` (the last frame starts before the end).
+/// Saturates at INT_MAX instead of overflowing.
 int frame_count(double seconds, double fps);
+
+/// frame_count, checked against limits().max_frames: throws Error("S s at F fps: N frames is
+/// more than the limit of M") when a score or --seconds asks for too many.
+int checked_frame_count(double seconds, double fps);
 
 /// Renders (or exports) the frames. Throws Error for whole-run problems (bad options, an
 /// unwritable directory); per-frame failures are counted in the report.

@@ -431,7 +431,9 @@ namespace {
 // Counts the statements that add vertices and faces (a cheap pass over line starts) and
 // reserves for them: growing the arrays by doubling costs more than the count. Faces are
 // counted as one triangle each, the common case; polygons simply grow the arrays.
-void reserve_for(std::string_view text, Scene& scene) {
+// The counts come from the file, so they are held to the limits first: a file of 700 million
+// "f" lines must fail at the limit's line with its message, not in a 30 GB reservation.
+void reserve_for(std::string_view text, Scene& scene, const Limits& limits) {
     std::size_t v = 0, vn = 0, vt = 0, f = 0;
     const char* p = text.data();
     const char* end = p + text.size();
@@ -449,6 +451,12 @@ void reserve_for(std::string_view text, Scene& scene) {
         if (!nl) break;
         p = static_cast<const char*>(nl) + 1;
     }
+    const std::uint64_t max_vertices = std::min(limits.max_vertices, kMaxIndexable);
+    v = std::min<std::uint64_t>(v, max_vertices);
+    vn = std::min<std::uint64_t>(vn, max_vertices);
+    vt = std::min<std::uint64_t>(vt, max_vertices);
+    f = std::min<std::uint64_t>(f, std::min(limits.max_triangles, kMaxIndexable));
+    if (scene_bytes(v + vn + vt, f) > limits.max_memory) return;  // the parse stops at the limit
     scene.positions.reserve(v);
     scene.normals.reserve(vn);
     scene.texcoords.reserve(vt);
@@ -471,7 +479,7 @@ void parse_obj(std::string_view text, const std::filesystem::path& path, Scene& 
     std::string_view line;
     std::size_t line_number = 0;
     WarningSink warn(warnings, file);
-    reserve_for(text, scene);
+    reserve_for(text, scene, options.limits);
 
     std::unordered_map<std::string, std::uint32_t> object_ids{{"(default)", 0}};
     std::unordered_map<std::string, std::uint32_t> warned_materials, warned_statements;
