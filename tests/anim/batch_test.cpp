@@ -21,21 +21,14 @@
 #include "toonray/core/error.h"
 #include "toonray/io/file.h"
 #include "toonray/io/png.h"
+#include "support/test_support.h"
 
 using namespace toonray;
 namespace fs = std::filesystem;
 
 namespace {
 
-struct TempDir {
-    fs::path path;
-    explicit TempDir(const std::string& name) {
-        path = fs::temp_directory_path() / ("toonray_batch_" + name + "_" + std::to_string(::getpid()));
-        fs::remove_all(path);
-        fs::create_directories(path);
-    }
-    ~TempDir() { fs::remove_all(path); }
-};
+using toonray::test_support::TempDir;
 
 // A small animated scene: a box whose corners and camera move with the frame number, and a
 // tessellated strip whose length varies so that frames differ in size.

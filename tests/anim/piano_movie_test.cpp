@@ -9,21 +9,14 @@
 
 #include "toonray/anim/batch.h"
 #include "toonray/piano/piano_animation.h"
+#include "support/test_support.h"
 
 using namespace toonray;
 namespace fs = std::filesystem;
 
 namespace {
 
-struct TempDir {
-    fs::path path;
-    explicit TempDir(const std::string& name) {
-        path = fs::temp_directory_path() / ("toonray_movie_" + name + "_" + std::to_string(::getpid()));
-        fs::remove_all(path);
-        fs::create_directories(path);
-    }
-    ~TempDir() { fs::remove_all(path); }
-};
+using toonray::test_support::TempDir;
 
 std::string bytes(const fs::path& p) {
     std::ifstream f(p, std::ios::binary);

@@ -9,6 +9,8 @@
 #include <fstream>
 #include <string>
 
+#include "support/test_support.h"
+
 struct CommandResult {
     int exit_code = -1;
     std::string output;  ///< stdout and stderr together
@@ -28,18 +30,4 @@ inline CommandResult run_toonray(const std::string& args) {
     return r;
 }
 
-/// A fresh temporary directory, removed when the object goes away.
-struct TempDir {
-    std::filesystem::path path;
-    explicit TempDir(const std::string& name) {
-        path = std::filesystem::temp_directory_path() /
-               ("toonray_" + name + "_" + std::to_string(::getpid()));
-        std::filesystem::remove_all(path);
-        std::filesystem::create_directories(path);
-    }
-    ~TempDir() { std::filesystem::remove_all(path); }
-    std::filesystem::path operator/(const std::string& name) const { return path / name; }
-    void write(const std::string& name, const std::string& text) const {
-        std::ofstream(path / name, std::ios::binary) << text;
-    }
-};
+using toonray::test_support::TempDir;

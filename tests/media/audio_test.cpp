@@ -11,29 +11,14 @@
 #include "toonray/core/error.h"
 #include "toonray/io/file.h"
 #include "toonray/media/wav.h"
+#include "support/test_support.h"
 
 namespace toonray {
 namespace {
 
+using toonray::test_support::TempDir;
+
 namespace fs = std::filesystem;
-
-/// A fresh directory under the system temp dir, removed at the end of the test.
-class TempDir {
-public:
-    TempDir() {
-        std::string tmpl = (fs::temp_directory_path() / "toonray_audio_XXXXXX").string();
-        if (!::mkdtemp(tmpl.data())) throw std::runtime_error("mkdtemp failed");
-        path_ = tmpl;
-    }
-    ~TempDir() {
-        std::error_code ec;
-        fs::remove_all(path_, ec);
-    }
-    const fs::path& path() const { return path_; }
-
-private:
-    fs::path path_;
-};
 
 Score one_note(double start, double end, int key = 60, int velocity = 100) {
     Score s;
@@ -207,7 +192,7 @@ TEST(Audio, OverlappingSameKeyNotesKeepSounding) {
 
 TEST(Audio, WritesAReadableWav) {
     TempDir dir;
-    const fs::path wav = dir.path() / "out.wav";
+    const fs::path wav = dir.path / "out.wav";
     AudioResult r = render_audio(one_note(0.0, 0.5), wav);
     WavAudio back = read_wav(wav);
     EXPECT_EQ(back.sample_rate, 44100);
@@ -215,7 +200,7 @@ TEST(Audio, WritesAReadableWav) {
     EXPECT_TRUE(back.samples == r.audio.samples);
     EXPECT_EQ(fs::file_size(wav), 44 + r.audio.samples.size() * 2);
     // No temporary left behind.
-    EXPECT_EQ(std::distance(fs::directory_iterator(dir.path()), fs::directory_iterator()), 1);
+    EXPECT_EQ(std::distance(fs::directory_iterator(dir.path), fs::directory_iterator()), 1);
 }
 
 TEST(Audio, MissingSoundFontIsNamed) {
@@ -233,7 +218,7 @@ TEST(Audio, MissingSoundFontIsNamed) {
 
 TEST(Audio, InvalidSoundFontIsNamed) {
     TempDir dir;
-    const fs::path bad = dir.path() / "bogus.sf2";
+    const fs::path bad = dir.path / "bogus.sf2";
     const std::string text = "RIFF\x10\0\0\0sfbkLIST but nothing else";
     write_file_atomic(bad, {reinterpret_cast<const std::uint8_t*>(text.data()), text.size()});
     AudioOptions o;
@@ -244,7 +229,7 @@ TEST(Audio, InvalidSoundFontIsNamed) {
     } catch (const Error& e) {
         EXPECT_NE(std::string(e.what()).find(bad.string()), std::string::npos) << e.what();
     }
-    const fs::path text_file = dir.path() / "notes.txt";
+    const fs::path text_file = dir.path / "notes.txt";
     write_file_atomic(text_file, {reinterpret_cast<const std::uint8_t*>("hello"), 5});
     o.soundfont = text_file;
     try {
@@ -287,14 +272,14 @@ TEST(Wav, RoundTripsAndRejectsGarbage) {
     a.sample_rate = 22050;
     a.channels = 1;
     for (int i = 0; i < 1000; ++i) a.samples.push_back(static_cast<std::int16_t>(i * 37 - 18000));
-    write_wav(dir.path() / "a.wav", a);
-    WavAudio b = read_wav(dir.path() / "a.wav");
+    write_wav(dir.path / "a.wav", a);
+    WavAudio b = read_wav(dir.path / "a.wav");
     EXPECT_EQ(b.sample_rate, 22050);
     EXPECT_EQ(b.channels, 1);
     EXPECT_TRUE(a.samples == b.samples);
-    write_file_atomic(dir.path() / "x.wav", {reinterpret_cast<const std::uint8_t*>("nope"), 4});
-    EXPECT_THROW(read_wav(dir.path() / "x.wav"), Error);
-    EXPECT_THROW(read_wav(dir.path() / "missing.wav"), Error);
+    write_file_atomic(dir.path / "x.wav", {reinterpret_cast<const std::uint8_t*>("nope"), 4});
+    EXPECT_THROW(read_wav(dir.path / "x.wav"), Error);
+    EXPECT_THROW(read_wav(dir.path / "missing.wav"), Error);
 }
 
 }  // namespace

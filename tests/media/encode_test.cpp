@@ -14,28 +14,15 @@
 #include "toonray/io/png.h"
 #include "toonray/media/process.h"
 #include "toonray/media/wav.h"
+#include "support/test_support.h"
 
 namespace toonray {
 namespace {
 
+using toonray::test_support::TempDir;
+using toonray::test_support::error_of;
+
 namespace fs = std::filesystem;
-
-class TempDir {
-public:
-    TempDir() {
-        std::string tmpl = (fs::temp_directory_path() / "toonray_encode_XXXXXX").string();
-        if (!::mkdtemp(tmpl.data())) throw std::runtime_error("mkdtemp failed");
-        path_ = tmpl;
-    }
-    ~TempDir() {
-        std::error_code ec;
-        fs::remove_all(path_, ec);
-    }
-    const fs::path& path() const { return path_; }
-
-private:
-    fs::path path_;
-};
 
 /// Writes frames first .. first + count - 1 as name_pattern (fmt, e.g. "frame_{:04d}.png"),
 /// each a different colour so the encoder has something to do.
@@ -71,24 +58,14 @@ std::size_t count_entries(const fs::path& dir) {
     return static_cast<std::size_t>(std::distance(fs::directory_iterator(dir), fs::directory_iterator()));
 }
 
-template <typename F>
-std::string error_of(F&& f) {
-    try {
-        f();
-    } catch (const Error& e) {
-        return e.what();
-    }
-    return "(no error)";
-}
-
 constexpr double kFrame = 1.0 / 24.0;
 
 TEST(Encode, VideoOnly) {
     TempDir tmp;
-    write_frames(tmp.path() / "frames", "frame_{:04d}.png", 1, 12);
+    write_frames(tmp.path / "frames", "frame_{:04d}.png", 1, 12);
     EncodeOptions o;
-    o.frames_dir = tmp.path() / "frames";
-    o.output = tmp.path() / "out.mp4";
+    o.frames_dir = tmp.path / "frames";
+    o.output = tmp.path / "out.mp4";
     o.fps = 24;
     EncodeResult r = encode_video(o);
     EXPECT_EQ(r.frames.prefix, "frame_");
@@ -112,16 +89,16 @@ TEST(Encode, VideoOnly) {
     EXPECT_NEAR(v.duration, 0.5, kFrame);
     EXPECT_NEAR(info.duration, 0.5, kFrame);
     // Only out.mp4 and the frames directory: no temporary left behind.
-    EXPECT_EQ(count_entries(tmp.path()), 2u);
+    EXPECT_EQ(count_entries(tmp.path), 2u);
 }
 
 TEST(Encode, WithAudioCutToTheVideo) {
     TempDir tmp;
-    write_frames(tmp.path() / "frames", "f{:03d}.png", 0, 12);
+    write_frames(tmp.path / "frames", "f{:03d}.png", 0, 12);
     EncodeOptions o;
-    o.frames_dir = tmp.path() / "frames";
-    o.output = tmp.path() / "av.mp4";
-    o.audio = write_tone(tmp.path() / "tone.wav", 1.0);
+    o.frames_dir = tmp.path / "frames";
+    o.output = tmp.path / "av.mp4";
+    o.audio = write_tone(tmp.path / "tone.wav", 1.0);
     encode_video(o);
     MediaInfo info = probe_media(o.output);
     ASSERT_EQ(info.streams.size(), 2u);
@@ -139,7 +116,7 @@ TEST(Encode, WithAudioCutToTheVideo) {
 
     // Without the cut the file runs as long as the soundtrack.
     o.cut_audio_to_video = false;
-    o.output = tmp.path() / "long.mp4";
+    o.output = tmp.path / "long.mp4";
     encode_video(o);
     EXPECT_NEAR(probe_media(o.output).duration, 1.0, kFrame);
 }
@@ -148,18 +125,18 @@ TEST(Encode, AudioStartsWithFrameZero) {
     // A tone starting 0.25 s in: decoded back from the MP4 it must start 0.25 s in too (the AAC
     // encoder's priming samples must be hidden by the edit list, not shift the sound late).
     TempDir tmp;
-    write_frames(tmp.path() / "frames", "f{:03d}.png", 0, 12);
+    write_frames(tmp.path / "frames", "f{:03d}.png", 0, 12);
     EncodeOptions o;
-    o.frames_dir = tmp.path() / "frames";
-    o.output = tmp.path() / "av.mp4";
-    o.audio = write_tone(tmp.path() / "tone.wav", 0.5, 0.25);
+    o.frames_dir = tmp.path / "frames";
+    o.output = tmp.path / "av.mp4";
+    o.audio = write_tone(tmp.path / "tone.wav", 0.5, 0.25);
     encode_video(o);
     MediaInfo info = probe_media(o.output);
     ASSERT_TRUE(info.first("video") && info.first("audio"));
     EXPECT_NEAR(info.first("video")->start_time, 0.0, 1e-6);
     EXPECT_NEAR(info.first("audio")->start_time, 0.0, 1e-3);
 
-    const fs::path back = tmp.path() / "back.wav";
+    const fs::path back = tmp.path / "back.wav";
     ProcessResult run = run_process({"ffmpeg", "-nostdin", "-loglevel", "error", "-i",
                                      o.output.string(), "-c:a", "pcm_s16le", back.string()});
     ASSERT_TRUE(run.ok()) << run.err;
@@ -173,10 +150,10 @@ TEST(Encode, AudioStartsWithFrameZero) {
 
 TEST(Encode, OddSizedFramesArePadded) {
     TempDir tmp;
-    write_frames(tmp.path() / "frames", "frame_{:04d}.png", 1, 12, 63, 47);
+    write_frames(tmp.path / "frames", "frame_{:04d}.png", 1, 12, 63, 47);
     EncodeOptions o;
-    o.frames_dir = tmp.path() / "frames";
-    o.output = tmp.path() / "odd.mp4";
+    o.frames_dir = tmp.path / "frames";
+    o.output = tmp.path / "odd.mp4";
     EncodeResult r = encode_video(o);
     EXPECT_TRUE(r.padded);
     MediaInfo info = probe_media(o.output);
@@ -187,7 +164,7 @@ TEST(Encode, OddSizedFramesArePadded) {
     EXPECT_EQ(info.streams[0].pix_fmt, "yuv420p");
 
     // The added column and row repeat the edge rather than being black.
-    const fs::path png = tmp.path() / "first.png";
+    const fs::path png = tmp.path / "first.png";
     ProcessResult run = run_process({"ffmpeg", "-nostdin", "-loglevel", "error", "-i",
                                      o.output.string(), "-frames:v", "1", png.string()});
     ASSERT_TRUE(run.ok()) << run.err;
@@ -202,29 +179,29 @@ TEST(Encode, OddSizedFramesArePadded) {
 
 TEST(Encode, GapNamesTheFirstMissingFrame) {
     TempDir tmp;
-    write_frames(tmp.path() / "frames", "frame_{:04d}.png", 1, 12);
-    fs::remove(tmp.path() / "frames" / "frame_0007.png");
-    fs::remove(tmp.path() / "frames" / "frame_0009.png");
+    write_frames(tmp.path / "frames", "frame_{:04d}.png", 1, 12);
+    fs::remove(tmp.path / "frames" / "frame_0007.png");
+    fs::remove(tmp.path / "frames" / "frame_0009.png");
     EncodeOptions o;
-    o.frames_dir = tmp.path() / "frames";
-    o.output = tmp.path() / "gap.mp4";
+    o.frames_dir = tmp.path / "frames";
+    o.output = tmp.path / "gap.mp4";
     const std::string e = error_of([&] { encode_video(o); });
     EXPECT_NE(e.find("frame_0007.png: missing frame"), std::string::npos) << e;
     EXPECT_FALSE(fs::exists(o.output));
-    EXPECT_EQ(count_entries(tmp.path()), 1u);
+    EXPECT_EQ(count_entries(tmp.path), 1u);
 }
 
 TEST(Encode, MissingOrBadAudioIsAnError) {
     TempDir tmp;
-    write_frames(tmp.path() / "frames", "frame_{:04d}.png", 1, 12);
+    write_frames(tmp.path / "frames", "frame_{:04d}.png", 1, 12);
     EncodeOptions o;
-    o.frames_dir = tmp.path() / "frames";
-    o.output = tmp.path() / "a.mp4";
-    o.audio = tmp.path() / "no such.wav";
+    o.frames_dir = tmp.path / "frames";
+    o.output = tmp.path / "a.mp4";
+    o.audio = tmp.path / "no such.wav";
     std::string e = error_of([&] { encode_video(o); });
     EXPECT_NE(e.find("no such.wav: cannot open audio file"), std::string::npos) << e;
 
-    o.audio = tmp.path() / "notes.txt";
+    o.audio = tmp.path / "notes.txt";
     write_file_atomic(o.audio, {reinterpret_cast<const std::uint8_t*>("not audio"), 9});
     e = error_of([&] { encode_video(o); });
     EXPECT_NE(e.find("notes.txt: cannot read audio"), std::string::npos) << e;
@@ -234,7 +211,7 @@ TEST(Encode, MissingOrBadAudioIsAnError) {
     encode_video(o);
     EncodeOptions o2 = o;
     o2.audio = o.output;
-    o2.output = tmp.path() / "b.mp4";
+    o2.output = tmp.path / "b.mp4";
     e = error_of([&] { encode_video(o2); });
     EXPECT_NE(e.find("a.mp4: has no audio stream"), std::string::npos) << e;
     EXPECT_FALSE(fs::exists(o2.output));
@@ -242,13 +219,13 @@ TEST(Encode, MissingOrBadAudioIsAnError) {
 
 TEST(Encode, MissingFfmpegSaysWhatToInstall) {
     TempDir tmp;
-    write_frames(tmp.path() / "frames", "frame_{:04d}.png", 1, 3);
+    write_frames(tmp.path / "frames", "frame_{:04d}.png", 1, 3);
     EncodeOptions o;
-    o.frames_dir = tmp.path() / "frames";
-    o.output = tmp.path() / "a.mp4";
+    o.frames_dir = tmp.path / "frames";
+    o.output = tmp.path / "a.mp4";
     // PATH without ffmpeg: the default program name is looked up there.
     const std::string saved = std::getenv("PATH") ? std::getenv("PATH") : "";
-    ::setenv("PATH", tmp.path().c_str(), 1);
+    ::setenv("PATH", tmp.path.c_str(), 1);
     const std::string e = error_of([&] { encode_video(o); });
     ::setenv("PATH", saved.c_str(), 1);
     EXPECT_EQ(e, "ffmpeg not found on PATH; install the Debian package ffmpeg");
@@ -259,28 +236,28 @@ TEST(Encode, MissingFfmpegSaysWhatToInstall) {
 
 TEST(Encode, FfmpegFailureQuotesItsStderrAndKeepsTheOldOutput) {
     TempDir tmp;
-    write_frames(tmp.path() / "frames", "frame_{:04d}.png", 1, 3);
+    write_frames(tmp.path / "frames", "frame_{:04d}.png", 1, 3);
     EncodeOptions o;
-    o.frames_dir = tmp.path() / "frames";
-    o.output = tmp.path() / "a.mp4";
+    o.frames_dir = tmp.path / "frames";
+    o.output = tmp.path / "a.mp4";
     write_file_atomic(o.output, {reinterpret_cast<const std::uint8_t*>("old"), 3});
     o.tune = "no-such-tune";
     const std::string e = error_of([&] { encode_video(o); });
     EXPECT_NE(e.find("a.mp4: ffmpeg failed (exit status"), std::string::npos) << e;
     EXPECT_NE(e.find("no-such-tune"), std::string::npos) << "stderr tail missing: " << e;
     EXPECT_EQ(read_file(o.output), "old");
-    EXPECT_EQ(count_entries(tmp.path()), 2u);  // frames/ and a.mp4: temporary removed
+    EXPECT_EQ(count_entries(tmp.path), 2u);  // frames/ and a.mp4: temporary removed
 }
 
 TEST(Encode, AwkwardPathsArePassedIntact) {
     // Spaces, quotes, '$', '%' and ':' must survive: no shell, '%' escaped, file: protocol.
     TempDir tmp;
-    const fs::path dir = tmp.path() / "my $frames 100% 'done'";
+    const fs::path dir = tmp.path / "my $frames 100% 'done'";
     write_frames(dir, "take:2 {:03d}.png", 1, 4);
     EncodeOptions o;
     o.frames_dir = dir;
-    o.output = tmp.path() / "-out: 50%.mp4";
-    o.audio = write_tone(tmp.path() / "tone $1.wav", 0.2);
+    o.output = tmp.path / "-out: 50%.mp4";
+    o.audio = write_tone(tmp.path / "tone $1.wav", 0.2);
     EncodeResult r = encode_video(o);
     EXPECT_EQ(r.frames.pattern(), "take:2 %03d.png");
     MediaInfo info = probe_media(o.output);
@@ -290,12 +267,12 @@ TEST(Encode, AwkwardPathsArePassedIntact) {
 
 TEST(Encode, ExplicitPatternAndStartNumber) {
     TempDir tmp;
-    write_frames(tmp.path(), "shot-{:03d}.png", 0, 12);
-    write_frames(tmp.path(), "other_{:02d}.png", 0, 2);  // a second sequence: fine with a pattern
+    write_frames(tmp.path, "shot-{:03d}.png", 0, 12);
+    write_frames(tmp.path, "other_{:02d}.png", 0, 2);  // a second sequence: fine with a pattern
     EncodeOptions o;
-    o.pattern = (tmp.path() / "shot-%03d.png").string();
+    o.pattern = (tmp.path / "shot-%03d.png").string();
     o.start_number = 3;
-    o.output = tmp.path() / "p.mp4";
+    o.output = tmp.path / "p.mp4";
     EncodeResult r = encode_video(o);
     EXPECT_EQ(r.frames.first, 3);
     EXPECT_EQ(r.frames.count, 9);
@@ -305,69 +282,69 @@ TEST(Encode, ExplicitPatternAndStartNumber) {
     EXPECT_NE(error_of([&] { encode_video(o); }).find("shot-020.png: first frame not found"),
               std::string::npos);
     o.start_number.reset();
-    o.pattern = (tmp.path() / "shot-%03d-%d.png").string();
+    o.pattern = (tmp.path / "shot-%03d-%d.png").string();
     EXPECT_NE(error_of([&] { encode_video(o); }).find("exactly one %d"), std::string::npos);
 }
 
 TEST(FrameSequence, DetectsPrefixAndPadding) {
     TempDir tmp;
-    write_frames(tmp.path(), "render.{:05d}.png", 7, 3);
-    write_file_atomic(tmp.path() / "poster.png", {reinterpret_cast<const std::uint8_t*>("x"), 1});
-    write_file_atomic(tmp.path() / "notes.txt", {reinterpret_cast<const std::uint8_t*>("x"), 1});
-    FrameSequence s = find_frame_sequence(tmp.path());
+    write_frames(tmp.path, "render.{:05d}.png", 7, 3);
+    write_file_atomic(tmp.path / "poster.png", {reinterpret_cast<const std::uint8_t*>("x"), 1});
+    write_file_atomic(tmp.path / "notes.txt", {reinterpret_cast<const std::uint8_t*>("x"), 1});
+    FrameSequence s = find_frame_sequence(tmp.path);
     EXPECT_EQ(s.prefix, "render.");
     EXPECT_EQ(s.digits, 5);
     EXPECT_EQ(s.first, 7);
     EXPECT_EQ(s.count, 3);
     EXPECT_EQ(s.width, 64);
     EXPECT_EQ(s.pattern(), "render.%05d.png");
-    EXPECT_EQ(s.frame_path(8), tmp.path() / "render.00008.png");
+    EXPECT_EQ(s.frame_path(8), tmp.path / "render.00008.png");
 }
 
 TEST(FrameSequence, UnpaddedNumbersAndPaddingOverflow) {
     TempDir tmp;
-    write_frames(tmp.path() / "a", "f{}.png", 8, 5);  // f8 .. f12
-    FrameSequence s = find_frame_sequence(tmp.path() / "a");
+    write_frames(tmp.path / "a", "f{}.png", 8, 5);  // f8 .. f12
+    FrameSequence s = find_frame_sequence(tmp.path / "a");
     EXPECT_EQ(s.pattern(), "f%d.png");
     EXPECT_EQ(s.count, 5);
-    write_frames(tmp.path() / "b", "f{:03d}.png", 998, 4);  // f998, f999, f1000, f1001
-    s = find_frame_sequence(tmp.path() / "b");
+    write_frames(tmp.path / "b", "f{:03d}.png", 998, 4);  // f998, f999, f1000, f1001
+    s = find_frame_sequence(tmp.path / "b");
     EXPECT_EQ(s.pattern(), "f%03d.png");
     EXPECT_EQ(s.count, 4);
 }
 
 TEST(FrameSequence, MixedSequencesAndPaddingsAreNamed) {
     TempDir tmp;
-    write_frames(tmp.path() / "a", "beauty_{:04d}.png", 1, 3);
-    write_frames(tmp.path() / "a", "depth_{:04d}.png", 1, 2);
-    std::string e = error_of([&] { find_frame_sequence(tmp.path() / "a"); });
+    write_frames(tmp.path / "a", "beauty_{:04d}.png", 1, 3);
+    write_frames(tmp.path / "a", "depth_{:04d}.png", 1, 2);
+    std::string e = error_of([&] { find_frame_sequence(tmp.path / "a"); });
     EXPECT_NE(e.find("several image sequences"), std::string::npos) << e;
     EXPECT_NE(e.find("beauty_%04d.png (3 files)"), std::string::npos) << e;
     EXPECT_NE(e.find("depth_%04d.png (2 files)"), std::string::npos) << e;
 
-    write_frames(tmp.path() / "b", "f{:03d}.png", 1, 3);
-    write_frames(tmp.path() / "b", "f{:04d}.png", 4, 1);
-    e = error_of([&] { find_frame_sequence(tmp.path() / "b"); });
+    write_frames(tmp.path / "b", "f{:03d}.png", 1, 3);
+    write_frames(tmp.path / "b", "f{:04d}.png", 4, 1);
+    e = error_of([&] { find_frame_sequence(tmp.path / "b"); });
     EXPECT_NE(e.find("different zero padding"), std::string::npos) << e;
     EXPECT_NE(e.find("f0004.png"), std::string::npos) << e;
 }
 
 TEST(FrameSequence, NoFramesMismatchedSizesAndNonPngs) {
     TempDir tmp;
-    fs::create_directories(tmp.path() / "empty");
-    EXPECT_NE(error_of([&] { find_frame_sequence(tmp.path() / "empty"); }).find("no PNG frames"),
+    fs::create_directories(tmp.path / "empty");
+    EXPECT_NE(error_of([&] { find_frame_sequence(tmp.path / "empty"); }).find("no PNG frames"),
               std::string::npos);
-    EXPECT_NE(error_of([&] { find_frame_sequence(tmp.path() / "nowhere"); })
+    EXPECT_NE(error_of([&] { find_frame_sequence(tmp.path / "nowhere"); })
                   .find("frame directory not found"),
               std::string::npos);
-    write_frames(tmp.path() / "s", "f{:02d}.png", 1, 2, 64, 48);
-    write_frames(tmp.path() / "s", "f{:02d}.png", 3, 1, 32, 48);
-    std::string e = error_of([&] { find_frame_sequence(tmp.path() / "s"); });
+    write_frames(tmp.path / "s", "f{:02d}.png", 1, 2, 64, 48);
+    write_frames(tmp.path / "s", "f{:02d}.png", 3, 1, 32, 48);
+    std::string e = error_of([&] { find_frame_sequence(tmp.path / "s"); });
     EXPECT_NE(e.find("f03.png: frame is 32x48 but the first frame f01.png is 64x48"),
               std::string::npos) << e;
-    write_frames(tmp.path() / "t", "f{:02d}.png", 1, 2);
-    write_file_atomic(tmp.path() / "t" / "f03.png", {reinterpret_cast<const std::uint8_t*>("GIF89a"), 6});
-    e = error_of([&] { find_frame_sequence(tmp.path() / "t"); });
+    write_frames(tmp.path / "t", "f{:02d}.png", 1, 2);
+    write_file_atomic(tmp.path / "t" / "f03.png", {reinterpret_cast<const std::uint8_t*>("GIF89a"), 6});
+    e = error_of([&] { find_frame_sequence(tmp.path / "t"); });
     EXPECT_NE(e.find("f03.png: frame is not a PNG"), std::string::npos) << e;
 }
 
@@ -385,7 +362,7 @@ TEST(Process, ArgvIsPassedWithoutAShell) {
 
 TEST(Probe, UnreadableFileIsAnError) {
     TempDir tmp;
-    EXPECT_NE(error_of([&] { probe_media(tmp.path() / "missing.mp4"); }).find("missing.mp4: ffprobe failed"),
+    EXPECT_NE(error_of([&] { probe_media(tmp.path / "missing.mp4"); }).find("missing.mp4: ffprobe failed"),
               std::string::npos);
 }
 

@@ -15,31 +15,14 @@
 #include "toonray/core/error.h"
 #include "toonray/io/file.h"
 #include "toonray/scene/obj_loader.h"
+#include "support/test_support.h"
 
 namespace toonray {
 namespace {
 
+using toonray::test_support::TempDir;
+
 namespace fs = std::filesystem;
-
-/// A fresh directory per test, removed afterwards.
-class TempDir {
-public:
-    TempDir() {
-        static int counter = 0;
-        path_ = fs::temp_directory_path() / ("toonray_obj_writer_" + std::to_string(::getpid()) +
-                                             "_" + std::to_string(counter++));
-        fs::remove_all(path_);
-        fs::create_directories(path_);
-    }
-    ~TempDir() {
-        std::error_code ec;
-        fs::remove_all(path_, ec);
-    }
-    [[nodiscard]] const fs::path& path() const { return path_; }
-
-private:
-    fs::path path_;
-};
 
 bool same_bits(float a, float b) {
     return std::bit_cast<std::uint32_t>(a) == std::bit_cast<std::uint32_t>(b);
@@ -127,11 +110,11 @@ void expect_round_trip(const Scene& in, const Scene& out) {
 TEST(ObjWriter, RoundTripsBitExactly) {
     TempDir dir;
     const Scene in = tricky_scene();
-    write_obj(dir.path() / "scene.obj", in);
-    ASSERT_TRUE(fs::exists(dir.path() / "scene.mtl"));
+    write_obj(dir.path / "scene.obj", in);
+    ASSERT_TRUE(fs::exists(dir.path / "scene.mtl"));
     Scene out;
     Warnings warnings;
-    load_obj(dir.path() / "scene.obj", out, warnings);
+    load_obj(dir.path / "scene.obj", out, warnings);
     EXPECT_TRUE(warnings.empty()) << warnings.front();
     expect_round_trip(in, out);
 }
@@ -209,10 +192,10 @@ TEST(ObjWriter, WritesOnlyCompleteFilesAndNoTemporaries) {
     ObjWriter writer;
     for (int frame = 0; frame < 3; ++frame) {
         s.positions[0].x = static_cast<float>(frame);
-        writer.write(dir.path() / "frame.obj", s);
+        writer.write(dir.path / "frame.obj", s);
     }
     int files = 0;
-    for (const auto& entry : fs::directory_iterator(dir.path())) {
+    for (const auto& entry : fs::directory_iterator(dir.path)) {
         ++files;
         EXPECT_TRUE(entry.path().filename() == "frame.obj" ||
                     entry.path().filename() == "frame.mtl")
@@ -221,7 +204,7 @@ TEST(ObjWriter, WritesOnlyCompleteFilesAndNoTemporaries) {
     EXPECT_EQ(files, 2);
     Scene out;
     Warnings warnings;
-    load_obj(dir.path() / "frame.obj", out, warnings);
+    load_obj(dir.path / "frame.obj", out, warnings);
     EXPECT_EQ(out.positions[0].x, 2.0f);
 }
 
@@ -233,9 +216,9 @@ TEST(ObjWriter, OptionsLeaveOutWhatIsNotWanted) {
     options.write_texcoords = false;
     options.write_camera = false;
     options.write_mtl = false;
-    ObjWriter().write(dir.path() / "bare.obj", s, options);
-    EXPECT_FALSE(fs::exists(dir.path() / "bare.mtl"));
-    const std::string text = read_file(dir.path() / "bare.obj");
+    ObjWriter().write(dir.path / "bare.obj", s, options);
+    EXPECT_FALSE(fs::exists(dir.path / "bare.mtl"));
+    const std::string text = read_file(dir.path / "bare.obj");
     EXPECT_EQ(text.find("vn "), std::string::npos);
     EXPECT_EQ(text.find("vt "), std::string::npos);
     EXPECT_EQ(text.find("Camera"), std::string::npos);
@@ -265,14 +248,14 @@ TEST(ObjWriter, RejectsWhatCannotRoundTrip) {
 
 TEST(ObjWriter, TextureMapPathsFollowTheMtl) {
     TempDir dir;
-    fs::create_directories(dir.path() / "in" / "tex");
-    fs::create_directories(dir.path() / "out");
+    fs::create_directories(dir.path / "in" / "tex");
+    fs::create_directories(dir.path / "out");
     Scene s = tricky_scene();
-    s.materials[1].map_kd = (dir.path() / "in" / "tex" / "wood.png").string();
-    write_obj(dir.path() / "out" / "scene.obj", s);
+    s.materials[1].map_kd = (dir.path / "in" / "tex" / "wood.png").string();
+    write_obj(dir.path / "out" / "scene.obj", s);
     Scene back;
     Warnings warnings;
-    load_obj(dir.path() / "out" / "scene.obj", back, warnings);
+    load_obj(dir.path / "out" / "scene.obj", back, warnings);
     EXPECT_EQ(fs::weakly_canonical(back.materials[1].map_kd),
               fs::weakly_canonical(s.materials[1].map_kd));
 }
@@ -283,11 +266,11 @@ TEST(ObjWriter, AnotherReaderAgrees) {
     const Scene in = tricky_scene();
     ObjWriteOptions options;
     options.write_camera = false;  // `c` is toonray's own statement
-    write_obj(dir.path() / "scene.obj", in, options);
+    write_obj(dir.path / "scene.obj", in, options);
     tinyobj::ObjReader reader;
     tinyobj::ObjReaderConfig config;
     config.triangulate = false;
-    ASSERT_TRUE(reader.ParseFromFile((dir.path() / "scene.obj").string(), config))
+    ASSERT_TRUE(reader.ParseFromFile((dir.path / "scene.obj").string(), config))
         << reader.Error();
     const auto& attrib = reader.GetAttrib();
     ASSERT_EQ(attrib.vertices.size(), 3 * in.positions.size());

@@ -7,24 +7,17 @@
 #include "toonray/score/note_script.h"
 #include "toonray/score/piano_keys.h"
 #include "toonray/score/score_io.h"
+#include "support/test_support.h"
 
 namespace toonray {
 namespace {
+
+using toonray::test_support::error_of;
 
 // One seed line: an eighth at 72 bpm, 60/72/2 s, with the quarter rounded to whole
 // microseconds (833333) as MIDI stores tempo, so scripts and MIDI files agree exactly.
 constexpr double kLine = 833333e-6 / 2.0;
 static_assert(kLine - 60.0 / 72.0 / 2.0 < 1e-6 && kLine < 60.0 / 72.0 / 2.0);
-
-template <typename F>
-std::string error_of(F&& f) {
-    try {
-        f();
-    } catch (const Error& e) {
-        return e.what();
-    }
-    return "(no error)";
-}
 
 std::string parse_error(std::string_view text) {
     return error_of([&] { (void)parse_note_script(text, "bad.notes"); });

@@ -7,9 +7,12 @@
 
 #include "toonray/io/file.h"
 #include "toonray/score/score_io.h"
+#include "support/test_support.h"
 
 namespace toonray {
 namespace {
+
+using toonray::test_support::error_of;
 
 namespace fs = std::filesystem;
 
@@ -30,16 +33,6 @@ protected:
 
     fs::path dir_;
 };
-
-template <typename F>
-std::string error_of(F&& f) {
-    try {
-        f();
-    } catch (const Error& e) {
-        return e.what();
-    }
-    return "(no error)";
-}
 
 const char* const kEntertainer = TOONRAY_DATA_DIR "/entertainer.midi";
 
