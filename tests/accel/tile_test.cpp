@@ -14,35 +14,15 @@
 #include "toonray/accel/triangle_accel.h"
 #include "toonray/scene/camera.h"
 #include "toonray/scene/obj_loader.h"
+#include "accel/soup.h"
 
 using namespace toonray;
 
 namespace {
 
-struct Soup {
-    std::vector<Vec3f> positions;
-    std::vector<std::array<std::uint32_t, 3>> tris;
-};
-
-Soup random_soup(int count, unsigned seed, float size = 0.2f) {
-    std::mt19937 rng(seed);
-    std::uniform_real_distribution<float> pos(-1.0f, 1.0f), off(-size, size);
-    Soup s;
-    for (int i = 0; i < count; ++i) {
-        Vec3f c(pos(rng), pos(rng), pos(rng));
-        auto base = static_cast<std::uint32_t>(s.positions.size());
-        for (int k = 0; k < 3; ++k) s.positions.push_back(c + Vec3f(off(rng), off(rng), off(rng)));
-        s.tris.push_back({base, base + 1, base + 2});
-    }
-    return s;
-}
-
-Soup from_obj(const std::string& name) {
-    Scene scene;
-    Warnings w;
-    load_obj(std::string(TOONRAY_TEST_DATA_DIR) + "/" + name, scene, w);
-    return {scene.positions, scene.tri_positions};
-}
+using test_support::from_obj;
+using test_support::random_soup;
+using test_support::Soup;
 
 // An axis-aligned grid of unit squares in the plane z = 0 (two triangles each): rays from a
 // camera looking straight down hit shared edges and corners exactly.
