@@ -54,23 +54,25 @@ def check(ok, what):
     return ok
 
 
-# ---- PNG (8-bit grey, grey+alpha, RGB or RGBA, not interlaced) -----------------------------
+# ---- PNG (8-bit grey, grey+alpha, RGB, RGBA or indexed, not interlaced) --------------------
 
 def read_png(path):
     with open(path, "rb") as f:
         data = f.read()
     if data[:8] != b"\x89PNG\r\n\x1a\n":
         raise ValueError("%s: not a PNG" % path)
-    pos, idat, width = 8, [], None
+    pos, idat, width, palette = 8, [], None, None
     while pos < len(data):
         length, kind = struct.unpack(">I4s", data[pos:pos + 8])
         body = data[pos + 8:pos + 8 + length]
         pos += 12 + length
         if kind == b"IHDR":
             width, height, depth, ctype, _c, _f, interlace = struct.unpack(">IIBBBBB", body)
-            if depth != 8 or interlace != 0 or ctype not in (0, 2, 4, 6):
+            if depth != 8 or interlace != 0 or ctype not in (0, 2, 3, 4, 6):
                 raise ValueError("%s: unsupported PNG (depth %d, type %d)" % (path, depth, ctype))
-            channels = {0: 1, 2: 3, 4: 2, 6: 4}[ctype]
+            channels = {0: 1, 2: 3, 3: 1, 4: 2, 6: 4}[ctype]  # indexed: one index a pixel
+        elif kind == b"PLTE":
+            palette = body  # toonray writes frames of at most 256 colours indexed
         elif kind == b"IDAT":
             idat.append(body)
         elif kind == b"IEND":
@@ -97,6 +99,9 @@ def read_png(path):
                 line[i] = (line[i] + (a if pa <= pb and pa <= pc else b if pb <= pc else c)) & 255
         rows.append(line)
         prev = line
+    if palette is not None:  # indexed: expand to RGB
+        rows = [bytearray(b"".join(palette[3 * i:3 * i + 3] for i in row)) for row in rows]
+        channels = 3
     return width, height, channels, rows
 
 

@@ -5,6 +5,8 @@
 #include <filesystem>
 #include <fstream>
 #include <random>
+#include <set>
+#include <utility>
 
 #include "toonray/core/error.h"
 #include "toonray/io/file.h"
@@ -19,6 +21,38 @@ fs::path temp_dir(const std::string& name) {
     fs::remove_all(dir);
     fs::create_directories(dir);
     return dir;
+}
+
+/// Colour type from the IHDR chunk (byte 25 of the file): 2 RGB, 3 indexed, 0 gray.
+int colour_type(const std::vector<std::uint8_t>& png) { return png.at(25); }
+
+/// An image with `colours` distinct colours (at most 2^24), in runs and rows like a toon frame,
+/// plus single pixels so that every colour appears.
+ImageRgb8 image_with_colours(int width, int height, int colours, std::uint32_t seed) {
+    ImageRgb8 image(width, height);
+    std::mt19937 rng(seed);
+    auto colour_of = [](std::uint32_t i) {
+        i *= 2654435761u;  // spread the colours over the cube
+        return Rgb8{static_cast<std::uint8_t>(i >> 24), static_cast<std::uint8_t>(i >> 16),
+                    static_cast<std::uint8_t>(i >> 8)};
+    };
+    for (int y = 0; y < height; ++y)
+        for (int x = 0; x < width; ++x)
+            image(x, y) = colour_of(((x / 7) + (y / 5) * 3 + static_cast<int>(rng() % 2)) % colours);
+    for (int i = 0; i < colours && i < width * height; ++i) image(i % width, i / width) = colour_of(i);
+    return image;
+}
+
+void expect_round_trip(const ImageRgb8& image, const PngOptions& options, int expect_colour_type) {
+    const auto bytes = encode_png(image.width(), image.height(), 3,
+                                  reinterpret_cast<const std::uint8_t*>(image.data()), options);
+    EXPECT_EQ(colour_type(bytes), expect_colour_type);
+    DecodedPng decoded = decode_png(bytes, "memory");
+    ASSERT_EQ(decoded.width, image.width());
+    ASSERT_EQ(decoded.height, image.height());
+    for (int y = 0; y < image.height(); ++y)
+        for (int x = 0; x < image.width(); ++x)
+            ASSERT_EQ(decoded.rgb(x, y), image(x, y)) << x << "," << y << " of " << image.width() << "x" << image.height();
 }
 
 }  // namespace
@@ -100,4 +134,35 @@ TEST(ReadFile, MissingFileNamesThePath) {
     } catch (const Error& e) {
         EXPECT_NE(std::string(e.what()).find("/nonexistent/toonray.obj"), std::string::npos);
     }
+}
+
+TEST(Png, FewColoursAreIndexedAndRoundTrip) {
+    // Up to 256 colours are written with a palette; from 257 on as RGB. Both decode to exactly
+    // the pixels given, at every size (1x1, odd widths, a row, a column) and level.
+    for (auto [w, h] : {std::pair{1, 1}, {1, 40}, {33, 1}, {37, 23}, {640, 3}}) {
+        for (int colours : {1, 2, 255, 256, 257, 1000}) {
+            SCOPED_TRACE(testing::Message() << w << "x" << h << ", " << colours << " colours");
+            ImageRgb8 image = image_with_colours(w, h, colours, 11);
+            std::set<std::uint32_t> used;
+            for (int y = 0; y < h; ++y)
+                for (int x = 0; x < w; ++x) used.insert(image(x, y)[0] << 16 | image(x, y)[1] << 8 | image(x, y)[2]);
+            for (int level : {1, 12}) expect_round_trip(image, {level}, used.size() <= 256 ? 3 : 2);
+        }
+    }
+}
+
+TEST(Png, NoiseAndLargeFramesRoundTrip) {
+    ImageRgb8 noise(641, 359);
+    std::mt19937 rng(3);
+    for (int y = 0; y < noise.height(); ++y)
+        for (int x = 0; x < noise.width(); ++x)
+            noise(x, y) = {static_cast<std::uint8_t>(rng()), static_cast<std::uint8_t>(rng()),
+                           static_cast<std::uint8_t>(rng())};
+    expect_round_trip(noise, {}, 2);
+    // A 4K frame of toon-like bands, indexed; and with one pixel more than 256 colours, RGB.
+    ImageRgb8 frame = image_with_colours(3840, 2160, 200, 5);
+    expect_round_trip(frame, {}, 3);
+    frame(3839, 2159) = {1, 2, 3};
+    for (int i = 0; i < 60; ++i) frame(i, 2159) = {static_cast<std::uint8_t>(i), 7, 9};
+    expect_round_trip(frame, {}, 2);
 }

@@ -85,8 +85,8 @@ TEST(Filesystem, ReadOnlyOutputDirectory) {
 }
 
 TEST(Filesystem, FullDiskFailsTheFrameAndLeavesNoPartialFile) {
-    // The teapot at 1280x720 is a ~110 KB PNG: it cannot fit a 64 KiB tmpfs.
-    ScratchMount disk("fs_full", "size=64k");
+    // The teapot at 1280x720 (classic lines) is a ~60 KB PNG: it cannot fit a 32 KiB tmpfs.
+    ScratchMount disk("fs_full", "size=32k");
     if (!disk.ok) GTEST_SKIP() << disk.why;
     const fs::path out = disk.path / "frame.png";
     CommandResult r = run_toonray("render " + kTeapot + " -o " + out.string() + " --size 1280x720 --edges classic");
@@ -105,7 +105,7 @@ TEST(Filesystem, FullDiskFailsTheFrameAndLeavesNoPartialFile) {
     EXPECT_EQ(count_with(disk.path, ".tmp"), 0);
     EXPECT_EQ(count_with(disk.path, ".png"), 0);
 
-    // A score written to a full disk: the 64 KiB tmpfs is filled by a large file first.
+    // A score written to a full disk: the 32 KiB tmpfs is filled by a large file first.
     {
         std::ofstream fill(disk.path / "fill", std::ios::binary);
         std::string block(4096, 'x');

@@ -276,7 +276,10 @@ std::vector<std::string> ffmpeg_arguments(const EncodeOptions& o, const FrameSeq
 
     // yuv420p needs even dimensions. Pad (rather than scale, which would blur every line of a
     // toon image) by one pixel, filled by repeating the edge so no dark border appears.
-    std::string filters;
+    // Frames are RGB or, with few colours, indexed PNGs (io/png.cpp); ffmpeg converts a palette
+    // to YUV slightly differently from the same pixels as RGB (1 in 900 samples off by one), so
+    // every frame is made RGB first and the video depends only on the pixels.
+    std::string filters = "format=rgb24,";
     const int pad_w = frames.width % 2, pad_h = frames.height % 2;
     if (pad_w || pad_h)
         filters += fmt::format("pad={}:{}:0:0,fillborders=right={}:bottom={}:mode=smear,",
