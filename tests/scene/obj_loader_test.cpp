@@ -288,3 +288,76 @@ TEST(ObjLoader, PlusSignedFaceIndices) {
     ASSERT_EQ(s.triangle_count(), 1u);
     EXPECT_EQ(s.tri_positions[0], (std::array<std::uint32_t, 3>{0, 1, 2}));
 }
+
+TEST(ObjLoader, CrOnlyLineEndingsAreRead) {
+    // Old Mac files end lines with a lone CR; tinyobjloader reads them, and so do we. Mixed
+    // endings too: each of LF, CRLF and CR ends one line (line 5 is the error's).
+    Scene s = parse("v 0 0 0\rv 1 0 0\r\nv 0 1 0\nf 1 2 3\r");
+    EXPECT_EQ(s.positions.size(), 3u);
+    EXPECT_EQ(s.triangle_count(), 1u);
+    EXPECT_NE(error_of("v 0 0 0\rv 1 0 0\r\nv 0 1 0\n\rf 1 2 4\r").find("test.obj:5: face vertex index 4"),
+              std::string::npos);
+}
+
+TEST(ObjLoader, HashInsideANameIsPartOfTheName) {
+    // '#' starts a comment only at the start of a word: "Mat#1" and "Mat#2" are two materials.
+    fs::path dir = temp_dir("hash");
+    write(dir / "m.mtl", "newmtl Mat#1\nKd 1 0 0\nnewmtl Mat#2 # green\nKd 0 1 0\n");
+    write(dir / "scene.obj", std::string("mtllib m.mtl\n") + kQuad +
+                                 "usemtl Mat#2\nf 1 2 3\nusemtl Mat#1 # the red one\nf 1 3 4\n");
+    Scene s;
+    Warnings w;
+    load_obj(dir / "scene.obj", s, w);
+    EXPECT_TRUE(w.empty()) << w.front();
+    ASSERT_EQ(s.triangle_count(), 2u);
+    EXPECT_EQ(s.materials[s.tri_material[0]].name, "Mat#2");
+    EXPECT_EQ(s.materials[s.tri_material[0]].kd, Vec3f(0, 1, 0));
+    EXPECT_EQ(s.materials[s.tri_material[1]].name, "Mat#1");
+    EXPECT_EQ(s.materials[s.tri_material[1]].kd, Vec3f(1, 0, 0));
+    fs::remove_all(dir);
+}
+
+TEST(ObjLoader, MaterialDefinedAgainKeepsItsFirstDefinition) {
+    // A later library (or a later newmtl in the same one) must not recolour faces already
+    // given the material: the first definition wins, as in tinyobjloader, with a warning.
+    fs::path dir = temp_dir("redefined");
+    write(dir / "a.mtl", "newmtl A\nKd 1 0 0\nnewmtl A\nKd 0 0 0.5\n");
+    write(dir / "b.mtl", "newmtl A\nKd 0 0 1\nnewmtl B\nKd 0 1 0\n");
+    write(dir / "scene.obj", std::string("mtllib a.mtl\n") + kQuad +
+                                 "usemtl A\nf 1 2 3\nmtllib b.mtl\nusemtl A\nf 1 2 3\nusemtl B\nf 1 2 3\n");
+    Scene s;
+    Warnings w;
+    load_obj(dir / "scene.obj", s, w);
+    ASSERT_EQ(s.triangle_count(), 3u);
+    EXPECT_EQ(s.tri_material[0], s.tri_material[1]);
+    EXPECT_EQ(s.materials[s.tri_material[0]].kd, Vec3f(1, 0, 0));
+    EXPECT_EQ(s.materials[s.tri_material[2]].kd, Vec3f(0, 1, 0));
+    ASSERT_EQ(w.size(), 2u);
+    EXPECT_NE(w[0].find("a.mtl:3: material 'A' defined again"), std::string::npos) << w[0];
+    EXPECT_NE(w[1].find("b.mtl:1: material 'A' defined again"), std::string::npos) << w[1];
+    fs::remove_all(dir);
+}
+
+TEST(ObjLoader, LongAndShortNumbersReadTheSameInEveryPosition) {
+    // The fast paths (plain v and f lines) read numbers in one pass without tokens: indices and
+    // numbers of every length, at the end of the text and not, must read as the general path
+    // (from_chars) reads them, including past the fast paths' 15- and 18-digit limits.
+    for (const char* tail : {"", "\n", " \n", "\r\n"}) {
+        for (int digits = 1; digits <= 20; ++digits) {
+            std::string index = std::string(static_cast<std::size_t>(digits - 1), '0') + "1";  // vertex 1
+            std::string text = std::string(kQuad) + "f " + index + " 2 " + index + tail;
+            // Past 18 digits the general path reads it (from_chars), still as 1.
+            Scene s = parse(text);
+            ASSERT_EQ(s.triangle_count(), 1u) << text;
+            EXPECT_EQ(s.tri_positions[0], (std::array<std::uint32_t, 3>{0, 1, 0})) << text;
+            std::string number = "0." + std::string(static_cast<std::size_t>(digits - 1), '3') + "7";
+            float expect;
+            std::from_chars(number.data(), number.data() + number.size(), expect);
+            Scene v = parse("v " + number + " -" + number + " " + number + tail);
+            ASSERT_EQ(v.positions.size(), 1u);
+            EXPECT_EQ(v.positions[0], Vec3f(expect, -expect, expect)) << number;
+        }
+    }
+    EXPECT_NE(error_of(std::string(kQuad) + "f 1 2 12345678x\n").find("malformed face corner '12345678x'"), std::string::npos);
+    EXPECT_NE(error_of("v 1 2 12345678.9x\n").find("malformed number '12345678.9x'"), std::string::npos);
+}

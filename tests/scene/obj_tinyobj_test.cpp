@@ -560,3 +560,33 @@ TEST(ObjTinyobjCrossCheck, UnderflowingNumbersReadAsZero) {
     ASSERT_NO_THROW(ours = flatten(load_ours(text, "tiny.obj")));
     EXPECT_EQ(joined(differences(ours, theirs)), "");
 }
+
+// Three cases where ours used to disagree with rc10, now read as rc10 reads them:
+// - A material defined again (in a later mtllib, or in the same file) keeps its first
+//   definition; ours used to let the later one recolour the faces already given it.
+// - Lines ended by a lone CR (old Mac files); ours used to read such a file as one line.
+// - '#' inside a material name is part of it ("Mat#2"); ours used to cut it as a comment and
+//   so merge "Mat#1" and "Mat#2". (A '#' that begins a word still starts a comment for us, as
+//   in "usemtl red # note", where rc10 keeps "red" too.)
+TEST(ObjTinyobjCrossCheck, RedefinedMaterialsCrOnlyLinesAndHashInNames) {
+    const fs::path dir = temp_dir("fixed");
+    write_text(dir / "a.mtl", "newmtl A\nKd 1 0 0\nnewmtl A\nKd 0 0 0.5\nnewmtl Mat#1\nKd 0.2 0.2 0.2\n");
+    write_text(dir / "b.mtl", "newmtl A\nKd 0 0 1\nnewmtl B\nKd 0 1 0\nnewmtl Mat#2\nKd 0.7 0.7 0.7\n");
+    const std::string body =
+        "mtllib a.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl A\nf 1 2 3\n"
+        "mtllib b.mtl\nusemtl A\nf 1 2 3\nusemtl B\nf 1 2 3\n"
+        "usemtl Mat#2\nf 1 2 3\nusemtl Mat#1\nf 1 2 3\nusemtl B # comment\nf 1 2 3\n";
+    std::string cr_only = body;
+    std::replace(cr_only.begin(), cr_only.end(), '\n', '\r');
+    for (const std::string& text : {body, cr_only}) {
+        std::vector<FlatTri> ours = flatten(load_ours(text, dir / "scene.obj"));
+        std::vector<FlatTri> theirs = flatten(load_tinyobj(text, dir, /*join=*/false));
+        ASSERT_EQ(theirs.size(), 6u);
+        // Not vacuous: the first A (red) on both A faces, and the two '#' names apart.
+        EXPECT_EQ(theirs[1].kd, Vec3f(1, 0, 0));
+        EXPECT_EQ(theirs[3].material, "Mat#2");
+        EXPECT_EQ(theirs[4].material, "Mat#1");
+        EXPECT_EQ(joined(differences(ours, theirs)), "");
+    }
+    fs::remove_all(dir);
+}

@@ -13,8 +13,11 @@
 namespace toonray {
 namespace {
 
-/// Splits text into logical lines: strips CR and comments' nothing (callers see '#'), joins
-/// lines ending in a backslash, and counts physical lines for messages.
+/// Splits text into logical lines: a line ends at LF, CRLF or a lone CR (old Mac files; as
+/// tinyobjloader reads them), lines ending in a backslash are joined, and physical lines are
+/// counted for messages. Comments are left to the callers ('#' starts one).
+/// parse_obj reads its common statements straight from the text (cursor(), consumed_line());
+/// everything else goes through next().
 class LineReader {
 public:
     LineReader(std::string_view text, std::string_view file, std::uint64_t max_line)
@@ -50,6 +53,17 @@ public:
         return true;
     }
 
+    /// The unread text, for a caller that reads a line itself.
+    const char* cursor() const { return text_.data() + pos_; }
+    const char* end() const { return text_.data() + text_.size(); }
+    std::uint64_t max_line() const { return max_line_; }
+    /// Marks one physical line, read by the caller, as consumed; `next_line` is where the next
+    /// one starts. Returns its line number.
+    std::size_t consumed_line(const char* next_line) {
+        pos_ = static_cast<std::size_t>(next_line - text_.data());
+        return ++physical_;
+    }
+
 private:
     static bool ends_with_backslash(std::string_view s) { return !s.empty() && s.back() == '\\'; }
     static bool is_comment(std::string_view s) {
@@ -59,12 +73,13 @@ private:
 
     std::string_view take_physical() {
         const char* begin = text_.data() + pos_;
-        const void* nl = std::memchr(begin, '\n', text_.size() - pos_);
-        std::size_t len = nl ? static_cast<std::size_t>(static_cast<const char*>(nl) - begin)
-                             : text_.size() - pos_;
+        const char* end = text_.data() + text_.size();
+        const char* p = begin;
+        while (p < end && *p != '\n' && *p != '\r') ++p;
+        const std::size_t len = static_cast<std::size_t>(p - begin);
         if (len > max_line_) too_long(physical_, false);
-        pos_ += len + (nl ? 1 : 0);
-        if (len > 0 && begin[len - 1] == '\r') --len;
+        if (p < end && *p++ == '\r' && p < end && *p == '\n') ++p;  // CRLF is one line end
+        pos_ = static_cast<std::size_t>(p - text_.data());
         return {begin, len};
     }
 
@@ -82,6 +97,7 @@ private:
     std::string joined_;
 };
 
+inline bool is_digit(char c) { return static_cast<unsigned char>(c - '0') < 10; }
 inline bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v'; }
 
 /// Cursor over one line's whitespace-separated tokens.
@@ -103,12 +119,15 @@ struct Tokens {
         while (p < end && !is_space(*p)) ++p;
         return {begin, static_cast<std::size_t>(p - begin)};
     }
-    /// The rest of the line, trimmed, with a trailing comment removed.
+    /// The rest of the line, trimmed, with a trailing comment removed. A comment starts at a
+    /// '#' that begins a word: names may contain '#' ("usemtl Mat#2", as Blender writes a
+    /// material of that name; tinyobjloader keeps it too), and cutting there would merge
+    /// "Mat#1" and "Mat#2" into one material.
     std::string_view rest() {
         skip_space();
         const char* e = end;
         for (const char* q = p; q < end; ++q)
-            if (*q == '#') {
+            if (*q == '#' && (q == p || is_space(q[-1]))) {
                 e = q;
                 break;
             }
@@ -122,52 +141,44 @@ struct Tokens {
 /// so m / 10^k rounds once to double; rounding that to float gives the correctly rounded float
 /// of the decimal because double rounding is innocuous for division when 53 >= 2 * 24 + 2
 /// (Figueroa, "When is double rounding innocuous?", 1995). So the result is bit for bit what
-/// from_chars<float> gives. Anything else (exponents, longer numbers) returns false.
-inline bool short_decimal(const char* p, const char* e, float& out) {
+/// from_chars<float> gives. Reads from `p` up to the first character that cannot continue the
+/// number and advances `p` there; the caller checks what follows (a separator, or the end of
+/// the token). Returns false, `p` unspecified, for anything else (exponents, longer numbers).
+inline bool scan_short_decimal(const char*& pos, const char* e, float& out) {
     static constexpr double kPow10[16] = {1e0, 1e1, 1e2,  1e3,  1e4,  1e5,  1e6,  1e7,
                                           1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15};
-    bool negative = false;
-    if (p < e && *p == '-') {
-        negative = true;
-        ++p;
-    }
+    const char* p = pos;  // a local cursor: the compiler keeps it in a register
+    const bool negative = p < e && *p == '-';
+    p += negative;
     std::uint64_t m = 0;
-    int digits = 0, decimals = 0;
-    bool point = false;
-    for (; p < e; ++p) {
-        char c = *p;
-        if (c >= '0' && c <= '9') {
-            m = m * 10 + static_cast<std::uint64_t>(c - '0');
-            if (++digits > 15) return false;
-            decimals += point;
-        } else if (c == '.' && !point) {
-            point = true;
-        } else {
-            return false;
-        }
-    }
-    if (digits == 0) return false;
-    float v = static_cast<float>(static_cast<double>(m) / kPow10[decimals]);
+    std::size_t digits = 0, decimals = 0;  // size_t: a line may be longer than 2^31 bytes
+    for (; p < e && is_digit(*p); ++p, ++digits) m = m * 10 + static_cast<std::uint64_t>(*p - '0');
+    if (p < e && *p == '.')
+        for (++p; p < e && is_digit(*p); ++p, ++decimals) m = m * 10 + static_cast<std::uint64_t>(*p - '0');
+    digits += decimals;
+    // Past 15 digits m may have wrapped, but then the result is not used.
+    if (digits == 0 || digits > 15) return false;
+    const float v = static_cast<float>(static_cast<double>(m) / kPow10[decimals]);
     out = negative ? -v : v;
+    pos = p;
     return true;
 }
 
 /// A face or camera index "[+-]digits" (up to 18 digits); false when malformed.
-inline bool parse_index(const char*& p, const char* e, long long& out) {
+inline bool parse_index(const char*& pos, const char* e, long long& out) {
+    const char* p = pos;  // a local cursor: the compiler keeps it in a register
     bool negative = false;
     if (p < e && (*p == '-' || *p == '+')) {
         negative = *p == '-';
         ++p;
     }
     const char* start = p;
-    long long v = 0;
-    while (p < e && *p >= '0' && *p <= '9') {
-        if (p - start >= 18) return false;
-        v = v * 10 + (*p - '0');
-        ++p;
-    }
-    if (p == start) return false;
-    out = negative ? -v : v;
+    std::uint64_t v = 0;
+    for (; p < e && is_digit(*p); ++p) v = v * 10 + static_cast<std::uint64_t>(*p - '0');
+    // 18 digits always fit a long long; a longer number may have wrapped, and is refused.
+    if (p == start || p - start > 18) return false;
+    pos = p;
+    out = negative ? -static_cast<long long>(v) : static_cast<long long>(v);
     return true;
 }
 
@@ -183,7 +194,8 @@ public:
         const char* b = tok.data();
         const char* e = b + tok.size();
         float v;
-        if (short_decimal(b, e, v)) return v;
+        const char* scanned = b;
+        if (scan_short_decimal(scanned, e, v) && scanned == e) return v;
         if (*b == '+') ++b;
         auto [ptr, ec] = std::from_chars(b, e, v);
         if (ec == std::errc::result_out_of_range && ptr == e) {
@@ -240,6 +252,65 @@ inline bool resolve_index(long long idx, std::size_t count, std::uint32_t& out) 
 struct Corner {
     std::uint32_t v, t, n;
 };
+
+// The fast paths below read the plain forms of the statements that make up nearly all of a
+// file (v, vn, vt, f) in one pass over the text: no line splitting ahead, no tokens, no keyword
+// comparisons. Each returns where the next line starts, or nullptr when the line has any other
+// form (a trailing comment, a continuation, an exponent, an error, ...); it has then changed
+// nothing, and the general path reads the line with its precise messages. So the fast paths
+// decide only how fast a line is read, never what it means.
+
+inline bool is_blank(char c) { return c == ' ' || c == '\t'; }
+
+/// Skips blanks, then expects the end of the line; returns the start of the next line.
+inline const char* after_line_end(const char* p, const char* end) {
+    while (p < end && is_blank(*p)) ++p;
+    if (p == end) return p;
+    if (*p == '\n') return p + 1;
+    if (*p == '\r') return p + 1 + (p + 1 < end && p[1] == '\n');
+    return nullptr;
+}
+
+/// Exactly `count` short decimals (scan_short_decimal), each after blanks, then the line's end.
+inline const char* read_numbers_line(const char* p, const char* end, float* out, int count) {
+    for (int i = 0; i < count; ++i) {
+        if (p == end || !is_blank(*p)) return nullptr;
+        do ++p;
+        while (p < end && is_blank(*p));
+        if (!scan_short_decimal(p, end, out[i])) return nullptr;
+    }
+    return after_line_end(p, end);
+}
+
+/// The corners of a face, each "v", "v/t", "v//n" or "v/t/n" after blanks, resolved against the
+/// vertices defined so far, into `corners`; at least 3.
+inline const char* read_face_line(const char* p, const char* end, const Scene& scene,
+                                  std::vector<Corner>& corners) {
+    corners.clear();
+    for (;;) {
+        const char* before = p;
+        while (p < end && is_blank(*p)) ++p;
+        if (p == end || *p == '\n' || *p == '\r') break;
+        if (p == before) return nullptr;  // corners are separated by blanks
+        long long index;
+        Corner c{0, kNoIndex, kNoIndex};
+        if (!parse_index(p, end, index) || !resolve_index(index, scene.positions.size(), c.v)) return nullptr;
+        if (p < end && *p == '/') {
+            ++p;
+            if (p < end && *p != '/' &&
+                (!parse_index(p, end, index) || !resolve_index(index, scene.texcoords.size(), c.t)))
+                return nullptr;
+            if (p < end && *p == '/') {
+                ++p;
+                if (!parse_index(p, end, index) || !resolve_index(index, scene.normals.size(), c.n))
+                    return nullptr;
+            }
+        }
+        corners.push_back(c);
+    }
+    if (corners.size() < 3) return nullptr;
+    return after_line_end(p, end);
+}
 
 std::uint32_t intern(std::unordered_map<std::string, std::uint32_t>& ids,
                      std::vector<std::string>& names, std::string_view name) {
@@ -348,7 +419,7 @@ private:
 }  // namespace
 
 void parse_mtl(std::string_view text, const std::filesystem::path& path,
-               std::vector<Material>& materials, Warnings& /*warnings*/) {
+               std::vector<Material>& materials, Warnings& warnings) {
     const std::string file = path.string();
     refuse_binary(text, file, "an MTL");
     const Limits& lim = limits();
@@ -356,6 +427,8 @@ void parse_mtl(std::string_view text, const std::filesystem::path& path,
     std::string_view line;
     std::size_t line_number = 0;
     Material* current = nullptr;
+    Material ignored;  // receives the statements of a name defined again
+    WarningSink warn(warnings, file);
     std::unordered_map<std::string, std::size_t> index;
     for (std::size_t i = 0; i < materials.size(); ++i) index[materials[i].name] = i;
     MemoryCheck memory;
@@ -369,10 +442,13 @@ void parse_mtl(std::string_view text, const std::filesystem::path& path,
             std::string_view name = t.rest();
             if (name.empty()) parse.fail("'newmtl' needs a material name");
             std::string key(name);
-            auto it = index.find(key);
-            if (it != index.end()) {
-                materials[it->second] = Material{key};
-                current = &materials[it->second];
+            if (index.contains(key)) {
+                // The first definition wins, in this file or an earlier library, as in
+                // tinyobjloader: replacing it would recolour the faces already given it.
+                warn.add(located(file, line_number,
+                                 fmt::format("material '{}' defined again; the first definition is kept", key)));
+                ignored = Material{key};
+                current = &ignored;
             } else {
                 check_count(parse, materials.size() + 1, kMaxIndexable, "materials", "");
                 if (memory.due(materials.size()))
@@ -521,15 +597,80 @@ void parse_obj(std::string_view text, const std::filesystem::path& path, Scene& 
             check_estimate(parse);
     };
 
-    while (reader.next(line, line_number)) {
+    // What both paths do before adding an element (so a limit names the line that exceeds it),
+    // and the face's triangles from `corners`.
+    auto adding_position = [&](const Parser& parse) {
+        check_count(parse, scene.positions.size() + 1, max_vertices, "vertices ('v')", "--max-vertices");
+        grew(parse);
+    };
+    auto adding_normal = [&](const Parser& parse) {
+        check_count(parse, scene.normals.size() + 1, max_vertices, "normals ('vn')", "--max-vertices");
+        grew(parse);
+    };
+    auto adding_texcoord = [&](const Parser& parse) {
+        check_count(parse, scene.texcoords.size() + 1, max_vertices, "texture coordinates ('vt')",
+                    "--max-vertices");
+        grew(parse);
+    };
+    auto add_face = [&](const Parser& parse) {
+        if (scene.triangle_count() + (corners.size() - 2) > max_triangles)
+            parse.fail(fmt::format("more than {} triangles (the limit; --max-triangles raises it)",
+                                   max_triangles));
+        grew(parse);
+        for (std::size_t i = 1; i + 1 < corners.size(); ++i) {
+            const Corner& a = corners[0];
+            const Corner& b = corners[i];
+            const Corner& c = corners[i + 1];
+            scene.add_triangle({a.v, b.v, c.v}, material, object, {a.n, b.n, c.n}, {a.t, b.t, c.t});
+        }
+    };
+
+    for (;;) {
+        // The common statements in their plain form, straight from the text (see
+        // read_numbers_line). A line longer than the limit goes the general way, which reports it.
+        const char* begin = reader.cursor();
+        const char* end = reader.end();
+        if (end - begin >= 2 && (begin[0] == 'v' || begin[0] == 'f')) {
+            auto within_limit = [&](const char* next) {
+                return next && static_cast<std::uint64_t>(next - begin) <= reader.max_line();
+            };
+            float f[3];
+            const char* next;
+            if (begin[0] == 'f') {
+                if (is_blank(begin[1]) && within_limit(next = read_face_line(begin + 1, end, scene, corners))) {
+                    add_face(Parser(file, reader.consumed_line(next)));
+                    continue;
+                }
+            } else if (is_blank(begin[1])) {
+                if (within_limit(next = read_numbers_line(begin + 1, end, f, 3))) {
+                    adding_position(Parser(file, reader.consumed_line(next)));
+                    scene.positions.push_back({f[0], f[1], f[2]});
+                    continue;
+                }
+            } else if (begin[1] == 'n' && end - begin >= 3 && is_blank(begin[2])) {
+                if (within_limit(next = read_numbers_line(begin + 2, end, f, 3))) {
+                    adding_normal(Parser(file, reader.consumed_line(next)));
+                    scene.normals.push_back({f[0], f[1], f[2]});
+                    continue;
+                }
+            } else if (begin[1] == 't' && end - begin >= 3 && is_blank(begin[2])) {
+                if (within_limit(next = read_numbers_line(begin + 2, end, f, 2))) {
+                    adding_texcoord(Parser(file, reader.consumed_line(next)));
+                    scene.texcoords.push_back({f[0], f[1]});
+                    continue;
+                }
+            }
+        }
+
+        // Everything else: the general path.
+        if (!reader.next(line, line_number)) break;
         Tokens t(line);
         if (t.at_end()) continue;
         std::string_view kw = t.next();
         Parser parse(file, line_number);
 
         if (kw == "v") {
-            check_count(parse, scene.positions.size() + 1, max_vertices, "vertices ('v')", "--max-vertices");
-            grew(parse);
+            adding_position(parse);
             scene.positions.push_back(parse.vec3(t, kw));
             // Optional w (or vertex colour) values are accepted and ignored, but must be numbers.
             while (!t.at_end()) parse.number(t, kw);
@@ -585,24 +726,12 @@ void parse_obj(std::string_view text, const std::filesystem::path& path, Scene& 
             }
             if (corners.size() < 3)
                 parse.fail(fmt::format("face needs at least 3 corners, has {}", corners.size()));
-            if (scene.triangle_count() + (corners.size() - 2) > max_triangles)
-                parse.fail(fmt::format("more than {} triangles (the limit; --max-triangles raises it)",
-                                       max_triangles));
-            grew(parse);
-            for (std::size_t i = 1; i + 1 < corners.size(); ++i) {
-                const Corner& a = corners[0];
-                const Corner& b = corners[i];
-                const Corner& c = corners[i + 1];
-                scene.add_triangle({a.v, b.v, c.v}, material, object, {a.n, b.n, c.n}, {a.t, b.t, c.t});
-            }
+            add_face(parse);
         } else if (kw == "vn") {
-            check_count(parse, scene.normals.size() + 1, max_vertices, "normals ('vn')", "--max-vertices");
-            grew(parse);
+            adding_normal(parse);
             scene.normals.push_back(parse.vec3(t, kw));
         } else if (kw == "vt") {
-            check_count(parse, scene.texcoords.size() + 1, max_vertices, "texture coordinates ('vt')",
-                        "--max-vertices");
-            grew(parse);
+            adding_texcoord(parse);
             Vec2f uv;
             uv.x = parse.number(t, kw);
             if (!t.at_end()) uv.y = parse.number(t, kw);

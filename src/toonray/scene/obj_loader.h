@@ -4,7 +4,7 @@
 /// Reads: v (optional w or colour values ignored), vt, vn, f with 3 or more corners in all four
 /// index forms (v, v/vt, v//vn, v/vt/vn), negative (relative) indices, o, g, usemtl, mtllib
 /// (several files, paths relative to the OBJ), s (accepted, ignored: normals come from vn),
-/// comments, `\` line continuations, CRLF line endings, a UTF-8 byte-order mark, and the
+/// comments, `\` line continuations, LF, CRLF and CR line endings, a UTF-8 byte-order mark, and the
 /// camera block statement `c eye gaze up`. Polygons are triangulated as a fan from their first
 /// corner, which is exact for convex polygons. Faces index only vertices defined before them.
 /// An object is the run of faces after an `o` or `g` statement, named by it.
@@ -38,7 +38,8 @@ void load_obj(const std::filesystem::path& path, Scene& scene, Warnings& warning
 void parse_obj(std::string_view text, const std::filesystem::path& path, Scene& scene,
                Warnings& warnings, const ObjOptions& options = {});
 
-/// Parses MTL text, appending its materials (a name defined again replaces the earlier one).
+/// Parses MTL text, appending its materials. A name already in `materials` (defined earlier in
+/// this text or in an earlier library) keeps its first definition, with a warning.
 void parse_mtl(std::string_view text, const std::filesystem::path& path,
                std::vector<Material>& materials, Warnings& warnings);
 
