@@ -7,10 +7,12 @@
 #include <cstdio>
 #include <cstdlib>
 #include <functional>
+#include <limits>
 #include <set>
 #include <vector>
 
 #include "toonray/core/error.h"
+#include "toonray/render/classic.h"
 #include "toonray/render/renderer.h"
 
 using namespace toonray;
@@ -431,4 +433,266 @@ TEST(RobustLines, DistanceTransformIsExact) {
     Image<std::uint8_t> none(4, 4, 0);
     distance_to_seeds(none, d, 1);
     EXPECT_TRUE(std::isinf(d(2, 2)));
+}
+
+// ---- The fast row-wise stages against straightforward references ----------------------------
+
+namespace {
+
+// find_line_seeds as it was first written, pixel by pixel: the reference the row-wise,
+// vectorised version must match bit for bit.
+Image<std::uint8_t> reference_seeds(const FineBuffers& fine, const RobustLineSettings& s) {
+    const float inf = std::numeric_limits<float>::infinity();
+    const int w = fine.depth.width(), h = fine.depth.height();
+    Image<std::uint8_t> seeds(w, h, 0);
+    const float cos_crease = std::cos(s.crease_angle * 3.14159265f / 180.0f);
+    auto pair_bits = [&](int ax, int ay, int bx, int by) -> unsigned {
+        float za = fine.depth(ax, ay), zb = fine.depth(bx, by);
+        bool hit_a = za != inf, hit_b = zb != inf;
+        if (!hit_a && !hit_b) return 0;
+        if (hit_a != hit_b) return s.types & kLineSilhouette;
+        unsigned bits = 0;
+        if ((s.types & kLineObject) && fine.object(ax, ay) != fine.object(bx, by)) bits |= kLineObject;
+        if ((s.types & kLineMaterial) && fine.material(ax, ay) != fine.material(bx, by)) bits |= kLineMaterial;
+        if ((s.types & kLineCrease) && dot(fine.geometric_normal(ax, ay), fine.geometric_normal(bx, by)) < cos_crease)
+            bits |= kLineCrease;
+        return bits;
+    };
+    auto depth_bits = [&](int x, int y) -> unsigned {
+        float z = fine.depth(x, y);
+        if (z == inf) return 0;
+        const float inv = 1.0f / z;
+        float farthest_step = -1.0f;
+        auto along = [&](int x0, int y0, int x1, int y1) {
+            float z0 = fine.depth(x0, y0), z1 = fine.depth(x1, y1);
+            if (z0 == inf || z1 == inf) return;
+            float i0 = 1.0f / z0, i1 = 1.0f / z1;
+            if (!(std::abs(i0 - 2.0f * inv + i1) > s.depth_threshold * inv)) return;
+            bool first = std::abs(i0 - inv) > std::abs(i1 - inv);
+            float z_across = first ? z0 : z1;
+            if (z_across > z) farthest_step = std::max(farthest_step, (z_across - z) / z);
+        };
+        if (x > 0 && x + 1 < w) along(x - 1, y, x + 1, y);
+        if (y > 0 && y + 1 < h) along(x, y - 1, x, y + 1);
+        if (farthest_step < 0.0f) return 0;
+        return s.types & (farthest_step > s.silhouette_ratio ? kLineSilhouette : kLineDepth);
+    };
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            unsigned bits = 0;
+            const int nx[4] = {x - 1, x + 1, x, x};
+            const int ny[4] = {y, y, y - 1, y + 1};
+            for (int i = 0; i < 4; ++i) {
+                if (nx[i] < 0 || nx[i] >= w || ny[i] < 0 || ny[i] >= h) continue;
+                unsigned b = pair_bits(x, y, nx[i], ny[i]);
+                if (!b) continue;
+                float z_self = fine.depth(x, y), z_other = fine.depth(nx[i], ny[i]);
+                bool tie = std::abs(z_self - z_other) <= 1e-5f * std::min(z_self, z_other);
+                bool first_in_scan = ny[i] > y || (ny[i] == y && nx[i] > x);
+                if (tie ? first_in_scan : z_self < z_other) bits |= b;
+            }
+            seeds(x, y) = static_cast<std::uint8_t>(bits | depth_bits(x, y));
+        }
+    return seeds;
+}
+
+// A random fine G-buffer with every case the line tests tell apart: background, ties and
+// near-ties in depth, sloped planes (1/z affine), small and large steps, few ids, normals
+// from a small set (some pairs across the crease angle).
+struct RandomGBuffer {
+    RandomGBuffer(int w, int h, unsigned seed)
+        : depth(w, h), normal(w, h), object(w, h), material(w, h) {
+        std::srand(seed);
+        auto unit = [] { return static_cast<float>(std::rand()) / static_cast<float>(RAND_MAX); };
+        const Vec3f normals[4] = {normalize(Vec3f(0, 0, 1)), normalize(Vec3f(0.2f, 0, 1)), normalize(Vec3f(1, 0, 1)),
+                                  normalize(Vec3f(0, 1, 0.3f))};
+        const float a = 0.3f + unit(), b = unit() * 0.01f, c = unit() * 0.01f;
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x) {
+                float r = unit();
+                float plane = 1.0f / (a + b * x + c * y);  // 1/z affine: no depth lines inside
+                float z = r < 0.1f ? std::numeric_limits<float>::infinity()
+                        : r < 0.5f ? plane
+                        : r < 0.6f ? plane * (1.0f + 4e-6f)  // a tie with the plane
+                        : r < 0.75f ? plane * 1.05f           // a small step (depth line)
+                        : r < 0.9f ? plane * 1.5f             // a large step (silhouette)
+                                   : 0.5f + 10.0f * unit();
+                depth(x, y) = z;
+                bool hit = z != std::numeric_limits<float>::infinity();
+                normal(x, y) = hit ? normals[std::rand() % 4] : Vec3f(0.0f);
+                object(x, y) = hit ? static_cast<std::uint32_t>(std::rand() % 3) : kNoIndex;
+                material(x, y) = hit ? static_cast<std::uint32_t>(std::rand() % 3) : kNoIndex;
+            }
+    }
+    [[nodiscard]] FineBuffers fine() const { return {depth, normal, object, material}; }
+    ImageF depth;
+    Image<Vec3f> normal;
+    Image<std::uint32_t> object, material;
+};
+
+Image<std::uint8_t> random_seeds(int w, int h, float density, unsigned seed) {
+    std::srand(seed);
+    Image<std::uint8_t> seeds(w, h, 0);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x)
+            if (static_cast<float>(std::rand()) / static_cast<float>(RAND_MAX) < density)
+                seeds(x, y) = static_cast<std::uint8_t>(1u << (std::rand() % 5));
+    return seeds;
+}
+
+// resolve_lines as it was first written, pixel by pixel, with to_byte.
+void reference_resolve(const Image<Vec3f>& fine_colour, const ImageF& squared_distance, float thickness, int sub,
+                       const Vec3f& line_colour, ImageRgb8& final_image, ImageRgb8& cel, ImageGray8& lines) {
+    const int w = fine_colour.width() / sub, h = fine_colour.height() / sub;
+    final_image.resize(w, h);
+    cel.resize(w, h);
+    lines.resize(w, h);
+    const float reach = thickness > 0.0f ? thickness * 0.5f + 0.5f : 0.0f;
+    const float reach2 = reach * reach;
+    const float inv_n = 1.0f / static_cast<float>(sub * sub);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            Vec3f sum(0.0f);
+            float covered = 0.0f;
+            for (int j = 0; j < sub; ++j)
+                for (int i = 0; i < sub; ++i) {
+                    int fx = x * sub + i, fy = y * sub + j;
+                    sum += fine_colour(fx, fy);
+                    float d2 = squared_distance(fx, fy);
+                    if (d2 < reach2) covered += std::min(1.0f, reach - std::sqrt(d2));
+                }
+            Vec3f colour = sum * inv_n;
+            float a = covered * inv_n;
+            Vec3f out = colour * (1.0f - a) + line_colour * a;
+            final_image(x, y) = {to_byte(out.x), to_byte(out.y), to_byte(out.z)};
+            cel(x, y) = {to_byte(colour.x), to_byte(colour.y), to_byte(colour.z)};
+            lines(x, y) = to_byte(1.0f - a);
+        }
+}
+
+// Exact squared distance to the nearest seed by looking at all of them; +inf for none.
+float brute_force_squared_distance(const Image<std::uint8_t>& seeds, int x, int y) {
+    float best = std::numeric_limits<float>::infinity();
+    for (int sy = 0; sy < seeds.height(); ++sy)
+        for (int sx = 0; sx < seeds.width(); ++sx)
+            if (seeds(sx, sy)) best = std::min(best, static_cast<float>((sx - x) * (sx - x) + (sy - y) * (sy - y)));
+    return best;
+}
+
+}  // namespace
+
+TEST(RobustLines, SeedsMatchThePerPixelReference) {
+    const int sizes[][2] = {{1, 1}, {1, 9}, {9, 1}, {2, 2}, {37, 23}, {64, 70}};
+    unsigned seed = 1;
+    int lines_found = 0;
+    for (const auto& size : sizes)
+        for (unsigned types : {unsigned(kLineAll), unsigned(kLineSilhouette | kLineDepth), unsigned(kLineCrease), 0u})
+            for (int threads : {1, 2, 3}) {
+                RandomGBuffer g(size[0], size[1], ++seed);
+                RobustLineSettings settings;
+                settings.types = types;
+                Image<std::uint8_t> expected = reference_seeds(g.fine(), settings), seeds;
+                find_line_seeds(g.fine(), settings, seeds, threads);
+                ASSERT_EQ(seeds.width(), size[0]);
+                ASSERT_EQ(seeds.height(), size[1]);
+                for (int y = 0; y < size[1]; ++y)
+                    for (int x = 0; x < size[0]; ++x) {
+                        ASSERT_EQ(seeds(x, y), expected(x, y))
+                            << x << "," << y << " in " << size[0] << "x" << size[1] << ", types " << types;
+                        lines_found += seeds(x, y) != 0;
+                    }
+            }
+    EXPECT_GT(lines_found, 1000);  // the random images do exercise the tests
+}
+
+TEST(RobustLines, DistanceTransformMatchesBruteForce) {
+    for (float density : {0.0f, 0.002f, 0.05f, 0.5f})
+        for (int threads : {1, 2}) {
+            Image<std::uint8_t> seeds = random_seeds(41, 29, density, 7 + threads);
+            ImageF d;
+            distance_to_seeds(seeds, d, threads);
+            for (int y = 0; y < seeds.height(); ++y)
+                for (int x = 0; x < seeds.width(); ++x)
+                    ASSERT_EQ(d(x, y), brute_force_squared_distance(seeds, x, y)) << x << "," << y;
+        }
+}
+
+TEST(RobustLines, BandedDistanceIsTheExactOneClamped) {
+    unsigned seed = 100;
+    for (float density : {0.0f, 0.001f, 0.01f, 0.1f, 0.6f})
+        for (int band : {0, 1, 2, 3, 5, 9, kMaxDistanceBand})
+            for (int threads : {1, 2}) {
+                Image<std::uint8_t> seeds = random_seeds(150, 90, density, ++seed);
+                ImageF exact;
+                Image<std::uint16_t> banded;
+                distance_to_seeds(seeds, exact, 1);
+                distance_to_seeds_banded(seeds, band, banded, threads);
+                const float clamp = static_cast<float>((band + 1) * (band + 1));
+                for (int y = 0; y < seeds.height(); ++y)
+                    for (int x = 0; x < seeds.width(); ++x)
+                        ASSERT_EQ(static_cast<float>(banded(x, y)), std::min(exact(x, y), clamp))
+                            << x << "," << y << " band " << band << " density " << density;
+            }
+    Image<std::uint8_t> seeds(4, 4, 0);
+    Image<std::uint16_t> banded;
+    EXPECT_THROW(distance_to_seeds_banded(seeds, -1, banded, 1), Error);
+    EXPECT_THROW(distance_to_seeds_banded(seeds, kMaxDistanceBand + 1, banded, 1), Error);
+}
+
+TEST(RobustLines, ResolvingMatchesThePerPixelReference) {
+    unsigned seed = 500;
+    // Thicknesses from none through the usual to wider than kMaxDistanceBand (the fallback).
+    for (float thickness : {0.0f, 0.5f, 1.0f, 2.0f, 4.0f, 7.3f, 8.0f, 300.0f})
+        for (int sub = 1; sub <= 4; ++sub)
+            for (int threads : {1, 2}) {
+                const int w = 23, h = 17;
+                Image<std::uint8_t> seeds = random_seeds(w * sub, h * sub, 0.01f, ++seed);
+                // Colours partly outside [0, 1] (as with specular highlights), to test the clamp.
+                Image<Vec3f> colour(w * sub, h * sub);
+                for (std::size_t i = 0; i < colour.size(); ++i)
+                    colour.data()[i] = Vec3f(static_cast<float>(std::rand() % 1000) / 997.0f,
+                                             static_cast<float>(std::rand() % 2000) / 991.0f - 0.5f, 0.25f);
+                const Vec3f line_colour(0.1f, 0.2f, 0.05f);
+                ImageF distance;
+                ImageRgb8 final_ref, cel_ref, final_a, cel_a, final_b, cel_b;
+                ImageGray8 lines_ref, lines_a, lines_b;
+                distance_to_seeds(seeds, distance, 1);
+                reference_resolve(colour, distance, thickness, sub, line_colour, final_ref, cel_ref, lines_ref);
+                resolve_lines(colour, distance, thickness, sub, line_colour, final_a, cel_a, lines_a, threads);
+                resolve_lines_from_seeds(colour, seeds, thickness, sub, line_colour, final_b, cel_b, lines_b, threads);
+                for (const ImageRgb8* image : {&final_a, &cel_a, &final_b, &cel_b}) {
+                    ASSERT_EQ(image->width(), w);
+                    ASSERT_EQ(image->height(), h);
+                }
+                for (int y = 0; y < h; ++y)
+                    for (int x = 0; x < w; ++x) {
+                        ASSERT_EQ(final_a(x, y), final_ref(x, y)) << x << "," << y << " thickness " << thickness;
+                        ASSERT_EQ(cel_a(x, y), cel_ref(x, y));
+                        ASSERT_EQ(lines_a(x, y), lines_ref(x, y)) << x << "," << y << " thickness " << thickness;
+                        ASSERT_EQ(final_b(x, y), final_ref(x, y)) << x << "," << y << " thickness " << thickness;
+                        ASSERT_EQ(cel_b(x, y), cel_ref(x, y));
+                        ASSERT_EQ(lines_b(x, y), lines_ref(x, y)) << x << "," << y << " thickness " << thickness;
+                    }
+            }
+}
+
+TEST(RobustLines, SeedTypeImagesCountSamples) {
+    for (int sub = 1; sub <= 4; ++sub)
+        for (int threads : {1, 2}) {
+            const int w = 19, h = 11;
+            Image<std::uint8_t> seeds = random_seeds(w * sub, h * sub, 0.3f, 900 + sub);
+            for (unsigned type : {unsigned(kLineSilhouette), unsigned(kLineCrease), unsigned(kLineMaterial)}) {
+                ImageGray8 out;
+                resolve_seed_type(seeds, type, sub, out, threads);
+                for (int y = 0; y < h; ++y)
+                    for (int x = 0; x < w; ++x) {
+                        int n = 0;
+                        for (int j = 0; j < sub; ++j)
+                            for (int i = 0; i < sub; ++i) n += (seeds(x * sub + i, y * sub + j) & type) != 0;
+                        const float inv_n = 1.0f / static_cast<float>(sub * sub);
+                        ASSERT_EQ(out(x, y), to_byte(1.0f - static_cast<float>(n) * inv_n))
+                            << x << "," << y << " sub " << sub;
+                    }
+            }
+        }
 }

@@ -55,6 +55,17 @@ void find_line_seeds(const FineBuffers& fine, const RobustLineSettings& settings
 /// (Felzenszwalb and Huttenlocher's linear-time transform, exact). +inf where there is none.
 void distance_to_seeds(const Image<std::uint8_t>& seeds, ImageF& squared_distance, int threads);
 
+/// The widest band distance_to_seeds_banded accepts. Its cost grows with the band (a window of
+/// 2 * band + 1 columns), so beyond this the linear-time full transform is the faster one.
+inline constexpr int kMaxDistanceBand = 64;
+
+/// min(d^2, (band + 1)^2), d the Euclidean distance (in fine pixels) to the nearest non-zero
+/// seed: the exact d^2 wherever d < band + 1, else (band + 1)^2 (also where there is no seed).
+/// Looks only band pixels around each pixel, so it costs O(band) per pixel. Throws Error for a
+/// band outside [0, kMaxDistanceBand].
+void distance_to_seeds_banded(const Image<std::uint8_t>& seeds, int band, Image<std::uint16_t>& squared_distance,
+                              int threads);
+
 /// Line thickness in fine pixels for `width` (pixels at 720 lines), an image `height` pixels
 /// tall and `sub` x `sub` samples per pixel: width * height / 720 * sub.
 float line_thickness(float width, int height, int sub);
@@ -68,6 +79,13 @@ float line_thickness(float width, int height, int sub);
 void resolve_lines(const Image<Vec3f>& fine_colour, const ImageF& squared_distance, float thickness, int sub,
                    const Vec3f& line_colour, ImageRgb8& final_image, ImageRgb8& cel, ImageGray8& lines,
                    int threads);
+
+/// Exactly distance_to_seeds followed by resolve_lines (the same bytes), without the full-size
+/// distance image: strips of rows get their distances from distance_to_seeds_banded's method,
+/// over the few pixels a line can reach (see robust.cpp for why that is exact).
+void resolve_lines_from_seeds(const Image<Vec3f>& fine_colour, const Image<std::uint8_t>& seeds, float thickness,
+                              int sub, const Vec3f& line_colour, ImageRgb8& final_image, ImageRgb8& cel,
+                              ImageGray8& lines, int threads);
 
 /// One line type's seeds filtered down to pixels (255 = none, 0 = a seed in every sample), for AOVs.
 void resolve_seed_type(const Image<std::uint8_t>& seeds, unsigned type, int sub, ImageGray8& out, int threads);
