@@ -17,6 +17,7 @@
 
 #include <fmt/format.h>
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cfloat>
 #include <chrono>
@@ -142,65 +143,40 @@ void for_each_pixel(int w, int h, int threads, const Body& body) {
     });
 }
 
-// A copy of the renderer's per-hit work in classic mode with default settings (the shading
-// normal, one point light, the seed's 16-step cel band, the G-buffer writes), written out so
-// shading can be timed on stored hits, apart from traversal. It is checked bit-equal against
-// the renderer's G-buffer before it is timed; when the renderer's shading changes, that check
-// fails and this copy must follow (or call the renderer's own functions once they are public).
-Vec3f copied_shading_normal(const Scene& scene, const Hit& hit, const Vec3f& dir) {
-    const auto& tri = scene.tri_positions[hit.prim];
-    const auto& tn = scene.tri_normals[hit.prim];
-    Vec3f n;
-    bool interpolated = false;
-    if (tn[0] != kNoIndex && tn[1] != kNoIndex && tn[2] != kNoIndex) {
-        float w0 = 1.0f - hit.u - hit.v;
-        n = scene.normals[tn[0]] * w0 + scene.normals[tn[1]] * hit.u + scene.normals[tn[2]] * hit.v;
-        float len = length(n);
-        if (len > 0.0f && std::isfinite(len)) {
-            n = n / len;
-            interpolated = true;
-        }
-    }
-    if (!interpolated) {
-        const Vec3f& p0 = scene.positions[tri[0]];
-        n = cross(scene.positions[tri[1]] - p0, scene.positions[tri[2]] - p0);
-        float len = length(n);
-        n = len > 0.0f ? n / len : -normalize(dir);
-    }
-    return dot(n, dir) > 0.0f ? -n : n;
-}
-
-void shade(const Scene& scene, const ViewPlane& view, const Vec3f& light,
-           const RenderSettings& settings, const std::vector<Hit>& hits, GBuffer& g, int threads) {
+// The renderer's per-sample shading stage (shade_tile: shading normal, light, cel band,
+// G-buffer writes) on stored rays and hits, so shading is timed apart from traversal. They are
+// handed over in the renderer's 16 x 16 tiles, as trace_primary does; the G-buffer must come out
+// bit-equal to Renderer's, which is checked before anything is timed.
+void shade(const Scene& scene, const TriangleAccel& accel, const ViewPlane& view, const Vec3f& light,
+           const RenderSettings& settings, const std::vector<Vec3f>& ray_dirs, const std::vector<Hit>& hits,
+           GBuffer& g, int threads) {
     const int w = settings.width, h = settings.height;
-    const float inf = std::numeric_limits<float>::infinity();
-    g.distance.resize(w, h, inf);
-    g.normal.resize(w, h);
-    g.colour.resize(w, h);
-    g.material.resize(w, h, kNoIndex);
-    g.object.resize(w, h, kNoIndex);
-    for_each_pixel(w, h, threads, [&](int x, int y) {
-        const Hit& hit = hits[static_cast<std::size_t>(y) * w + x];
-        if (!hit.valid()) {
-            g.distance(x, y) = inf;
-            g.normal(x, y) = Vec3f(0.0f);
-            g.colour(x, y) = settings.background;
-            g.material(x, y) = kNoIndex;
-            g.object(x, y) = kNoIndex;
-            return;
+    const std::vector<Light> lights{Light{Light::Kind::Point, light, 1.0f}};  // as Renderer::render
+    const ShadingContext ctx{scene, accel, settings.shading, lights, nullptr};
+    prepare_gbuffer(g, w, h, 1, settings.edges);
+    const int tiles_x = (w + kTile - 1) / kTile, tiles_y = (h + kTile - 1) / kTile;
+    parallel_for(tiles_x * tiles_y, 1, threads, [&](int begin, int end) {
+        std::array<Vec3f, kTile * kTile> dirs;
+        std::array<Hit, kTile * kTile> tile_hits;
+        std::array<bool, kTile * kTile> found;
+        for (int tile = begin; tile < end; ++tile) {
+            SampleTile t{};
+            t.x0 = (tile % tiles_x) * kTile;
+            t.y0 = (tile / tiles_x) * kTile;
+            t.x1 = std::min(t.x0 + kTile, w);
+            t.y1 = std::min(t.y0 + kTile, h);
+            int i = 0;
+            for (int y = t.y0; y < t.y1; ++y)
+                for (int x = t.x0; x < t.x1; ++x, ++i) {
+                    dirs[i] = ray_dirs[static_cast<std::size_t>(y) * w + x];
+                    tile_hits[i] = hits[static_cast<std::size_t>(y) * w + x];
+                    found[i] = tile_hits[i].valid();
+                }
+            t.dirs = dirs.data();
+            t.hits = tile_hits.data();
+            t.found = found.data();
+            shade_tile(ctx, view, settings, t, g);
         }
-        Vec3f dir = primary_ray(view, x, y).dir;
-        Vec3f n = copied_shading_normal(scene, hit, dir);
-        Vec3f p = view.eye + dir * hit.t;
-        Vec3f to_light = light - p;
-        float len = length(to_light);
-        float l_dot_n = len > 0.0f ? dot(to_light, n) / len : 1.0f;
-        std::uint32_t m = scene.tri_material[hit.prim];
-        g.distance(x, y) = hit.t;
-        g.normal(x, y) = n;
-        g.colour(x, y) = scene.materials[m].kd * classic_cel_level(l_dot_n);
-        g.material(x, y) = m;
-        g.object(x, y) = scene.tri_object[hit.prim];
     });
 }
 
@@ -521,14 +497,17 @@ SceneResult bench_scene(const fs::path& path, const Options& opt) {
         rep += "- hits: Embree check skipped (built without Embree)\n";
     }
 
-    // 3. The bench's shading copy against the renderer, for both thread counts.
+    // 3. The shading stage on stored hits against the renderer, for both thread counts.
     RenderSettings settings = fro.settings;
     std::vector<Hit> hits(static_cast<std::size_t>(w) * h);
+    std::vector<Vec3f> dirs(hits.size());  // kept for the shading stage, as trace_primary hands them on
     auto trace = [&](int threads) {
         for_each_pixel(w, h, threads, [&](int x, int y) {
             Hit hit;
-            accel.intersect(primary_ray(view, x, y), hit);
+            const Ray ray = primary_ray(view, x, y);
+            accel.intersect(ray, hit);
             hits[static_cast<std::size_t>(y) * w + x] = hit;
+            dirs[static_cast<std::size_t>(y) * w + x] = ray.dir;
         });
     };
     Renderer renderer;
@@ -539,18 +518,18 @@ SceneResult bench_scene(const fs::path& path, const Options& opt) {
         settings.threads = threads;
         renderer.render(scene, accel, camera, settings);
         trace(threads);
-        shade(scene, view, light, settings, hits, g, threads);
+        shade(scene, accel, view, light, settings, dirs, hits, g, threads);
         const GBuffer& r = renderer.gbuffer();
         shade_ok = shade_ok && same_bytes(g.distance, r.distance) &&
                    same_bytes(g.normal, r.normal) && same_bytes(g.colour, r.colour) &&
                    same_bytes(g.material, r.material) && same_bytes(g.object, r.object);
     }
     if (shade_ok)
-        rep += "- shade: the bench's shading copy is bit-equal to the renderer's G-buffer\n";
+        rep += "- shade: shade_tile on stored hits is bit-equal to the renderer's G-buffer\n";
     else
         fail(
-            "the bench's shading copy differs from Renderer's G-buffer: the renderer's shading "
-            "changed; update shade() in bench/bench_main.cpp");
+            "shading stored hits through shade_tile differs from Renderer's G-buffer: the bench's "
+            "rays or tiles no longer match trace_primary's; update shade() in bench/bench_main.cpp");
     if (opt.quick || !result.correct) return result;
 
     // 4. Timings.
@@ -607,8 +586,8 @@ SceneResult bench_scene(const fs::path& path, const Options& opt) {
     }
 
     auto [shade1, shadeN] = time_pair(
-        R, [&] { shade(scene, view, light, settings, hits, g, 1); },
-        [&] { shade(scene, view, light, settings, hits, g, 0); });
+        R, [&] { shade(scene, accel, view, light, settings, dirs, hits, g, 1); },
+        [&] { shade(scene, accel, view, light, settings, dirs, hits, g, 0); });
     rows.push_back(
         {"shade (normal, cel band, G-buffer)", shade1, shadeN, "per pixel, after trace"});
 
@@ -624,7 +603,7 @@ SceneResult bench_scene(const fs::path& path, const Options& opt) {
     };
     auto blur = [&](int t) {
         merge_edges(a.edges_depth, a.edges_normal, a.edges);
-        compose_lines(g.colour, a.edges, composed, t);
+        compose_lines(g.colour, a.edges, composed, t, &a.cel);  // with the cel AOV, as the renderer does
     };
     auto edges = [&](int t) {
         maps(t);

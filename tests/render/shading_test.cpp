@@ -169,7 +169,9 @@ TEST(Shading, RimBandBrightensGrazingSurfaces) {
     const Image<Vec3f>& plain = colours(r, s, settings, cam);
     for (int y = 0; y < 64; ++y)
         for (int x = 0; x < 64; ++x)
-            if (r.gbuffer().material(x, y) != kNoIndex) EXPECT_LE(plain(x, y).x, 0.5f);
+            if (r.gbuffer().material(x, y) != kNoIndex) {
+                EXPECT_LE(plain(x, y).x, 0.5f);
+            }
 }
 
 TEST(Shading, TexturesMultiplyKdAndBadOnesWarn) {
@@ -214,4 +216,32 @@ TEST(Shading, TexturesMultiplyKdAndBadOnesWarn) {
         EXPECT_FLOAT_EQ(plain(10, 10).x, 0.4f);
     }
     fs::remove_all(dir);
+}
+
+TEST(Shading, PlainPathEqualsTheGeneralOne) {
+    // shade_hit takes a short path for one point light without shadows, specular, rim or
+    // texture. Shadows on an open square (nothing can block the light) and a second, zero
+    // intensity light both force the general path, which must give bit-identical colours.
+    Scene s = square(10.0f, Vec3f(0.8f, 0.6f, 0.3f));
+    RenderSettings settings;
+    settings.width = 48;
+    settings.height = 48;
+    settings.shading.lights = {Light{Light::Kind::Point, {6, 0, 1.5f}, 1.0f}};  // low: all three bands
+    Renderer r;
+    const Image<Vec3f> plain = colours(r, s, settings, kTopDown);
+    int bands[3] = {0, 0, 0};
+    for (std::size_t i = 0; i < plain.size(); ++i)
+        for (int b = 0; b < 3; ++b) bands[b] += plain.data()[i].x == 0.8f * (b == 0 ? 0.5f : b == 1 ? 0.75f : 1.0f);
+    EXPECT_GT(bands[0], 0);
+    EXPECT_GT(bands[1], 0);
+    EXPECT_GT(bands[2], 0);
+    RenderSettings shadowed = settings;
+    shadowed.shading.shadows = true;
+    RenderSettings two_lights = settings;
+    two_lights.shading.lights.push_back(Light{Light::Kind::Point, {0, 0, 5}, 0.0f});
+    for (const RenderSettings& general : {shadowed, two_lights}) {
+        const Image<Vec3f>& other = colours(r, s, general, kTopDown);
+        ASSERT_EQ(other.size(), plain.size());
+        for (std::size_t i = 0; i < plain.size(); ++i) EXPECT_EQ(other.data()[i], plain.data()[i]) << i;
+    }
 }

@@ -4,9 +4,35 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
+#include <new>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 namespace toonray {
+
+/// std::allocator, except that constructing an element without a value default-initialises it
+/// rather than value-initialising it: for pixel types without a constructor (float, uint32_t,
+/// Rgb8) growing a vector then leaves the new memory untouched instead of zeroing it. Image uses
+/// it so that reshape() does not write every pixel of a buffer its caller is about to overwrite.
+template <typename T>
+struct DefaultInitAllocator : std::allocator<T> {
+    template <typename U>
+    struct rebind {
+        using other = DefaultInitAllocator<U>;
+    };
+    using std::allocator<T>::allocator;
+
+    template <typename U>
+    void construct(U* p) noexcept(std::is_nothrow_default_constructible_v<U>) {
+        ::new (static_cast<void*>(p)) U;
+    }
+    template <typename U, typename... Args>
+    void construct(U* p, Args&&... args) {
+        ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+    }
+};
 
 template <typename T>
 class Image {
@@ -18,6 +44,14 @@ public:
         width_ = width;
         height_ = height;
         pixels_.assign(static_cast<std::size_t>(width) * height, fill);
+    }
+    /// Sets the size without filling: every pixel's value is unspecified (new ones are left
+    /// uninitialised for types without a constructor). For buffers the caller overwrites
+    /// completely, where a fill would only touch the memory twice.
+    void reshape(int width, int height) {
+        width_ = width;
+        height_ = height;
+        pixels_.resize(static_cast<std::size_t>(width) * height);
     }
     [[nodiscard]] int width() const { return width_; }
     [[nodiscard]] int height() const { return height_; }
@@ -33,7 +67,7 @@ public:
 
 private:
     int width_ = 0, height_ = 0;
-    std::vector<T> pixels_;
+    std::vector<T, DefaultInitAllocator<T>> pixels_;
 };
 
 using Rgb8 = std::array<std::uint8_t, 3>;

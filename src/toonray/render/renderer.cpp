@@ -66,57 +66,87 @@ int samples_per_side(int samples) {
     throw Error(fmt::format("--samples {}: must be 1, 4, 9 or 16 (a square grid per pixel)", samples));
 }
 
+void prepare_gbuffer(GBuffer& g, int width, int height, int sub, EdgeMode mode) {
+    const int w = width * sub, h = height * sub;
+    const bool classic = mode == EdgeMode::Classic;
+    g.sub = sub;
+    // Only the buffers this mode reads are kept at full size. No fill: shade_tile writes every
+    // sample of the fine grid (the tiles cover it exactly), so filling would only touch the
+    // memory twice.
+    g.distance.reshape(classic ? w : 0, classic ? h : 0);
+    g.normal.reshape(classic ? w : 0, classic ? h : 0);
+    g.view_depth.reshape(classic ? 0 : w, classic ? 0 : h);
+    g.geometric_normal.reshape(classic ? 0 : w, classic ? 0 : h);
+    g.colour.reshape(w, h);
+    g.material.reshape(w, h);
+    g.object.reshape(w, h);
+}
+
+namespace {
+
+// shade_tile for one line mode: the mode decides which depth and normal are stored, so it is a
+// template parameter rather than a test per sample.
+template <bool kClassic>
+void shade_tile_rows(const ShadingContext& ctx, const ViewPlane& view, const Vec3f& background,
+                     const SampleTile& t, GBuffer& g) {
+    const Scene& scene = ctx.scene;
+    const float inf = std::numeric_limits<float>::infinity();
+    const int tw = t.width();
+    const Light* plain = plain_point_light(ctx);  // the common case, shaded inline below
+    for (int y = t.y0; y < t.y1; ++y) {
+        const int first = (y - t.y0) * tw;  // the row's first sample in the tile's arrays
+        const Vec3f* dirs = t.dirs + first;
+        const Hit* hits = t.hits + first;
+        const bool* found = t.found + first;
+        float* depth = kClassic ? g.distance.row(y) + t.x0 : g.view_depth.row(y) + t.x0;
+        Vec3f* normal = kClassic ? g.normal.row(y) + t.x0 : g.geometric_normal.row(y) + t.x0;
+        Vec3f* colour = g.colour.row(y) + t.x0;
+        std::uint32_t* material = g.material.row(y) + t.x0;
+        std::uint32_t* object = g.object.row(y) + t.x0;
+        for (int i = 0; i < tw; ++i) {
+            if (!found[i]) {
+                depth[i] = inf;
+                normal[i] = Vec3f(0.0f);
+                colour[i] = background;
+                material[i] = kNoIndex;
+                object[i] = kNoIndex;
+                continue;
+            }
+            const Hit& hit = hits[i];
+            const Vec3f& dir = dirs[i];
+            const Vec3f n = shading_normal(scene, hit, dir);
+            if constexpr (kClassic) {
+                depth[i] = hit.t;
+                normal[i] = n;
+            } else {
+                depth[i] = hit.t * dot(dir, view.forward);
+                normal[i] = geometric_normal(scene, hit, dir);
+            }
+            const std::uint32_t m = scene.tri_material[hit.prim];
+            colour[i] = plain && !material_texture(ctx, m) ? shade_plain(ctx, *plain, hit, view.eye, dir, n)
+                                                            : shade_hit(ctx, hit, view.eye, dir, n);
+            material[i] = m;
+            object[i] = scene.tri_object[hit.prim];
+        }
+    }
+}
+
+}  // namespace
+
+void shade_tile(const ShadingContext& ctx, const ViewPlane& view, const RenderSettings& settings,
+                const SampleTile& tile, GBuffer& g) {
+    if (settings.edges == EdgeMode::Classic)
+        shade_tile_rows<true>(ctx, view, settings.background, tile, g);
+    else
+        shade_tile_rows<false>(ctx, view, settings.background, tile, g);
+}
+
 void Renderer::trace(const Scene& scene, const TriangleAccel& accel, const ViewPlane& view,
                      const RenderSettings& settings, int sub, const TextureSet* textures) {
     const ShadingContext shading{scene, accel, settings.shading, lights_, textures};
-    const int w = settings.width * sub, h = settings.height * sub;
-    const bool classic = settings.edges == EdgeMode::Classic;
-    const float inf = std::numeric_limits<float>::infinity();
-    GBuffer& g = gbuffer_;
-    g.sub = sub;
-    // Only the buffers this mode reads are kept at full size.
-    g.distance.resize(classic ? w : 0, classic ? h : 0, inf);
-    g.normal.resize(classic ? w : 0, classic ? h : 0);
-    g.view_depth.resize(classic ? 0 : w, classic ? 0 : h, inf);
-    g.geometric_normal.resize(classic ? 0 : w, classic ? 0 : h);
-    g.colour.resize(w, h);
-    g.material.resize(w, h, kNoIndex);
-    g.object.resize(w, h, kNoIndex);
-    const Vec3f forward = view.forward;
-
-    trace_primary(accel, view, settings.width, settings.height, sub, settings.threads, [&](const SampleTile& t) {
-        int i = 0;
-        for (int y = t.y0; y < t.y1; ++y)
-            for (int x = t.x0; x < t.x1; ++x, ++i) {
-                const Vec3f& dir = t.dirs[i];
-                if (!t.found[i]) {
-                    if (classic) {
-                        g.distance(x, y) = inf;
-                        g.normal(x, y) = Vec3f(0.0f);
-                    } else {
-                        g.view_depth(x, y) = inf;
-                        g.geometric_normal(x, y) = Vec3f(0.0f);
-                    }
-                    g.colour(x, y) = settings.background;
-                    g.material(x, y) = kNoIndex;
-                    g.object(x, y) = kNoIndex;
-                    continue;
-                }
-                const Hit& hit = t.hits[i];
-                Vec3f n = shading_normal(scene, hit, dir);
-                std::uint32_t m = scene.tri_material[hit.prim];
-                if (classic) {
-                    g.distance(x, y) = hit.t;
-                    g.normal(x, y) = n;
-                } else {
-                    g.view_depth(x, y) = hit.t * dot(dir, forward);
-                    g.geometric_normal(x, y) = geometric_normal(scene, hit, dir);
-                }
-                g.colour(x, y) = shade_hit(shading, hit, view.eye, dir, n);
-                g.material(x, y) = m;
-                g.object(x, y) = scene.tri_object[hit.prim];
-            }
-    });
+    prepare_gbuffer(gbuffer_, settings.width, settings.height, sub, settings.edges);
+    trace_primary(accel, view, settings.width, settings.height, sub, settings.threads,
+                  [&](const SampleTile& t) { shade_tile(shading, view, settings, t, gbuffer_); });
 }
 
 const ImageRgb8& Renderer::render(const Scene& scene, const TriangleAccel& accel,
@@ -143,12 +173,7 @@ void Renderer::render_classic(const RenderSettings& settings) {
     sobel_edges(aovs_.depth, settings.depth_threshold, aovs_.edges_depth, threads);
     sobel_edges(aovs_.normal, settings.normal_threshold, aovs_.edges_normal, threads);
     merge_edges(aovs_.edges_depth, aovs_.edges_normal, aovs_.edges);
-    compose_lines(gbuffer_.colour, aovs_.edges, final_, threads);
-    aovs_.cel.resize(settings.width, settings.height);
-    for (std::size_t i = 0; i < aovs_.cel.size(); ++i) {
-        const Vec3f& c = gbuffer_.colour.data()[i];
-        aovs_.cel.data()[i] = {to_byte(c.x), to_byte(c.y), to_byte(c.z)};
-    }
+    compose_lines(gbuffer_.colour, aovs_.edges, final_, threads, &aovs_.cel);
 }
 
 void Renderer::render_robust(const RenderSettings& settings) {
@@ -156,10 +181,10 @@ void Renderer::render_robust(const RenderSettings& settings) {
     const GBuffer& g = gbuffer_;
     FineBuffers fine{g.view_depth, g.geometric_normal, g.object, g.material};
     find_line_seeds(fine, settings.lines, seeds_, threads);
-    distance_to_seeds(seeds_, distance_, threads);
     float thickness = line_thickness(settings.lines.width, settings.height, g.sub);
-    resolve_lines(g.colour, distance_, thickness, g.sub, settings.lines.colour, final_, aovs_.cel, aovs_.edges,
-                  threads);
+    // Distance to the seeds and line coverage in one banded pass: no full-size distance image.
+    resolve_lines_from_seeds(g.colour, seeds_, thickness, g.sub, settings.lines.colour, final_, aovs_.cel,
+                             aovs_.edges, threads);
     robust_feature_images(g, seeds_, aovs_, threads);
 }
 

@@ -7,6 +7,7 @@
 #include "toonray/core/image.h"
 #include "toonray/render/robust.h"
 #include "toonray/render/shading.h"
+#include "toonray/render/trace.h"
 #include "toonray/scene/camera.h"
 #include "toonray/scene/scene.h"
 
@@ -61,6 +62,16 @@ struct Aovs {
     ImageRgb8 object_id, material_id;  ///< robust: ids in false colour
 };
 
+/// Sizes the G-buffer for a frame of width x height pixels with sub x sub samples each, for
+/// `mode`'s buffers. The contents are left unspecified until shade_tile has covered every sample.
+void prepare_gbuffer(GBuffer& g, int width, int height, int sub, EdgeMode mode);
+
+/// The per-sample work of Renderer::trace for one traced tile: shading normal, toon colour,
+/// material and object ids, and the depth and normal settings.edges needs, written into `g`
+/// (sized by prepare_gbuffer). Public so the stage benchmark times the renderer's own code.
+void shade_tile(const ShadingContext& ctx, const ViewPlane& view, const RenderSettings& settings,
+                const SampleTile& tile, GBuffer& g);
+
 /// Renders frames, keeping its buffers between calls so an animation allocates once.
 class Renderer {
 public:
@@ -89,7 +100,6 @@ private:
     Aovs aovs_;
     ImageRgb8 final_;
     Image<std::uint8_t> seeds_;
-    ImageF distance_;
     Vec3f light_;
     std::vector<Light> lights_;
 };

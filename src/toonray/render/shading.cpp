@@ -149,45 +149,17 @@ void TextureSet::load(const Scene& scene, Warnings& warnings) {
     }
 }
 
-Vec3f geometric_normal(const Scene& scene, const Hit& hit, const Vec3f& dir) {
-    const auto& tri = scene.tri_positions[hit.prim];
-    const Vec3f& p0 = scene.positions[tri[0]];
-    Vec3f n = cross(scene.positions[tri[1]] - p0, scene.positions[tri[2]] - p0);
-    float len = length(n);
-    n = len > 0.0f ? n / len : -dir;
-    return dot(n, dir) > 0.0f ? -n : n;
-}
+namespace {
 
-Vec3f shading_normal(const Scene& scene, const Hit& hit, const Vec3f& dir) {
-    const auto& tri = scene.tri_positions[hit.prim];
-    const auto& tn = scene.tri_normals[hit.prim];
-    Vec3f n;
-    bool interpolated = false;
-    if (tn[0] != kNoIndex && tn[1] != kNoIndex && tn[2] != kNoIndex) {
-        float w0 = 1.0f - hit.u - hit.v;
-        n = scene.normals[tn[0]] * w0 + scene.normals[tn[1]] * hit.u + scene.normals[tn[2]] * hit.v;
-        float len = length(n);
-        if (len > 0.0f && std::isfinite(len)) {
-            n = n / len;
-            interpolated = true;
-        }
-    }
-    if (!interpolated) {
-        const Vec3f& p0 = scene.positions[tri[0]];
-        n = cross(scene.positions[tri[1]] - p0, scene.positions[tri[2]] - p0);
-        float len = length(n);
-        n = len > 0.0f ? n / len : -normalize(dir);
-    }
-    return dot(n, dir) > 0.0f ? -n : n;
-}
-
-Vec3f shade_hit(const ShadingContext& ctx, const Hit& hit, const Vec3f& eye, const Vec3f& dir, const Vec3f& n) {
+// Everything shade_hit can do: any lights, toon shadows, specular and rim bands, textures, for
+// the hit at p. Kept out of line (noinline) so that shade_hit's plain path (shade_plain), taken
+// for almost every hit of a default frame, does not pay for this function's register saves and
+// stack frame.
+[[gnu::noinline]] Vec3f shade_hit_general(const ShadingContext& ctx, const Hit& hit, const Vec3f& dir,
+                                          const Vec3f& n, const Vec3f& p, const ImageRgb8* texture) {
     const Scene& scene = ctx.scene;
     const ShadingSettings& s = ctx.settings;
-    const std::uint32_t m = scene.tri_material[hit.prim];
-    const Material& material = scene.materials[m];
-    const Vec3f p = eye + dir * hit.t;
-
+    const Material& material = scene.materials[scene.tri_material[hit.prim]];
     float diffuse = 0.0f;
     float highlight = 0.0f;
     for (const Light& light : ctx.lights) {
@@ -195,12 +167,10 @@ Vec3f shade_hit(const ShadingContext& ctx, const Hit& hit, const Vec3f& eye, con
         float distance = std::numeric_limits<float>::infinity();
         float l_dot_n;
         if (light.kind == Light::Kind::Point) {
-            to_light = light.vector - p;
-            float len = length(to_light);
-            // The seed's l.n, computed as it did (unit light vector against the unit normal).
-            l_dot_n = len > 0.0f ? dot(to_light, n) / len : 1.0f;
-            to_light = len > 0.0f ? to_light / len : n;
-            distance = len;
+            const PointLighting l = light_point(light.vector, p, n);
+            l_dot_n = l.l_dot_n;
+            to_light = l.distance > 0.0f ? l.to_light / l.distance : n;
+            distance = l.distance;
         } else {
             to_light = -normalize(light.vector);
             l_dot_n = dot(to_light, n);
@@ -221,22 +191,36 @@ Vec3f shade_hit(const ShadingContext& ctx, const Hit& hit, const Vec3f& eye, con
     }
     // With one unit light this is max(0, l.n): the same band as the seed's int(l.n * 16).
     Vec3f kd = material.kd;
-    if (s.textures && ctx.textures) {
-        if (const ImageRgb8* tex = ctx.textures->get(m)) {
-            const auto& tt = scene.tri_texcoords[hit.prim];
-            if (tt[0] != kNoIndex && tt[1] != kNoIndex && tt[2] != kNoIndex) {
-                float w0 = 1.0f - hit.u - hit.v;
-                const Vec2f& a = scene.texcoords[tt[0]];
-                const Vec2f& b = scene.texcoords[tt[1]];
-                const Vec2f& c = scene.texcoords[tt[2]];
-                kd = kd * sample_texture(*tex, a.x * w0 + b.x * hit.u + c.x * hit.v, a.y * w0 + b.y * hit.u + c.y * hit.v);
-            }
+    if (texture) {
+        const auto& tt = scene.tri_texcoords[hit.prim];
+        if (tt[0] != kNoIndex && tt[1] != kNoIndex && tt[2] != kNoIndex) {
+            float w0 = 1.0f - hit.u - hit.v;
+            const Vec2f& a = scene.texcoords[tt[0]];
+            const Vec2f& b = scene.texcoords[tt[1]];
+            const Vec2f& c = scene.texcoords[tt[2]];
+            kd = kd * sample_texture(*texture, a.x * w0 + b.x * hit.u + c.x * hit.v, a.y * w0 + b.y * hit.u + c.y * hit.v);
         }
     }
     Vec3f colour = kd * s.ramp.level(std::min(diffuse, 1.0f));
     if (highlight > 0.0f) colour += material.ks;
     if (s.rim > 0.0f && 1.0f - std::abs(dot(n, dir)) > 1.0f - s.rim) colour += kd * s.rim_strength;
     return colour;
+}
+
+}  // namespace
+
+const Light* plain_point_light(const ShadingContext& ctx) {
+    const ShadingSettings& s = ctx.settings;
+    const bool plain = ctx.lights.size() == 1 && ctx.lights[0].kind == Light::Kind::Point && !s.shadows &&
+                       !s.specular && !(s.rim > 0.0f);
+    return plain ? &ctx.lights[0] : nullptr;
+}
+
+Vec3f shade_hit(const ShadingContext& ctx, const Hit& hit, const Vec3f& eye, const Vec3f& dir, const Vec3f& n) {
+    const ImageRgb8* texture = material_texture(ctx, ctx.scene.tri_material[hit.prim]);
+    if (const Light* light = plain_point_light(ctx); light && !texture)
+        return shade_plain(ctx, *light, hit, eye, dir, n);
+    return shade_hit_general(ctx, hit, dir, n, eye + dir * hit.t, texture);
 }
 
 }  // namespace toonray

@@ -85,13 +85,80 @@ struct ShadingContext {
     const TextureSet* textures = nullptr;
 };
 
+/// The hit triangle's geometric normal, unit, facing the viewer. Inline (as is shading_normal):
+/// both run once per sample, inside the renderer's per-tile loop.
+inline Vec3f geometric_normal(const Scene& scene, const Hit& hit, const Vec3f& dir) {
+    const auto& tri = scene.tri_positions[hit.prim];
+    const Vec3f& p0 = scene.positions[tri[0]];
+    Vec3f n = cross(scene.positions[tri[1]] - p0, scene.positions[tri[2]] - p0);
+    float len = length(n);
+    n = len > 0.0f ? n / len : -dir;
+    return dot(n, dir) > 0.0f ? -n : n;
+}
+
 /// The shading normal at a hit: vertex normals interpolated when all three corners have one,
 /// else the geometric normal; turned to face the viewer (against `dir`).
-Vec3f shading_normal(const Scene& scene, const Hit& hit, const Vec3f& dir);
-/// The hit triangle's geometric normal, unit, facing the viewer.
-Vec3f geometric_normal(const Scene& scene, const Hit& hit, const Vec3f& dir);
+inline Vec3f shading_normal(const Scene& scene, const Hit& hit, const Vec3f& dir) {
+    const auto& tri = scene.tri_positions[hit.prim];
+    const auto& tn = scene.tri_normals[hit.prim];
+    Vec3f n;
+    bool interpolated = false;
+    if (tn[0] != kNoIndex && tn[1] != kNoIndex && tn[2] != kNoIndex) {
+        float w0 = 1.0f - hit.u - hit.v;
+        n = scene.normals[tn[0]] * w0 + scene.normals[tn[1]] * hit.u + scene.normals[tn[2]] * hit.v;
+        float len = length(n);
+        if (len > 0.0f && std::isfinite(len)) {
+            n = n / len;
+            interpolated = true;
+        }
+    }
+    if (!interpolated) {
+        const Vec3f& p0 = scene.positions[tri[0]];
+        n = cross(scene.positions[tri[1]] - p0, scene.positions[tri[2]] - p0);
+        float len = length(n);
+        n = len > 0.0f ? n / len : -normalize(dir);
+    }
+    return dot(n, dir) > 0.0f ? -n : n;
+}
 
 /// Toon colour of a hit seen along `dir` from `eye`, with shading normal `n`.
 Vec3f shade_hit(const ShadingContext& ctx, const Hit& hit, const Vec3f& eye, const Vec3f& dir, const Vec3f& n);
+
+/// The texture that multiplies material m's Kd in this frame, or null.
+inline const ImageRgb8* material_texture(const ShadingContext& ctx, std::uint32_t m) {
+    return ctx.settings.textures && ctx.textures ? ctx.textures->get(m) : nullptr;
+}
+
+/// The frame's one point light when its shading is the seed's plain setup (one point light; no
+/// shadows, specular or rim band), else null. Then shade_plain gives shade_hit's colour for every
+/// hit on an untextured material; the renderer checks this once per tile, not per sample.
+const Light* plain_point_light(const ShadingContext& ctx);
+
+/// A point light as the seed lit a hit: l.n from the unit light vector against the unit normal,
+/// computed as the seed did (dot with the unnormalised vector, divided by its length). Every
+/// path of shade_hit uses this, so they all round alike.
+struct PointLighting {
+    Vec3f to_light;  ///< unnormalised, from the hit to the light
+    float distance;
+    float l_dot_n;
+};
+inline PointLighting light_point(const Vec3f& light_position, const Vec3f& p, const Vec3f& n) {
+    PointLighting l;
+    l.to_light = light_position - p;
+    l.distance = length(l.to_light);
+    l.l_dot_n = l.distance > 0.0f ? dot(l.to_light, n) / l.distance : 1.0f;
+    return l;
+}
+
+/// shade_hit under plain lighting (`light` from plain_point_light) on an untextured material:
+/// Kd times the ramp's band for the light's l.n. It is what shade_hit's general path computes
+/// there: its diffuse sum starts at 0 and 0 + x == x, with nothing else added.
+inline Vec3f shade_plain(const ShadingContext& ctx, const Light& light, const Hit& hit, const Vec3f& eye,
+                         const Vec3f& dir, const Vec3f& n) {
+    const Vec3f p = eye + dir * hit.t;
+    const float diffuse = light.intensity * std::max(0.0f, light_point(light.vector, p, n).l_dot_n);
+    const Material& material = ctx.scene.materials[ctx.scene.tri_material[hit.prim]];
+    return material.kd * ctx.settings.ramp.level(std::min(diffuse, 1.0f));
+}
 
 }  // namespace toonray
