@@ -29,6 +29,8 @@ struct Bvh {
         float traversal_cost = 1.0f;  ///< cost of visiting a node, relative to...
         float intersection_cost = 1.0f;  ///< ...testing one block of `block_size` primitives
         int block_size = 2;  ///< primitives tested together (the leaf test's SIMD width; a power of two)
+
+        bool operator==(const Config&) const = default;
     };
 
     std::vector<BvhNode> nodes;  ///< nodes[0] is the root; children follow parents; empty if no primitives

@@ -37,11 +37,26 @@ void FileRenderer::render(const Scene& scene, const std::filesystem::path& outpu
     CameraSpec camera = choose_camera(scene, options);
     // Validate the camera before any work so a bad one fails with nothing written.
     make_view_plane(camera, options.settings.width, options.settings.height);
-    accel_.build(scene.positions, scene.tri_positions, options.bvh);
+    prepare_accel(scene, options.bvh);
     if (options.settings.shading.textures) textures_.load(scene, warnings);
     const ImageRgb8& image = renderer_.render(scene, accel_, camera, options.settings,
                                               options.settings.shading.textures ? &textures_ : nullptr);
     write_frame(renderer_, image, output, options);
+}
+
+void FileRenderer::prepare_accel(const Scene& scene, const Bvh::Config& config) {
+    const bool same_triangles = accel_valid_ && config == accel_config_ && scene.tri_positions == accel_tris_;
+    if (same_triangles && refits_in_a_row_ < kMaxRefitsInARow) {
+        accel_.refit(scene.positions, scene.tri_positions);
+        ++refits_in_a_row_;
+        return;
+    }
+    accel_valid_ = false;  // stays false if the build throws
+    accel_.build(scene.positions, scene.tri_positions, config);
+    accel_tris_ = scene.tri_positions;
+    accel_config_ = config;
+    refits_in_a_row_ = 0;
+    accel_valid_ = true;
 }
 
 void write_frame(const Renderer& renderer, const ImageRgb8& image, const std::filesystem::path& output,

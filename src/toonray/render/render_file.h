@@ -51,9 +51,24 @@ public:
     [[nodiscard]] const Renderer& renderer() const { return renderer_; }
     [[nodiscard]] const Scene& scene() const { return scene_; }
 
+    /// An animation's frames usually keep their triangles while vertices move. When a scene has
+    /// exactly the triangles of the one before (and the same BVH settings), the BVH is refitted
+    /// instead of rebuilt, at most this many frames in a row: refitting costs a tenth of a build,
+    /// but the tree loosens as vertices travel, so it is rebuilt now and then. Images do not
+    /// depend on it: among hits at the same distance the lowest triangle index wins, whatever
+    /// the tree.
+    static constexpr int kMaxRefitsInARow = 15;
+
 private:
+    /// Builds or refits accel_ for `scene` (see kMaxRefitsInARow).
+    void prepare_accel(const Scene& scene, const Bvh::Config& config);
+
     Scene scene_;
     TriangleAccel accel_;
+    std::vector<std::array<std::uint32_t, 3>> accel_tris_;  ///< the triangles accel_ was built for
+    Bvh::Config accel_config_;
+    int refits_in_a_row_ = 0;
+    bool accel_valid_ = false;
     Renderer renderer_;
     TextureSet textures_;
 };
