@@ -3,8 +3,8 @@
 # build-bench/, builds the CLI and the benchmarks, and prints every table:
 #
 #   stages     toonray_bench: parse, BVH build, trace, shade, edges, PNG, whole frame, each
-#              against its reference (tinyobjloader, Embree, libpng) on the teapot and the
-#              generated 35k-triangle scene
+#              against its reference (tinyobjloader, Embree, libpng) on the teapot, the
+#              generated 35k-triangle scene, a piano frame and a 1M-triangle sphere
 #   rays       toonray_accel_bench: primary-ray throughput (single rays and tiles) and BVH build
 #              against Embree's rtcIntersect1 / rtcIntersect8 and builder, on the teapot, a
 #              70k-triangle mesh, the piano and a 1M-triangle sphere (needs libembree-dev)
@@ -67,8 +67,17 @@ for part in "${parts[@]}"; do
             if [ $quick = 1 ]; then
                 "$build/bench/toonray_bench" --quick --work-dir "$build/bench/stages"
             else
+                # The teapot and the generated 35k scene, then the scenes of issue #6's frame and
+                # scale targets: a piano frame (34,476 triangles, exported by the CLI) and the
+                # 1M-triangle sphere of bench/scale.py.
+                scenes=("$root/tests/data/teapot.obj"
+                        "$("$build/bench/toonray_bench" --generate "$build/bench/stages")")
+                piano="$build/bench/stages/piano/keys_000001.obj"
+                [ -f "$piano" ] || "$cli" piano --export-obj "$(dirname "$piano")" --start 6 --seconds 0.04 --quiet
+                sphere=$(python3 "$root/bench/scale.py" --write-sphere 1000000 --work-dir "$build/bench/scale")
+                scenes+=("$piano" "$sphere")
                 "$build/bench/toonray_bench" --repeats "$repeats" --work-dir "$build/bench/stages" \
-                    --markdown "$results/stages.md"
+                    --markdown "$results/stages.md" "${scenes[@]}"
                 { echo "## Stages"; echo; cat "$results/stages.md"; echo; } >>"$report"
             fi ;;
         rays)

@@ -182,7 +182,9 @@ def svg_plot(panels, path):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--toonray", required=True)
+    ap.add_argument("--toonray", help="the toonray CLI to time (required unless --write-sphere)")
+    ap.add_argument("--write-sphere", type=int, metavar="N",
+                    help="only write the N-triangle sphere into the work directory and print its path")
     ap.add_argument("--work-dir", required=True)
     ap.add_argument("--repeats", type=int, default=5)
     ap.add_argument("--quick", action="store_true", help="small scenes and images, one repeat")
@@ -191,6 +193,11 @@ def main():
     ap.add_argument("--svg")
     args = ap.parse_args()
     os.makedirs(args.work_dir, exist_ok=True)
+    if args.write_sphere:
+        print(sphere(args.work_dir, args.write_sphere)[0])
+        return
+    if not args.toonray:
+        ap.error("--toonray is required")
     out = os.path.join(args.work_dir, "frame.png")
     repeats = 1 if args.quick else args.repeats
     tri_counts = QUICK_TRIANGLES if args.quick else TRIANGLES
