@@ -4,6 +4,7 @@
 # Extra arguments go to `toonray demo` (e.g. --full for the whole piece).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bash scripts/install-deps.sh
-bash scripts/build.sh
+bash scripts/install-deps.sh demo
+# The demo needs neither the tests nor the benchmarks (nor their libraries).
+bash scripts/build.sh -DTOONRAY_BUILD_TESTS=OFF -DTOONRAY_BUILD_BENCH=OFF
 ./build/apps/toonray demo -o out "$@"

@@ -19,9 +19,9 @@ stage_done() {
   stage_start=$SECONDS
 }
 
-bash scripts/install-deps.sh
+bash scripts/install-deps.sh all
 stage_done "installing dependencies"
-bash scripts/build.sh
+bash scripts/build.sh -DTOONRAY_BUILD_TESTS=ON -DTOONRAY_BUILD_BENCH=ON
 stage_done "the Release build"
 ctest --test-dir "${TOONRAY_BUILD_DIR:-build}" --output-on-failure --parallel "$(nproc)" --timeout 900
 stage_done "the tests"

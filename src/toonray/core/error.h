@@ -16,6 +16,21 @@ public:
     using std::runtime_error::runtime_error;
 };
 
+/// The limits of core/limits.h that an input can exceed. Each front end has its own way to raise
+/// one (the CLI's --max-* options), so the library names the limit and the front end adds how.
+enum class Limit { InputBytes, LineBytes, Vertices, Triangles, ImagePixels, Memory, Frames, CameraKeys, Notes };
+
+/// An input asked for more than a limit allows. The message says what and by how much, never
+/// how to raise the limit: that is the front end's to say (see Limit).
+class LimitError : public Error {
+public:
+    LimitError(Limit limit, const std::string& message) : Error(message), limit_(limit) {}
+    [[nodiscard]] Limit limit() const { return limit_; }
+
+private:
+    Limit limit_;
+};
+
 /// Builds "file:line: message" (or "file: message" when line is 0).
 std::string located(std::string_view file, std::size_t line, std::string_view message);
 
