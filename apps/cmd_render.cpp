@@ -1,0 +1,45 @@
+#include <memory>
+#include <string>
+
+#include "commands.h"
+#include "toonray/anim/batch.h"
+#include "toonray/core/limits.h"
+#include "toonray/render/render_file.h"
+
+namespace toonray::cli {
+namespace {
+
+struct RenderCommandArgs {
+    RenderArgs render;
+    std::string input, output;
+};
+
+int run_render(const RenderCommandArgs& args) {
+    FileRenderOptions options = args.render.resolve();
+    {  // The frame buffers come first: the loader counts them in its memory estimate.
+        Limits l = limits();
+        l.reserved_memory = plan_frame_jobs(options.settings, 1, 1).frame_bytes;
+        set_limits(l);
+    }
+    Warnings warnings;
+    FileRenderer renderer;
+    renderer.render(args.input, args.output, options, warnings);
+    print_warnings(warnings);
+    return 0;
+}
+
+}  // namespace
+
+Subcommand add_render_command(CLI::App& app, LimitArgs& limit_args) {
+    auto args = std::make_shared<RenderCommandArgs>();
+    CLI::App* render = app.add_subcommand("render", "Render one OBJ scene to a PNG image");
+    render->add_option("scene", args->input, "OBJ file (with its camera block, if any)")
+        ->required()
+        ->check(CLI::ExistingFile);
+    render->add_option("-o,--output", args->output, "Output PNG file")->required();
+    args->render.add_to(*render);
+    limit_args.add_to(*render);
+    return {render, [args] { return run_render(*args); }};
+}
+
+}  // namespace toonray::cli

@@ -1,0 +1,40 @@
+// toonray command line: parses arguments into options and calls the library. Errors from the
+// library carry file and line; they are caught here once and printed.
+
+#include <CLI/CLI.hpp>
+#include <cstdio>
+#include <exception>
+#include <fmt/format.h>
+
+#include "commands.h"
+#include "toonray/core/error.h"
+
+int main(int argc, char** argv) {
+    using namespace toonray::cli;
+    CLI::App app{"toonray: a toon ray tracer. OBJ/MTL scenes in, cel-shaded and outlined PNG out."};
+    app.require_subcommand(1);
+    app.set_version_flag("--version", "toonray 0.1.0");
+
+    LimitArgs limit_args;
+    const Subcommand commands[] = {
+        add_render_command(app, limit_args), add_batch_command(app, limit_args),
+        add_encode_command(app),             add_score_command(app, limit_args),
+        add_piano_command(app, limit_args),  add_demo_command(app, limit_args),
+    };
+
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& e) {
+        return app.exit(e);
+    }
+
+    try {
+        limit_args.apply();
+        for (const Subcommand& command : commands)
+            if (*command.app) return command.run();
+    } catch (const std::exception& e) {
+        fmt::print(stderr, "toonray: error: {}\n", e.what());
+        return 1;
+    }
+    return 0;
+}
