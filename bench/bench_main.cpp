@@ -42,7 +42,7 @@
 #include "toonray/io/file.h"
 #include "toonray/io/png.h"
 #include "toonray/render/classic.h"
-#include "toonray/render/render_file.h"
+#include "toonray/frame/frame_renderer.h"
 #include "toonray/render/renderer.h"
 #include "toonray/scene/obj_loader.h"
 
@@ -471,7 +471,7 @@ SceneResult bench_scene(const fs::path& path, const Options& opt) {
 
     TriangleAccel accel;
     accel.build(scene.positions, scene.tri_positions);
-    FileRenderOptions fro;
+    FrameOptions fro;
     fro.settings.width = w;
     fro.settings.height = h;
     // The classic line pipeline (Sobel on 8-bit maps, merge, blur): the stages this benchmark
@@ -656,13 +656,15 @@ SceneResult bench_scene(const fs::path& path, const Options& opt) {
     fs::create_directories(out_dir);
     const fs::path frame_png = out_dir / (path.stem().string() + "_inprocess.png");
     auto frame = [&](int threads) {
-        FileRenderOptions o = fro;
+        FrameOptions o = fro;
         o.settings.threads = threads;
-        FileRenderer fr;
+        Scene loaded;
         Warnings ws;
-        fr.render(path, frame_png, o, ws);
+        load_obj(path, loaded, ws);
+        FrameRenderer fr;
+        fr.render(loaded, choose_camera(loaded, o), frame_png, o, ws);
     };
-    both("frame in-process (FileRenderer, OBJ to PNG)", frame, "load, build, render, write");
+    both("frame in-process (FrameRenderer, OBJ to PNG)", frame, "load, build, render, write");
 
     if (opt.cli != "none" && fs::exists(opt.cli)) {
         const fs::path cli_png = out_dir / (path.stem().string() + "_cli.png");

@@ -6,6 +6,7 @@
 
 #include "fuzz_util.h"
 #include "toonray/core/error.h"
+#include "toonray/frame/lights.h"
 #include "toonray/render/shading.h"
 
 using namespace toonray;

@@ -130,6 +130,12 @@ TEST(Shard, ParsesKOverN) {
     EXPECT_EQ(s.count, 4);
     for (const char* bad : {"0/4", "5/4", "3", "a/b", "3/0", "-1/4", "1/4/5"})
         EXPECT_THROW(parse_shard(bad), Error) << bad;
+    try {
+        parse_shard("5/4");
+        FAIL();
+    } catch (const Error& e) {
+        EXPECT_EQ(std::string(e.what()), "shard '5/4': expected K/N with 1 <= K <= N");
+    }
 }
 
 TEST(Shard, FromSlurmArrayVariables) {

@@ -4,11 +4,12 @@
 
 #include <cmath>
 #include <cstring>
-#include <filesystem>
+#include <string_view>
+#include <variant>
+#include <vector>
 
 #include "toonray/io/png.h"
 #include "toonray/render/classic.h"
-#include "toonray/render/render_file.h"
 #include "toonray/scene/obj_loader.h"
 #include "support/test_support.h"
 
@@ -34,6 +35,19 @@ Scene square(float a, Vec3f kd) {
     s.add_triangle({0, 1, 2}, 1, 0);
     s.add_triangle({0, 2, 3}, 1, 0);
     return s;
+}
+
+// The automatic camera for a whole scene at the settings' size.
+CameraSpec framing_camera(const Scene& s, const RenderSettings& settings) {
+    std::vector<Vec3f> used;
+    for (const auto& tri : s.tri_positions)
+        for (std::uint32_t v : tri) used.push_back(s.positions[v]);
+    return auto_camera(used, settings.width, settings.height);
+}
+
+template <typename T>
+std::uint64_t bytes_of(const Image<T>& image) {
+    return image.size() * sizeof(T);
 }
 
 const Image<Vec3f>& render_scene(Renderer& r, const Scene& s, const CameraSpec& cam, RenderSettings settings) {
@@ -104,6 +118,7 @@ TEST(Renderer, SilhouetteOfASquareOnBackgroundIsOutlined) {
     settings.width = 200;
     settings.height = 200;
     settings.light = Vec3f(0, 0, 100);
+    settings.feature_images = true;
     Renderer r;
     TriangleAccel accel;
     accel.build(s.positions, s.tri_positions);
@@ -172,22 +187,23 @@ TEST(Renderer, DefaultLightIsTheEyeMovedAlongUpAndRight) {
 
 TEST(Renderer, OutputIsIdenticalForEveryThreadCount) {
     Scene s = load("teapot.obj");
-    FileRenderOptions o;
-    o.settings.width = 320;
-    o.settings.height = 180;
-    CameraSpec cam = choose_camera(s, o);
+    RenderSettings settings;
+    settings.width = 320;
+    settings.height = 180;
+    settings.feature_images = true;
+    CameraSpec cam = framing_camera(s, settings);
     TriangleAccel accel;
     accel.build(s.positions, s.tri_positions);
     Renderer one, two, many;
-    o.settings.threads = 1;
+    settings.threads = 1;
     for (EdgeMode mode : {EdgeMode::Classic, EdgeMode::Robust}) {
-    o.settings.edges = mode;
-    o.settings.threads = 1;
-    ImageRgb8 a = one.render(s, accel, cam, o.settings);
-    o.settings.threads = 2;
-    ImageRgb8 b = two.render(s, accel, cam, o.settings);
-    o.settings.threads = 7;
-    ImageRgb8 c = many.render(s, accel, cam, o.settings);
+    settings.edges = mode;
+    settings.threads = 1;
+    ImageRgb8 a = one.render(s, accel, cam, settings);
+    settings.threads = 2;
+    ImageRgb8 b = two.render(s, accel, cam, settings);
+    settings.threads = 7;
+    ImageRgb8 c = many.render(s, accel, cam, settings);
     ASSERT_EQ(0, std::memcmp(a.data(), b.data(), a.size() * 3));
     ASSERT_EQ(0, std::memcmp(a.data(), c.data(), a.size() * 3));
     ASSERT_EQ(0, std::memcmp(one.aovs().depth.data(), two.aovs().depth.data(), a.size()));
@@ -197,19 +213,19 @@ TEST(Renderer, OutputIsIdenticalForEveryThreadCount) {
 TEST(Renderer, MatchesABruteForceReference) {
     // The same pixels traced by testing every triangle: the BVH must find the same surfaces.
     Scene s = load("spot.obj");
-    FileRenderOptions o;
-    o.settings.edges = EdgeMode::Classic;  // its G-buffer holds the Euclidean distance
-    o.settings.width = 160;
-    o.settings.height = 90;
-    CameraSpec cam = choose_camera(s, o);
+    RenderSettings settings;
+    settings.edges = EdgeMode::Classic;  // its G-buffer holds the Euclidean distance
+    settings.width = 160;
+    settings.height = 90;
+    CameraSpec cam = framing_camera(s, settings);
     TriangleAccel accel;
     accel.build(s.positions, s.tri_positions);
     Renderer r;
-    r.render(s, accel, cam, o.settings);
-    ViewPlane view = make_view_plane(cam, o.settings.width, o.settings.height);
+    r.render(s, accel, cam, settings);
+    ViewPlane view = make_view_plane(cam, settings.width, settings.height);
     int mismatches = 0, hits = 0;
-    for (int y = 0; y < o.settings.height; ++y)
-        for (int x = 0; x < o.settings.width; ++x) {
+    for (int y = 0; y < settings.height; ++y)
+        for (int x = 0; x < settings.width; ++x) {
             Vec3f dir = normalize(view.pixel_point(x + 0.5f, y + 0.5f) - cam.eye);
             Ray ray{cam.eye, dir};
             float best = std::numeric_limits<float>::infinity();
@@ -232,13 +248,13 @@ TEST(Renderer, TeapotMatchesTheGoldenImage) {
     // Golden image made by this renderer at 1280x720 and checked by eye against the seed's
     // figures; tiny differences (a ray through a shared edge) are tolerated.
     Scene s = load("teapot.obj");
-    FileRenderOptions o;
-    o.settings.edges = EdgeMode::Classic;
-    CameraSpec cam = choose_camera(s, o);
+    RenderSettings settings;
+    settings.edges = EdgeMode::Classic;
+    CameraSpec cam = framing_camera(s, settings);
     TriangleAccel accel;
     accel.build(s.positions, s.tri_positions);
     Renderer r;
-    const ImageRgb8& out = r.render(s, accel, cam, o.settings);
+    const ImageRgb8& out = r.render(s, accel, cam, settings);
     DecodedPng golden = read_png(std::string(TOONRAY_TEST_DATA_DIR) + "/golden/teapot_classic_1280x720.png");
     ASSERT_EQ(golden.width, out.width());
     ASSERT_EQ(golden.height, out.height());
@@ -248,61 +264,103 @@ TEST(Renderer, TeapotMatchesTheGoldenImage) {
     EXPECT_LE(differ, out.size() / 1000) << differ << " pixels differ";
 }
 
-TEST(FileRenderer, WritesTheImageAndAllAovsNamedAfterTheOutput) {
-    fs::path dir = fs::temp_directory_path() / ("toonray_render_" + std::to_string(::getpid()));
-    fs::remove_all(dir);
-    fs::create_directories(dir);
-    FileRenderOptions o;
-    o.settings.width = 64;
-    o.settings.height = 48;
-    o.aov_dir = dir / "aov";
+TEST(Renderer, FeatureImagesAreComputedOnlyWhenAskedAndChangeNothingElse) {
+    Scene s = load("teapot.obj");
+    TriangleAccel accel;
+    accel.build(s.positions, s.tri_positions);
     for (EdgeMode mode : {EdgeMode::Classic, EdgeMode::Robust}) {
-        o.settings.edges = mode;
-        FileRenderer fr;
-        Warnings w;
-        fr.render(std::string(TOONRAY_TEST_DATA_DIR) + "/teapot.obj", dir / "frame.png", o, w);
-        EXPECT_TRUE(is_valid_png(dir / "frame.png"));
-        auto names = aov_names(mode);
-        EXPECT_EQ(names.size(), mode == EdgeMode::Classic ? 6u : 11u);
-        for (const std::string& name : names) {
-            fs::path p = dir / "aov" / ("frame_" + name + ".png");
-            EXPECT_TRUE(is_valid_png(p)) << p;
-            EXPECT_EQ(read_png(p).width, 64);
+        RenderSettings settings;
+        settings.edges = mode;
+        settings.width = 160;
+        settings.height = 90;
+        const CameraSpec cam = framing_camera(s, settings);
+        Renderer with, without;
+        settings.feature_images = true;
+        const ImageRgb8 a = with.render(s, accel, cam, settings);
+        settings.feature_images = false;
+        const ImageRgb8 b = without.render(s, accel, cam, settings);
+        ASSERT_EQ(a.size(), b.size());
+        EXPECT_EQ(0, std::memcmp(a.data(), b.data(), a.size() * sizeof(Rgb8)));
+        for (const FeatureImage& f : feature_images()) {
+            const std::size_t asked = std::visit([&](auto m) { return (with.aovs().*m).size(); }, f.image);
+            const std::size_t not_asked = std::visit([&](auto m) { return (without.aovs().*m).size(); }, f.image);
+            EXPECT_EQ(asked, f.in(mode) ? a.size() : 0u) << f.name;
+            EXPECT_EQ(not_asked, 0u) << f.name;
         }
+        // The same renderer, asked and then not: nothing of the earlier frame's features shows.
+        with.render(s, accel, cam, settings);
+        EXPECT_EQ(with.aovs().depth.size(), 0u);
+        EXPECT_EQ(with.aovs().cel.size(), 0u);
     }
-    fs::remove_all(dir);
 }
 
-// Frames with the same triangles refit the previous frame's BVH (FileRenderer::kMaxRefitsInARow
-// in a row, then a rebuild); the images must be exactly those of a fresh build per frame. The
-// teapot's vertices swirl more each frame, so the refitted tree drifts far from a built one.
-TEST(FileRenderer, RefittedFramesEqualRebuiltFrames) {
-    test_support::TempDir dir("render_refit");
-    const Scene teapot = load("teapot.obj");
-    FileRenderOptions o;
-    o.settings.width = 96;
-    o.settings.height = 64;
-    o.settings.threads = 1;
-    o.camera = choose_camera(teapot, o);
-    FileRenderer reused;
-    const int frames = 2 * FileRenderer::kMaxRefitsInARow + 3;  // refits, a rebuild, more refits
-    for (int f = 0; f < frames; ++f) {
-        Scene scene = teapot;
-        const float angle = 0.05f * static_cast<float>(f);
-        for (Vec3f& p : scene.positions) {
-            const float a = angle * p.y;  // a twist about y, growing with height and frame
-            p = Vec3f(p.x * std::cos(a) - p.z * std::sin(a), p.y, p.x * std::sin(a) + p.z * std::cos(a));
+TEST(Renderer, FeatureImageTableListsEachModesImages) {
+    std::vector<std::string_view> classic, robust;
+    for (const FeatureImage& f : feature_images()) {
+        if (f.in(EdgeMode::Classic)) classic.push_back(f.name);
+        if (f.in(EdgeMode::Robust)) robust.push_back(f.name);
+    }
+    EXPECT_EQ(classic, (std::vector<std::string_view>{"depth", "normal", "edges_depth", "edges_normal", "edges", "cel"}));
+    EXPECT_EQ(robust, (std::vector<std::string_view>{"depth", "normal", "edges", "cel", "lines_silhouette",
+                                                      "lines_crease", "lines_depth", "lines_object", "lines_material",
+                                                      "object_id", "material_id"}));
+}
+
+// frame_buffer_bytes counts exactly the buffers a renderer holds after a frame.
+TEST(Renderer, FrameBufferBytesCountTheBuffersRendererHolds) {
+    Scene s = load("spot.obj");
+    TriangleAccel accel;
+    accel.build(s.positions, s.tri_positions);
+    struct Case {
+        EdgeMode mode;
+        int samples;
+        float line_width;
+    };
+    // The last case draws lines so wide that the full distance image is used.
+    for (const Case& c : {Case{EdgeMode::Classic, 1, 2.0f}, Case{EdgeMode::Robust, 1, 2.0f},
+                          Case{EdgeMode::Robust, 4, 2.0f}, Case{EdgeMode::Robust, 9, 2.0f},
+                          Case{EdgeMode::Robust, 4, 100.0f}}) {
+        RenderSettings settings;
+        settings.edges = c.mode;
+        settings.samples = c.samples;
+        settings.lines.width = c.line_width;
+        settings.width = 96;
+        settings.height = 720;  // tall enough that 100-pixel lines need the full distance image
+        settings.feature_images = true;
+        const CameraSpec cam = framing_camera(s, settings);
+        Renderer r;
+        const ImageRgb8& out = r.render(s, accel, cam, settings);
+        const GBuffer& g = r.gbuffer();
+        std::uint64_t held = bytes_of(out) + bytes_of(g.distance) + bytes_of(g.normal) + bytes_of(g.view_depth) +
+                             bytes_of(g.geometric_normal) + bytes_of(g.colour) + bytes_of(g.material) +
+                             bytes_of(g.object) + bytes_of(r.line_seeds());
+        std::uint64_t features = 0;
+        for (const FeatureImage& f : feature_images())
+            features += std::visit([&](auto m) { return bytes_of(r.aovs().*m); }, f.image);
+        held += features;
+        const bool full_distance = c.line_width > 50.0f;
+        if (full_distance) {
+            EXPECT_GT(line_distance_band(line_thickness(c.line_width, settings.height, 2)), kMaxDistanceBand);
+            held += bytes_of(g.colour) / sizeof(Vec3f) * sizeof(float);  // allocated while resolving
         }
-        for (EdgeMode mode : {EdgeMode::Classic, EdgeMode::Robust}) {
-            o.settings.edges = mode;
-            Warnings w;
-            FileRenderer fresh;
-            fresh.render(scene, dir / "fresh.png", o, w);
-            reused.render(scene, dir / "reused.png", o, w);
-            const DecodedPng a = read_png(dir / "fresh.png"), b = read_png(dir / "reused.png");
-            ASSERT_EQ(a.rgb.size(), b.rgb.size());
-            ASSERT_EQ(std::memcmp(a.rgb.data(), b.rgb.data(), a.rgb.size() * sizeof(Rgb8)), 0)
-                << "frame " << f << (mode == EdgeMode::Classic ? " classic" : " robust");
-        }
+        EXPECT_EQ(frame_buffer_bytes(settings), held) << c.samples;
+        // Without feature images: classic keeps the maps its lines come from, less cel.
+        settings.feature_images = false;
+        const std::uint64_t kept = c.mode == EdgeMode::Classic ? features - bytes_of(r.aovs().cel) : 0;
+        EXPECT_EQ(frame_buffer_bytes(settings), held - features + kept) << c.samples;
+    }
+    RenderSettings huge;
+    huge.width = huge.height = 2147483647;
+    huge.samples = 16;
+    EXPECT_EQ(frame_buffer_bytes(huge), UINT64_MAX);
+}
+
+TEST(Renderer, SampleCountsAreSquareGrids) {
+    EXPECT_EQ(samples_per_side(9), 3);
+    try {
+        (void)samples_per_side(5);
+        FAIL();
+    } catch (const Error& e) {
+        EXPECT_EQ(std::string(e.what()), "5 samples per pixel: must be 1, 4, 9 or 16 (a square grid per pixel)");
     }
 }

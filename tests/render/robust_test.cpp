@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <functional>
 #include <limits>
 #include <set>
@@ -32,6 +33,7 @@ void render(Frame& f, const Scene& scene) {
     TriangleAccel accel;
     accel.build(scene.positions, scene.tri_positions);
     f.view = make_view_plane(f.camera, f.settings.width, f.settings.height);
+    f.settings.feature_images = true;  // coverage() reads the line coverage image
     f.renderer.render(scene, accel, f.camera, f.settings);
 }
 
@@ -417,6 +419,12 @@ TEST(RobustLines, ParsesLineTypes) {
     EXPECT_EQ(parse_line_types("none"), 0u);
     EXPECT_EQ(parse_line_types("silhouette,crease"), static_cast<unsigned>(kLineSilhouette | kLineCrease));
     EXPECT_THROW(parse_line_types("silhouette,outline"), Error);
+    try {
+        (void)parse_line_types("silhouette,outline");
+    } catch (const Error& e) {
+        EXPECT_EQ(std::string(e.what()), "unknown line type 'outline' (choose from silhouette, crease, depth, "
+                                         "object, material, all, none)");
+    }
 }
 
 TEST(RobustLines, DistanceTransformIsExact) {
@@ -658,8 +666,14 @@ TEST(RobustLines, ResolvingMatchesThePerPixelReference) {
                 ImageGray8 lines_ref, lines_a, lines_b;
                 distance_to_seeds(seeds, distance, 1);
                 reference_resolve(colour, distance, thickness, sub, line_colour, final_ref, cel_ref, lines_ref);
-                resolve_lines(colour, distance, thickness, sub, line_colour, final_a, cel_a, lines_a, threads);
-                resolve_lines_from_seeds(colour, seeds, thickness, sub, line_colour, final_b, cel_b, lines_b, threads);
+                resolve_lines(colour, distance, thickness, sub, line_colour, final_a, &cel_a, &lines_a, threads);
+                resolve_lines_from_seeds(colour, seeds, thickness, sub, line_colour, final_b, &cel_b, &lines_b, threads);
+                // Without the feature outputs, the same final image.
+                ImageRgb8 final_alone;
+                resolve_lines_from_seeds(colour, seeds, thickness, sub, line_colour, final_alone, nullptr, nullptr,
+                                         threads);
+                ASSERT_EQ(final_alone.size(), final_b.size());
+                ASSERT_EQ(0, std::memcmp(final_alone.data(), final_b.data(), final_b.size() * sizeof(Rgb8)));
                 for (const ImageRgb8* image : {&final_a, &cel_a, &final_b, &cel_b}) {
                     ASSERT_EQ(image->width(), w);
                     ASSERT_EQ(image->height(), h);

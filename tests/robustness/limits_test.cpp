@@ -97,9 +97,16 @@ TEST(LimitValues, DefaultsAreDocumented) {
 }
 
 TEST(LimitValues, MemoryEstimatesSaturateInsteadOfOverflowing) {
-    EXPECT_EQ(frame_buffer_bytes(UINT64_MAX / 2, 16), UINT64_MAX);
+    RenderSettings huge;
+    huge.width = huge.height = 2147483647;
+    huge.samples = 16;
+    EXPECT_EQ(frame_buffer_bytes(huge), UINT64_MAX);
     EXPECT_EQ(scene_bytes(UINT64_MAX, UINT64_MAX), UINT64_MAX);
-    EXPECT_GT(frame_buffer_bytes(1280 * 720, 4), 1280u * 720u * 196u);  // measured: 196 bytes/pixel
+    FrameOptions hd;  // measured with feature images: 196 bytes/pixel
+    hd.settings.width = 1280;
+    hd.settings.height = 720;
+    hd.aov_dir = "aov";
+    EXPECT_GT(frame_bytes(hd), 1280u * 720u * 196u);
 }
 
 // --- read_file ---------------------------------------------------------------------------
@@ -274,26 +281,33 @@ TEST(PngLimits, HeaderAnnouncingAHugeImageIsRefusedBeforeAllocating) {
 }
 
 TEST(FrameLimits, PlanChecksPixelsAndMemoryAndFitsJobsToMemory) {
-    RenderSettings s;
+    FrameOptions o;
+    RenderSettings& s = o.settings;
     s.width = 1920;
     s.height = 1080;
     {
         ScopedLimits l([](Limits& x) { x.max_memory = 8 * kGiB; });
-        FramePlan p = plan_frame_jobs(s, 3, 100);
+        FramePlan p = plan_frame_jobs(o, 3, 100);
         EXPECT_EQ(p.jobs, 3);
-        EXPECT_EQ(plan_frame_jobs(s, 8, 2).jobs, 2);  // never more jobs than frames
+        EXPECT_EQ(plan_frame_jobs(o, 8, 2).jobs, 2);  // never more jobs than frames
     }
     {
         // Room for two frames: an automatic job count takes two, an explicit 4 is an error.
-        const std::uint64_t frame = frame_buffer_bytes(1920ull * 1080, s.samples);
+        const std::uint64_t frame = frame_bytes(o);
         ScopedLimits l([&](Limits& x) { x.max_memory = 2 * frame + frame / 2; });
-        EXPECT_EQ(plan_frame_jobs(s, 0, 100).jobs, std::min(2, hardware_threads()));
-        EXPECT_NE(error_of([&] { plan_frame_jobs(s, 4, 100); }).find("render fewer at once with --jobs"), std::string::npos);
+        EXPECT_EQ(plan_frame_jobs(o, 0, 100).jobs, std::min(2, hardware_threads()));
+        EXPECT_NE(error_of([&] { plan_frame_jobs(o, 4, 100); }).find("render fewer frames at once"), std::string::npos);
     }
     s.width = 10000;
     s.height = 10000;
-    EXPECT_EQ(error_of([&] { plan_frame_jobs(s, 1, 1); }),
-              "--size 10000x10000: 100000000 pixels, more than the limit of 67108864 (--max-image-pixels raises it)");
+    EXPECT_EQ(error_of([&] { plan_frame_jobs(o, 1, 1); }),
+              "image size 10000x10000: 100000000 pixels, more than the limit of 67108864");
+    try {
+        plan_frame_jobs(o, 1, 1);
+        FAIL();
+    } catch (const LimitError& e) {
+        EXPECT_EQ(e.limit(), Limit::ImagePixels);
+    }
 }
 
 TEST(FrameLimits, FrameRangesAreCheckedBeforeAllocating) {

@@ -2,14 +2,14 @@
 /// Batch rendering of numbered frames: `toonray batch keys 1 2229`.
 
 #include <atomic>
-#include <cstdint>
 #include <filesystem>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "toonray/anim/frame_pattern.h"
-#include "toonray/render/render_file.h"
+#include "toonray/anim/frame_scheduler.h"
+#include "toonray/frame/frame_renderer.h"
 
 namespace toonray {
 
@@ -21,7 +21,7 @@ struct Shard {
     int count = 1;
 };
 
-/// Parses "K/N" with 1 <= K <= N. Throws Error.
+/// Parses "K/N" with 1 <= K <= N. Throws Error ("shard 'TEXT': ...").
 Shard parse_shard(const std::string& text);
 
 /// The shard from a Slurm job array: K = SLURM_ARRAY_TASK_ID - SLURM_ARRAY_TASK_MIN + 1 and
@@ -33,18 +33,6 @@ std::optional<Shard> shard_from_environment();
 /// or when there would be more than limits().max_frames (checked before allocating).
 std::vector<int> shard_frames(int first, int last, const Shard& shard);
 
-/// Frames rendered at once within the limits (docs/robustness.md).
-struct FramePlan {
-    int jobs = 1;                  ///< frames in flight
-    std::uint64_t frame_bytes = 0; ///< estimated frame buffers of one frame
-};
-
-/// Checks the image size against limits().max_image_pixels and the frame buffers of the frames
-/// in flight against limits().max_memory. `requested` jobs, 0 = one per core: then as many as
-/// fit (at least 1); an explicit number that does not fit is an Error, as is one frame that
-/// does not fit. Never more jobs than `frames`.
-FramePlan plan_frame_jobs(const RenderSettings& settings, int requested, std::size_t frames);
-
 struct BatchOptions {
     std::string name;  ///< animation name, e.g. "keys"
     int first = 1, last = 1;
@@ -52,35 +40,12 @@ struct BatchOptions {
     std::filesystem::path output_dir = ".";
     std::optional<std::string> input_pattern;  ///< default: see default_input_patterns()
     std::optional<std::string> output_pattern; ///< default: NAME_%06d.png
-    FileRenderOptions render;
+    FrameOptions render;
     int jobs = 0;  ///< frames rendered at once; 0 = one per hardware thread
     bool resume = false;     ///< skip frames whose PNG exists and is valid
     bool fail_fast = false;  ///< stop at the first failed frame
     Shard shard;
     const std::atomic<bool>* cancel = nullptr;  ///< set (e.g. by SIGINT) to stop cleanly
-};
-
-enum class FrameStatus { Rendered, Skipped, Failed };
-
-struct FrameFailure {
-    int frame = 0;
-    std::string message;  ///< names the file and line when the input was bad
-};
-
-struct BatchReport {
-    int total = 0;  ///< frames in this shard
-    int rendered = 0, skipped = 0, failed = 0;
-    bool cancelled = false;
-    std::vector<FrameFailure> failures;  ///< sorted by frame
-    double seconds = 0.0;
-};
-
-/// Receives progress from the worker threads (calls are serialised).
-class BatchObserver {
-public:
-    virtual ~BatchObserver() = default;
-    virtual void frame_done(int frame, FrameStatus status, const std::string& message) = 0;
-    virtual void warning(int frame, const std::string& message) = 0;
 };
 
 /// Renders the frames. Frames that fail are reported and the rest go on (unless fail_fast).

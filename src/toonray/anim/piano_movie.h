@@ -3,8 +3,8 @@
 /// along a camera path, with its soundtrack and the finished movie.
 ///
 /// Frame i (1-based, as the seed's `keys 1 2229`) shows score time start + (i - 1) / fps.
-/// In memory, each job poses its own copy of the piano and refits its BVH (the triangles never
-/// change); with --export-obj it writes the seed's files instead, one OBJ + MTL per frame with
+/// In memory, each job poses its own copy of the piano and renders it (refitting its BVH, see
+/// AnimationAccel); exporting, it writes the seed's files instead, one OBJ + MTL per frame with
 /// the camera block, which `toonray batch` renders to the same images.
 
 #include <atomic>
@@ -15,7 +15,7 @@
 
 #include "toonray/anim/batch.h"
 #include "toonray/anim/camera_path.h"
-#include "toonray/render/render_file.h"
+#include "toonray/frame/frame_renderer.h"
 #include "toonray/score/score.h"
 
 namespace toonray {
@@ -35,7 +35,7 @@ struct PianoMovieOptions {
     std::filesystem::path output_dir; ///< PNG frames go here
     /// Write OBJ + MTL frames here instead of rendering PNGs.
     std::optional<std::filesystem::path> export_obj_dir;
-    FileRenderOptions render;         ///< size, lines, AOVs, PNG level; camera comes from the path
+    FrameOptions render;              ///< size, lines, AOVs, PNG level; camera comes from the path
     int jobs = 0;                     ///< frames at once; 0 = one per core
     bool resume = false;              ///< skip frames whose PNG is already valid
     const std::atomic<bool>* cancel = nullptr;
@@ -52,8 +52,8 @@ struct PianoMovieReport {
 /// Saturates at INT_MAX instead of overflowing.
 int frame_count(double seconds, double fps);
 
-/// frame_count, checked against limits().max_frames: throws Error("S s at F fps: N frames is
-/// more than the limit of M") when a score or --seconds asks for too many.
+/// frame_count, checked against limits().max_frames: throws LimitError("S s at F fps: N frames
+/// is more than the limit of M") when a score or a length asks for too many.
 int checked_frame_count(double seconds, double fps);
 
 /// Renders (or exports) the frames. Throws Error for whole-run problems (bad options, an

@@ -78,18 +78,6 @@ const Limits& limits() { return process_limits(); }
 
 void set_limits(const Limits& limits) { process_limits() = limits; }
 
-std::uint64_t frame_buffer_bytes(std::uint64_t pixels, int samples) {
-    // Measured peak (maximum resident size) of `toonray render` at 2048x2048, less the scene:
-    // 58 bytes per pixel in classic mode, 72 / 196 / 688 at 1 / 4 / 16 samples in robust mode,
-    // so about 31 per pixel plus 41 per sample. Per sample: depth, view depth, material,
-    // object, line seeds and distances, normals and colour; per pixel: the feature images, the
-    // final image, the PNG filter buffer and its compressed copy. Rounded up by ~20%.
-    const std::uint64_t per_sample = 48;
-    const std::uint64_t per_pixel = 40;
-    const std::uint64_t s = samples < 1 ? 1 : static_cast<std::uint64_t>(samples);
-    return mul_sat(pixels, add_sat(mul_sat(per_sample, s), per_pixel));
-}
-
 std::uint64_t scene_bytes(std::uint64_t vertices, std::uint64_t triangles) {
     // Per vertex: the position and, at worst, a normal and a texture coordinate. Per triangle:
     // 5 index arrays (44 bytes), the BVH build (boxes, centres, indices, nodes: ~100 bytes),

@@ -63,7 +63,68 @@ Vec3f default_light(const Scene& scene, const ViewPlane& view) {
 int samples_per_side(int samples) {
     for (int sub = 1; sub <= 4; ++sub)
         if (sub * sub == samples) return sub;
-    throw Error(fmt::format("--samples {}: must be 1, 4, 9 or 16 (a square grid per pixel)", samples));
+    throw Error(fmt::format("{} samples per pixel: must be 1, 4, 9 or 16 (a square grid per pixel)", samples));
+}
+
+std::span<const FeatureImage> feature_images() {
+    static const FeatureImage kImages[] = {
+        {"depth", true, true, &Aovs::depth},
+        {"normal", true, true, &Aovs::normal},
+        {"edges_depth", true, false, &Aovs::edges_depth},
+        {"edges_normal", true, false, &Aovs::edges_normal},
+        {"edges", true, true, &Aovs::edges},
+        {"cel", true, true, &Aovs::cel},
+        {"lines_silhouette", false, true, &Aovs::lines_silhouette},
+        {"lines_crease", false, true, &Aovs::lines_crease},
+        {"lines_depth", false, true, &Aovs::lines_depth},
+        {"lines_object", false, true, &Aovs::lines_object},
+        {"lines_material", false, true, &Aovs::lines_material},
+        {"object_id", false, true, &Aovs::object_id},
+        {"material_id", false, true, &Aovs::material_id},
+    };
+    return kImages;
+}
+
+namespace {
+
+std::uint64_t add_saturated(std::uint64_t a, std::uint64_t b) { return a > UINT64_MAX - b ? UINT64_MAX : a + b; }
+std::uint64_t mul_saturated(std::uint64_t a, std::uint64_t b) {
+    return a != 0 && b > UINT64_MAX / a ? UINT64_MAX : a * b;
+}
+
+// Bytes per pixel of the feature images of a line mode, from the table.
+std::uint64_t feature_bytes_per_pixel(EdgeMode mode) {
+    std::uint64_t bytes = 0;
+    for (const FeatureImage& f : feature_images())
+        if (f.in(mode)) bytes += std::holds_alternative<ImageRgb8 Aovs::*>(f.image) ? sizeof(Rgb8) : 1;
+    return bytes;
+}
+
+}  // namespace
+
+std::uint64_t frame_buffer_bytes(const RenderSettings& settings) {
+    const std::uint64_t pixels = mul_saturated(static_cast<std::uint64_t>(std::max(settings.width, 0)),
+                                               static_cast<std::uint64_t>(std::max(settings.height, 0)));
+    const std::uint64_t final_image = sizeof(Rgb8);
+    // Per sample, the G-buffer of prepare_gbuffer: colour, material and object, and the mode's
+    // depth and normal.
+    const std::uint64_t gbuffer = sizeof(float) + sizeof(Vec3f) + sizeof(Vec3f) + 2 * sizeof(std::uint32_t);
+    if (settings.edges == EdgeMode::Classic) {
+        // The maps the lines are drawn from (depth, normal, edges_depth, edges_normal, edges);
+        // cel only as a feature image.
+        const std::uint64_t maps = 1 + sizeof(Rgb8) + 3;
+        const std::uint64_t per_pixel =
+            gbuffer + maps + final_image + (settings.feature_images ? sizeof(Rgb8) : 0);
+        return mul_saturated(pixels, per_pixel);
+    }
+    const std::uint64_t samples = static_cast<std::uint64_t>(std::max(settings.samples, 1));
+    const int sub = samples_per_side(settings.samples);
+    const float thickness = line_thickness(settings.lines.width, settings.height, sub);
+    const std::uint64_t per_sample =
+        gbuffer + 1 /* line seed */ + (line_distance_band(thickness) > kMaxDistanceBand ? sizeof(float) : 0);
+    const std::uint64_t per_pixel =
+        final_image + (settings.feature_images ? feature_bytes_per_pixel(EdgeMode::Robust) : 0);
+    return mul_saturated(pixels, add_saturated(mul_saturated(per_sample, samples), per_pixel));
 }
 
 void prepare_gbuffer(GBuffer& g, int width, int height, int sub, EdgeMode mode) {
@@ -149,12 +210,18 @@ void Renderer::trace(const Scene& scene, const TriangleAccel& accel, const ViewP
                   [&](const SampleTile& t) { shade_tile(shading, view, settings, t, gbuffer_); });
 }
 
+const Aovs& Renderer::aovs() const {
+    static const Aovs kNone;
+    return feature_images_ ? aovs_ : kNone;
+}
+
 const ImageRgb8& Renderer::render(const Scene& scene, const TriangleAccel& accel,
                                   const CameraSpec& camera, const RenderSettings& settings,
                                   const TextureSet* textures) {
     ViewPlane view = make_view_plane(camera, settings.width, settings.height);
     light_ = settings.light ? *settings.light : default_light(scene, view);
     lights_ = settings.shading.lights;
+    feature_images_ = settings.feature_images;
     if (lights_.empty()) lights_.push_back(Light{Light::Kind::Point, light_, 1.0f});
     if (settings.edges == EdgeMode::Classic) {
         trace(scene, accel, view, settings, 1, textures);
@@ -173,7 +240,7 @@ void Renderer::render_classic(const RenderSettings& settings) {
     sobel_edges(aovs_.depth, settings.depth_threshold, aovs_.edges_depth, threads);
     sobel_edges(aovs_.normal, settings.normal_threshold, aovs_.edges_normal, threads);
     merge_edges(aovs_.edges_depth, aovs_.edges_normal, aovs_.edges);
-    compose_lines(gbuffer_.colour, aovs_.edges, final_, threads, &aovs_.cel);
+    compose_lines(gbuffer_.colour, aovs_.edges, final_, threads, settings.feature_images ? &aovs_.cel : nullptr);
 }
 
 void Renderer::render_robust(const RenderSettings& settings) {
@@ -183,9 +250,10 @@ void Renderer::render_robust(const RenderSettings& settings) {
     find_line_seeds(fine, settings.lines, seeds_, threads);
     float thickness = line_thickness(settings.lines.width, settings.height, g.sub);
     // Distance to the seeds and line coverage in one banded pass: no full-size distance image.
-    resolve_lines_from_seeds(g.colour, seeds_, thickness, g.sub, settings.lines.colour, final_, aovs_.cel,
-                             aovs_.edges, threads);
-    robust_feature_images(g, seeds_, aovs_, threads);
+    const bool features = settings.feature_images;
+    resolve_lines_from_seeds(g.colour, seeds_, thickness, g.sub, settings.lines.colour, final_,
+                             features ? &aovs_.cel : nullptr, features ? &aovs_.edges : nullptr, threads);
+    if (features) robust_feature_images(g, seeds_, aovs_, threads);
 }
 
 }  // namespace toonray

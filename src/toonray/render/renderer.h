@@ -1,7 +1,11 @@
 #pragma once
 /// Renders a scene to a cel-shaded, outlined image and its feature images (AOVs).
 
+#include <cstdint>
 #include <optional>
+#include <span>
+#include <string_view>
+#include <variant>
 
 #include "toonray/accel/triangle_accel.h"
 #include "toonray/core/image.h"
@@ -31,9 +35,12 @@ struct RenderSettings {
     RobustLineSettings lines;       ///< robust: line types, thresholds, width, colour
     int samples = 4;                ///< robust: samples per pixel on a regular grid (1, 4, 9 or 16)
     int threads = 0;                ///< 0 = all hardware threads
+    /// Also compute the feature images (Renderer::aovs). The final image is the same either way.
+    bool feature_images = false;
 };
 
-/// Sub-samples per pixel side for a sample count: 1, 4, 9, 16 -> 1, 2, 3, 4. Throws Error otherwise.
+/// Sub-samples per pixel side for a sample count: 1, 4, 9, 16 -> 1, 2, 3, 4. Throws Error
+/// ("N samples per pixel: ...") otherwise.
 int samples_per_side(int samples);
 
 /// Per-sample results of the primary rays. Classic mode fills distance and normal; robust mode
@@ -50,7 +57,7 @@ struct GBuffer {
 };
 
 /// Feature images a user tunes thresholds with; all 8-bit. Which are filled depends on the
-/// line mode (see aov names in render_file.h).
+/// line mode (see feature_images()).
 struct Aovs {
     ImageGray8 depth;         ///< lighter = farther
     ImageRgb8 normal;
@@ -61,6 +68,28 @@ struct Aovs {
     ImageGray8 lines_silhouette, lines_crease, lines_depth, lines_object, lines_material;  ///< robust
     ImageRgb8 object_id, material_id;  ///< robust: ids in false colour
 };
+
+/// One feature image of Aovs: its name, the line modes that fill it, and which member it is.
+struct FeatureImage {
+    std::string_view name;
+    bool classic;  ///< filled in EdgeMode::Classic
+    bool robust;   ///< filled in EdgeMode::Robust
+    std::variant<ImageGray8 Aovs::*, ImageRgb8 Aovs::*> image;
+
+    [[nodiscard]] bool in(EdgeMode mode) const { return mode == EdgeMode::Classic ? classic : robust; }
+};
+
+/// Every feature image, in the order they are listed and written. Classic: depth, normal,
+/// edges_depth, edges_normal, edges (merged, before blur), cel. Robust: depth, normal, edges
+/// (line coverage), cel, lines_silhouette, lines_crease, lines_depth, lines_object,
+/// lines_material, object_id, material_id.
+std::span<const FeatureImage> feature_images();
+
+/// Bytes of the buffers Renderer keeps for a frame with `settings`: the G-buffer at the mode's
+/// samples, the line seeds and (for very wide lines) the full distance image in robust mode,
+/// classic mode's maps, the final image, and the feature images when settings.feature_images
+/// asks for them. Per-thread scratch rows and tiles are not counted. Saturates at UINT64_MAX.
+[[nodiscard]] std::uint64_t frame_buffer_bytes(const RenderSettings& settings);
 
 /// Sizes the G-buffer for a frame of width x height pixels with sub x sub samples each, for
 /// `mode`'s buffers. The contents are left unspecified until shade_tile has covered every sample.
@@ -80,9 +109,10 @@ public:
     const ImageRgb8& render(const Scene& scene, const TriangleAccel& accel, const CameraSpec& camera,
                             const RenderSettings& settings, const TextureSet* textures = nullptr);
 
-    /// Valid after render(): the G-buffer and AOVs of the last frame.
+    /// Valid after render(): the G-buffer of the last frame.
     [[nodiscard]] const GBuffer& gbuffer() const { return gbuffer_; }
-    [[nodiscard]] const Aovs& aovs() const { return aovs_; }
+    /// The feature images of the last frame; all empty unless its settings.feature_images.
+    [[nodiscard]] const Aovs& aovs() const;
     /// The single point light of the last frame (settings.light or the default).
     [[nodiscard]] Vec3f light() const { return light_; }
     /// All lights of the last frame.
@@ -97,7 +127,8 @@ private:
     void render_robust(const RenderSettings& settings);
 
     GBuffer gbuffer_;
-    Aovs aovs_;
+    Aovs aovs_;  ///< classic mode draws its lines from depth, normal and edges* here
+    bool feature_images_ = false;
     ImageRgb8 final_;
     Image<std::uint8_t> seeds_;
     Vec3f light_;

@@ -363,10 +363,11 @@ public:
     // sum * (1 / n), a = covered * (1 / n), final = colour * (1 - a) + line_colour * a (the
     // same float operations as with Vec3f), each to_byte'd. One loop per plane keeps each
     // loop's possible overlaps few enough for GCC to vectorise it.
-    void write(int y, int sub, const Vec3f& line_colour, ImageRgb8& final_image, ImageRgb8& cel, ImageGray8& lines) {
+    void write(int y, int sub, const Vec3f& line_colour, ImageRgb8& final_image, ImageRgb8* cel, ImageGray8* lines) {
         const float inv_n = 1.0f / static_cast<float>(sub * sub);
         const std::size_t w = covered_.size();
-        // The arithmetic, into planes: final r, g, b, cel r, g, b, lines ...
+        // The arithmetic, into planes: final r, g, b, then (for the feature images) cel r, g,
+        // b and lines ...
         const float *red = red_.data(), *green = green_.data(), *blue = blue_.data(), *covered = covered_.data();
         const Vec3f line = line_colour;
         auto a = [&](std::size_t x) { return covered[x] * inv_n; };
@@ -374,21 +375,29 @@ public:
         fill_plane(plane(0), w, [&](std::size_t x) { return red[x] * inv_n * (1.0f - a(x)) + line.x * a(x); });
         fill_plane(plane(1), w, [&](std::size_t x) { return green[x] * inv_n * (1.0f - a(x)) + line.y * a(x); });
         fill_plane(plane(2), w, [&](std::size_t x) { return blue[x] * inv_n * (1.0f - a(x)) + line.z * a(x); });
-        fill_plane(plane(3), w, [&](std::size_t x) { return red[x] * inv_n; });
-        fill_plane(plane(4), w, [&](std::size_t x) { return green[x] * inv_n; });
-        fill_plane(plane(5), w, [&](std::size_t x) { return blue[x] * inv_n; });
-        fill_plane(plane(6), w, [&](std::size_t x) { return 1.0f - a(x); });
+        int planes = 3;
+        if (cel) {
+            fill_plane(plane(3), w, [&](std::size_t x) { return red[x] * inv_n; });
+            fill_plane(plane(4), w, [&](std::size_t x) { return green[x] * inv_n; });
+            fill_plane(plane(5), w, [&](std::size_t x) { return blue[x] * inv_n; });
+            planes = 6;
+        }
+        const int lines_plane = planes;
+        if (lines) {
+            fill_plane(plane(lines_plane), w, [&](std::size_t x) { return 1.0f - a(x); });
+            ++planes;
+        }
         // ... converted to bytes ...
         std::uint8_t* byte = bytes_.data();
-        to_bytes(values_.data(), values_.size(), byte);
+        to_bytes(values_.data(), static_cast<std::size_t>(planes) * w, byte);
         // ... and interleaved into RGB.
         Rgb8* __restrict final_row = final_image.row(y);
-        Rgb8* __restrict cel_row = cel.row(y);
-        for (std::size_t x = 0; x < w; ++x) {
-            final_row[x] = {byte[x], byte[w + x], byte[2 * w + x]};
-            cel_row[x] = {byte[3 * w + x], byte[4 * w + x], byte[5 * w + x]};
+        for (std::size_t x = 0; x < w; ++x) final_row[x] = {byte[x], byte[w + x], byte[2 * w + x]};
+        if (cel) {
+            Rgb8* __restrict cel_row = cel->row(y);
+            for (std::size_t x = 0; x < w; ++x) cel_row[x] = {byte[3 * w + x], byte[4 * w + x], byte[5 * w + x]};
         }
-        std::copy(byte + 6 * w, byte + 7 * w, lines.row(y));
+        if (lines) std::copy(byte + lines_plane * w, byte + (lines_plane + 1) * w, lines->row(y));
     }
 
 private:
@@ -426,10 +435,10 @@ struct LineReach {
     float reach, reach_squared;
 };
 
-void size_resolved_outputs(int w, int h, ImageRgb8& final_image, ImageRgb8& cel, ImageGray8& lines) {
+void size_resolved_outputs(int w, int h, ImageRgb8& final_image, ImageRgb8* cel, ImageGray8* lines) {
     size_for_overwrite(final_image, w, h);
-    size_for_overwrite(cel, w, h);
-    size_for_overwrite(lines, w, h);
+    if (cel) size_for_overwrite(*cel, w, h);
+    if (lines) size_for_overwrite(*lines, w, h);
 }
 
 }  // namespace
@@ -447,8 +456,8 @@ unsigned parse_line_types(const std::string& text) {
         else if (item == "object") types |= kLineObject;
         else if (item == "material") types |= kLineMaterial;
         else
-            throw Error(fmt::format("--lines: unknown line type '{}' (choose from silhouette, crease, "
-                                    "depth, object, material, all, none)", item));
+            throw Error(fmt::format("unknown line type '{}' (choose from silhouette, crease, depth, "
+                                    "object, material, all, none)", item));
     }
     return types;
 }
@@ -543,7 +552,7 @@ float line_thickness(float width, int height, int sub) {
 }
 
 void resolve_lines(const Image<Vec3f>& fine_colour, const ImageF& squared_distance, float thickness, int sub,
-                   const Vec3f& line_colour, ImageRgb8& final_image, ImageRgb8& cel, ImageGray8& lines,
+                   const Vec3f& line_colour, ImageRgb8& final_image, ImageRgb8* cel, ImageGray8* lines,
                    int threads) {
     const int w = fine_colour.width() / sub, h = fine_colour.height() / sub;
     size_resolved_outputs(w, h, final_image, cel, lines);
@@ -563,9 +572,16 @@ void resolve_lines(const Image<Vec3f>& fine_colour, const ImageF& squared_distan
     });
 }
 
+int line_distance_band(float thickness) {
+    const LineReach reach(thickness);
+    int band = 0;
+    while (band <= kMaxDistanceBand && static_cast<float>((band + 1) * (band + 1)) < reach.reach_squared) ++band;
+    return band;
+}
+
 void resolve_lines_from_seeds(const Image<Vec3f>& fine_colour, const Image<std::uint8_t>& seeds, float thickness,
-                              int sub, const Vec3f& line_colour, ImageRgb8& final_image, ImageRgb8& cel,
-                              ImageGray8& lines, int threads) {
+                              int sub, const Vec3f& line_colour, ImageRgb8& final_image, ImageRgb8* cel,
+                              ImageGray8* lines, int threads) {
     const LineReach reach(thickness);
     // Why the banded distance gives the same bytes: a sample is covered only where
     // d^2 < reach^2 (compared as floats, d^2 an integer). Take band as the largest integer
@@ -573,8 +589,7 @@ void resolve_lines_from_seeds(const Image<Vec3f>& fine_colour, const Image<std::
     // then equals d^2 at every covered sample (d^2 < reach^2 <= (band + 1)^2), and at every
     // other one it is at least reach^2 (both d^2 and (band + 1)^2 are), so it stays
     // uncovered. Coverage, and so every output byte, is the same as with the exact distance.
-    int band = 0;
-    while (band <= kMaxDistanceBand && static_cast<float>((band + 1) * (band + 1)) < reach.reach_squared) ++band;
+    const int band = line_distance_band(thickness);
     if (band > kMaxDistanceBand) {  // very wide lines: the linear-time full transform is faster
         ImageF squared_distance;
         distance_to_seeds(seeds, squared_distance, threads);

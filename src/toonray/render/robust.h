@@ -22,7 +22,8 @@ enum LineType : unsigned {
     kLineAll = 31u,
 };
 
-/// Parses "silhouette,crease,depth,object,material" (any subset, or "all" / "none").
+/// Parses "silhouette,crease,depth,object,material" (any subset, or "all" / "none"). Throws
+/// Error ("unknown line type '...' ...").
 unsigned parse_line_types(const std::string& text);
 
 struct RobustLineSettings {
@@ -74,18 +75,23 @@ float line_thickness(float width, int height, int sub);
 /// clamp(thickness / 2 + 0.5 - d, 0, 1), which integrates to exactly `thickness` across a
 /// straight line, so widths scale smoothly with resolution; a pixel's coverage is the mean
 /// over its samples, and its colour the mean fine colour. Writes
-/// final = colour * (1 - coverage) + line * coverage, the mean colour (`cel`) and the
-/// coverage as 8-bit (`lines`, 255 = no line: black lines on white).
+/// final = colour * (1 - coverage) + line * coverage and, where not null, the mean colour
+/// (`cel`) and the coverage as 8-bit (`lines`, 255 = no line: black lines on white).
 void resolve_lines(const Image<Vec3f>& fine_colour, const ImageF& squared_distance, float thickness, int sub,
-                   const Vec3f& line_colour, ImageRgb8& final_image, ImageRgb8& cel, ImageGray8& lines,
+                   const Vec3f& line_colour, ImageRgb8& final_image, ImageRgb8* cel, ImageGray8* lines,
                    int threads);
 
+/// The band of distance_to_seeds_banded that covers every fine pixel a line of `thickness`
+/// reaches. Above kMaxDistanceBand, resolve_lines_from_seeds uses the full distance image.
+int line_distance_band(float thickness);
+
 /// Exactly distance_to_seeds followed by resolve_lines (the same bytes), without the full-size
-/// distance image: strips of rows get their distances from distance_to_seeds_banded's method,
-/// over the few pixels a line can reach (see robust.cpp for why that is exact).
+/// distance image unless line_distance_band(thickness) > kMaxDistanceBand: strips of rows get
+/// their distances from distance_to_seeds_banded's method, over the few pixels a line can reach
+/// (see robust.cpp for why that is exact).
 void resolve_lines_from_seeds(const Image<Vec3f>& fine_colour, const Image<std::uint8_t>& seeds, float thickness,
-                              int sub, const Vec3f& line_colour, ImageRgb8& final_image, ImageRgb8& cel,
-                              ImageGray8& lines, int threads);
+                              int sub, const Vec3f& line_colour, ImageRgb8& final_image, ImageRgb8* cel,
+                              ImageGray8* lines, int threads);
 
 /// One line type's seeds filtered down to pixels (255 = none, 0 = a seed in every sample), for AOVs.
 void resolve_seed_type(const Image<std::uint8_t>& seeds, unsigned type, int sub, ImageGray8& out, int threads);

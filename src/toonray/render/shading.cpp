@@ -5,9 +5,8 @@
 #include <fmt/format.h>
 #include <sstream>
 
+#include "toonray/core/error.h"
 #include "toonray/core/parse.h"
-#include "toonray/io/file.h"
-#include "toonray/io/png.h"
 
 namespace toonray {
 namespace {
@@ -50,15 +49,16 @@ Vec3f sample_texture(const ImageRgb8& tex, float u, float v) {
 ToonRamp parse_ramp(const std::string& text) {
     auto at = text.find('@');
     ToonRamp ramp;
-    ramp.levels = parse_float_list(text.substr(0, at), "--ramp");
-    ramp.thresholds = at == std::string::npos ? std::vector<float>{} : parse_float_list(text.substr(at + 1), "--ramp");
-    if (ramp.levels.empty()) throw Error("--ramp: needs at least one level");
+    const std::string what = fmt::format("ramp '{}'", text);
+    ramp.levels = parse_float_list(text.substr(0, at), what);
+    ramp.thresholds = at == std::string::npos ? std::vector<float>{} : parse_float_list(text.substr(at + 1), what);
+    if (ramp.levels.empty()) throw Error(fmt::format("{}: needs at least one level", what));
     if (ramp.thresholds.size() + 1 != ramp.levels.size())
-        throw Error(fmt::format("--ramp '{}': {} levels need {} thresholds after '@', got {}", text,
+        throw Error(fmt::format("ramp '{}': {} levels need {} thresholds after '@', got {}", text,
                                 ramp.levels.size(), ramp.levels.size() - 1, ramp.thresholds.size()));
     for (std::size_t i = 1; i < ramp.thresholds.size(); ++i)
         if (!(ramp.thresholds[i] > ramp.thresholds[i - 1]))
-            throw Error(fmt::format("--ramp '{}': thresholds must increase", text));
+            throw Error(fmt::format("ramp '{}': thresholds must increase", text));
     return ramp;
 }
 
@@ -71,82 +71,18 @@ Light parse_light(const std::string& text) {
         light.kind = Light::Kind::Directional;
         body = body.substr(4);
     }
+    const std::string what = fmt::format("light '{}'", text);
     auto at = body.find('@');
     if (at != std::string::npos) {
-        auto v = parse_float_list(body.substr(at + 1), "--light");
-        if (v.size() != 1 || v[0] < 0) throw Error(fmt::format("--light '{}': intensity must be one number >= 0", text));
+        auto v = parse_float_list(body.substr(at + 1), what);
+        if (v.size() != 1 || v[0] < 0) throw Error(fmt::format("{}: intensity must be one number >= 0", what));
         light.intensity = v[0];
         body = body.substr(0, at);
     }
-    light.vector = parse_vec3(body, "--light");
+    light.vector = parse_vec3(body, what);
     if (light.kind == Light::Kind::Directional && !(length(light.vector) > 0))
-        throw Error(fmt::format("--light '{}': a directional light needs a non-zero direction", text));
+        throw Error(fmt::format("{}: a directional light needs a non-zero direction", what));
     return light;
-}
-
-std::vector<Light> parse_lights(std::string_view text, const std::string& file) {
-    std::vector<Light> lights;
-    std::string s(text);
-    std::stringstream in(s);
-    std::string line;
-    std::size_t number = 0;
-    while (std::getline(in, line)) {
-        ++number;
-        if (auto hash = line.find('#'); hash != std::string::npos) line.resize(hash);
-        std::stringstream words(line);
-        std::string kind;
-        if (!(words >> kind)) continue;
-        Light light;
-        if (kind == "point") light.kind = Light::Kind::Point;
-        else if (kind == "directional") light.kind = Light::Kind::Directional;
-        else throw_at(file, number, fmt::format("unknown light '{}' (point or directional)", kind));
-        std::vector<float> v;
-        std::string word;
-        while (words >> word) {
-            float f;
-            auto [p, ec] = std::from_chars(word.data(), word.data() + word.size(), f);
-            if (ec != std::errc() || p != word.data() + word.size() || !std::isfinite(f))
-                throw_at(file, number, fmt::format("malformed number '{}'", word));
-            v.push_back(f);
-        }
-        if (v.size() != 3 && v.size() != 4) throw_at(file, number, "expected x y z [intensity]");
-        light.vector = {v[0], v[1], v[2]};
-        if (v.size() == 4) {
-            if (v[3] < 0) throw_at(file, number, "intensity must not be negative");
-            light.intensity = v[3];
-        }
-        if (light.kind == Light::Kind::Directional && !(length(light.vector) > 0))
-            throw_at(file, number, "a directional light needs a non-zero direction");
-        lights.push_back(light);
-    }
-    if (lights.empty()) throw Error(fmt::format("{}: no lights", file));
-    return lights;
-}
-
-std::vector<Light> load_lights(const std::filesystem::path& path) {
-    return parse_lights(read_file(path), path.string());
-}
-
-void TextureSet::load(const Scene& scene, Warnings& warnings) {
-    textures_.assign(scene.materials.size(), nullptr);
-    for (std::size_t m = 0; m < scene.materials.size(); ++m) {
-        const std::string& path = scene.materials[m].map_kd;
-        if (path.empty()) continue;
-        if (auto it = cache_.find(path); it != cache_.end()) {
-            textures_[m] = it->second;
-            continue;
-        }
-        if (failed_.count(path)) continue;
-        try {
-            DecodedPng png = read_png(path);
-            auto image = std::make_shared<const ImageRgb8>(std::move(png.rgb));
-            cache_[path] = image;
-            textures_[m] = image;
-        } catch (const Error& e) {
-            failed_[path] = true;
-            warnings.push_back(fmt::format("material '{}': texture not used: {}", scene.materials[m].name, e.what()));
-        }
-    }
 }
 
 namespace {

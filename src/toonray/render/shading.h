@@ -5,14 +5,11 @@
 /// With the defaults (the seed's ramp, one point light, nothing optional) this is exactly the
 /// seed's cel shading: k = clamp(int(l.n * 16), 0, 15) into {0.5 x4, 0.75 x4, 1.0 x8}.
 
-#include <filesystem>
-#include <map>
 #include <memory>
 #include <string>
 #include <vector>
 
 #include "toonray/accel/triangle_accel.h"
-#include "toonray/core/error.h"
 #include "toonray/core/image.h"
 #include "toonray/core/math.h"
 #include "toonray/scene/scene.h"
@@ -32,7 +29,8 @@ struct ToonRamp {
     }
 };
 
-/// Parses "0.5,0.75,1.0@0.25,0.5": N levels, then N-1 increasing thresholds. Throws Error.
+/// Parses "0.5,0.75,1.0@0.25,0.5": N levels, then N-1 increasing thresholds. Throws Error
+/// ("ramp '...': ...").
 ToonRamp parse_ramp(const std::string& text);
 
 struct Light {
@@ -43,13 +41,9 @@ struct Light {
 };
 
 /// Parses "x,y,z" or "point:x,y,z" (a point light) or "dir:x,y,z" (a directional light,
-/// shining along the vector), each optionally followed by "@intensity". Throws Error.
+/// shining along the vector), each optionally followed by "@intensity". Throws Error
+/// ("light '...': ...").
 Light parse_light(const std::string& text);
-
-/// Reads a lights file: one light per line, `point x y z [intensity]` or
-/// `directional dx dy dz [intensity]`, `#` comments. Throws Error("file:line: ...").
-std::vector<Light> load_lights(const std::filesystem::path& path);
-std::vector<Light> parse_lights(std::string_view text, const std::string& file);
 
 struct ShadingSettings {
     ToonRamp ramp;
@@ -61,20 +55,14 @@ struct ShadingSettings {
     bool textures = true;       ///< multiply Kd by map_Kd where a material has one
 };
 
-/// Textures of a scene's materials, decoded once (index = material). A texture that is missing
-/// or not a PNG is reported once as a warning and left out (the material keeps its Kd).
-class TextureSet {
-public:
-    void load(const Scene& scene, Warnings& warnings);
-    [[nodiscard]] const ImageRgb8* get(std::uint32_t material) const {
-        return material < textures_.size() ? textures_[material].get() : nullptr;
-    }
+/// The decoded textures of a scene's materials, by material index; a material without one
+/// (or past the end) keeps its Kd. Shared, so that frames of an animation reuse one decode.
+using TextureSet = std::vector<std::shared_ptr<const ImageRgb8>>;
 
-private:
-    std::vector<std::shared_ptr<const ImageRgb8>> textures_;
-    std::map<std::string, std::shared_ptr<const ImageRgb8>> cache_;  ///< by path, kept across frames
-    std::map<std::string, bool> failed_;
-};
+/// The texture of material m in `textures`, or null.
+inline const ImageRgb8* texture_of(const TextureSet& textures, std::uint32_t m) {
+    return m < textures.size() ? textures[m].get() : nullptr;
+}
 
 /// Everything shading needs for one frame.
 struct ShadingContext {
@@ -126,7 +114,7 @@ Vec3f shade_hit(const ShadingContext& ctx, const Hit& hit, const Vec3f& eye, con
 
 /// The texture that multiplies material m's Kd in this frame, or null.
 inline const ImageRgb8* material_texture(const ShadingContext& ctx, std::uint32_t m) {
-    return ctx.settings.textures && ctx.textures ? ctx.textures->get(m) : nullptr;
+    return ctx.settings.textures && ctx.textures ? texture_of(*ctx.textures, m) : nullptr;
 }
 
 /// The frame's one point light when its shading is the seed's plain setup (one point light; no

@@ -1,0 +1,63 @@
+#pragma once
+/// One frame from a scene to its PNG files: build or refit the BVH, load the textures, render,
+/// and write the image and its feature images atomically. Between render (which does no file
+/// I/O) and the animation drivers; holds its BVH, textures and image buffers so that the frames
+/// of an animation reuse them.
+
+#include <cstdint>
+#include <filesystem>
+#include <optional>
+#include <string_view>
+
+#include "toonray/core/error.h"
+#include "toonray/frame/animation_accel.h"
+#include "toonray/frame/textures.h"
+#include "toonray/io/png.h"
+#include "toonray/render/renderer.h"
+#include "toonray/scene/camera.h"
+#include "toonray/scene/scene.h"
+
+namespace toonray {
+
+struct FrameOptions {
+    RenderSettings settings;  ///< settings.feature_images is set from aov_dir
+    std::optional<CameraSpec> camera;              ///< overrides the scene's camera block
+    std::optional<std::filesystem::path> aov_dir;  ///< write the feature images here
+    Bvh::Config bvh;
+    PngOptions png;
+
+    /// The settings a frame is rendered with: feature images exactly when they are written.
+    [[nodiscard]] RenderSettings render_settings() const;
+};
+
+/// The camera a frame uses: the override, else the scene's camera block, else an automatic one.
+CameraSpec choose_camera(const Scene& scene, const FrameOptions& options);
+
+/// The feature image file for an output and a feature name: `<dir>/<stem>_<name>.png`.
+std::filesystem::path aov_path(const std::filesystem::path& dir, const std::filesystem::path& output,
+                               std::string_view name);
+
+/// Memory of one frame in flight: the renderer's buffers (frame_buffer_bytes), the PNG encoding
+/// of the largest image written (filtered rows, the compressed bound and the file's bytes, and
+/// the compressor), with a fifth on top for per-thread scratch and allocator overhead.
+/// Saturates at UINT64_MAX.
+[[nodiscard]] std::uint64_t frame_bytes(const FrameOptions& options);
+
+class FrameRenderer {
+public:
+    /// Renders `scene` seen by `camera` to `output` (and, with options.aov_dir, its feature
+    /// images, created if missing). Throws Error for a bad camera (before anything is written)
+    /// or a failed write; texture problems are appended to `warnings`.
+    void render(const Scene& scene, const CameraSpec& camera, const std::filesystem::path& output,
+                const FrameOptions& options, Warnings& warnings);
+
+    [[nodiscard]] const Renderer& renderer() const { return renderer_; }
+    [[nodiscard]] const AnimationAccel& accel() const { return accel_; }
+
+private:
+    AnimationAccel accel_;
+    TextureCache textures_;
+    Renderer renderer_;
+};
+
+}  // namespace toonray

@@ -1,0 +1,56 @@
+#include "toonray/frame/lights.h"
+
+#include <charconv>
+#include <cmath>
+#include <fmt/format.h>
+#include <sstream>
+
+#include "toonray/core/error.h"
+#include "toonray/io/file.h"
+
+namespace toonray {
+
+std::vector<Light> parse_lights(std::string_view text, const std::string& file) {
+    std::vector<Light> lights;
+    std::string s(text);
+    std::stringstream in(s);
+    std::string line;
+    std::size_t number = 0;
+    while (std::getline(in, line)) {
+        ++number;
+        if (auto hash = line.find('#'); hash != std::string::npos) line.resize(hash);
+        std::stringstream words(line);
+        std::string kind;
+        if (!(words >> kind)) continue;
+        Light light;
+        if (kind == "point") light.kind = Light::Kind::Point;
+        else if (kind == "directional") light.kind = Light::Kind::Directional;
+        else throw_at(file, number, fmt::format("unknown light '{}' (point or directional)", kind));
+        std::vector<float> v;
+        std::string word;
+        while (words >> word) {
+            float f;
+            auto [p, ec] = std::from_chars(word.data(), word.data() + word.size(), f);
+            if (ec != std::errc() || p != word.data() + word.size() || !std::isfinite(f))
+                throw_at(file, number, fmt::format("malformed number '{}'", word));
+            v.push_back(f);
+        }
+        if (v.size() != 3 && v.size() != 4) throw_at(file, number, "expected x y z [intensity]");
+        light.vector = {v[0], v[1], v[2]};
+        if (v.size() == 4) {
+            if (v[3] < 0) throw_at(file, number, "intensity must not be negative");
+            light.intensity = v[3];
+        }
+        if (light.kind == Light::Kind::Directional && !(length(light.vector) > 0))
+            throw_at(file, number, "a directional light needs a non-zero direction");
+        lights.push_back(light);
+    }
+    if (lights.empty()) throw Error(fmt::format("{}: no lights", file));
+    return lights;
+}
+
+std::vector<Light> load_lights(const std::filesystem::path& path) {
+    return parse_lights(read_file(path), path.string());
+}
+
+}  // namespace toonray

@@ -1,0 +1,173 @@
+#include "toonray/frame/frame_renderer.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+
+#include "toonray/io/png.h"
+#include "toonray/scene/obj_loader.h"
+#include "support/test_support.h"
+
+using namespace toonray;
+namespace fs = std::filesystem;
+
+namespace {
+
+Scene load(const std::string& name) {
+    Scene scene;
+    Warnings w;
+    load_obj(std::string(TOONRAY_TEST_DATA_DIR) + "/" + name, scene, w);
+    return scene;
+}
+
+// The teapot twisted about y, more with height and with the frame number.
+Scene twisted_teapot(const Scene& teapot, int frame) {
+    Scene scene = teapot;
+    const float angle = 0.05f * static_cast<float>(frame);
+    for (Vec3f& p : scene.positions) {
+        const float a = angle * p.y;
+        p = Vec3f(p.x * std::cos(a) - p.z * std::sin(a), p.y, p.x * std::sin(a) + p.z * std::cos(a));
+    }
+    return scene;
+}
+
+bool same_pixels(const fs::path& a, const fs::path& b) {
+    const DecodedPng pa = read_png(a), pb = read_png(b);
+    return pa.rgb.size() == pb.rgb.size() &&
+           std::memcmp(pa.rgb.data(), pb.rgb.data(), pa.rgb.size() * sizeof(Rgb8)) == 0;
+}
+
+}  // namespace
+
+TEST(FrameRenderer, WritesTheImageAndAllFeatureImagesNamedAfterTheOutput) {
+    test_support::TempDir dir("frame_aov");
+    const Scene teapot = load("teapot.obj");
+    FrameOptions o;
+    o.settings.width = 64;
+    o.settings.height = 48;
+    for (EdgeMode mode : {EdgeMode::Classic, EdgeMode::Robust}) {
+        o.settings.edges = mode;
+        FrameRenderer fr;
+        Warnings w;
+        // Without a feature directory: the image alone, and no feature images computed.
+        o.aov_dir.reset();
+        fr.render(teapot, choose_camera(teapot, o), dir.path / "plain.png", o, w);
+        EXPECT_EQ(fr.renderer().aovs().depth.size(), 0u);
+        o.aov_dir = dir.path / "aov";
+        fr.render(teapot, choose_camera(teapot, o), dir.path / "frame.png", o, w);
+        EXPECT_TRUE(is_valid_png(dir.path / "frame.png"));
+        EXPECT_TRUE(same_pixels(dir.path / "plain.png", dir.path / "frame.png"));
+        std::size_t written = 0;
+        for (const FeatureImage& f : feature_images()) {
+            const fs::path p = dir.path / "aov" / ("frame_" + std::string(f.name) + ".png");
+            EXPECT_EQ(is_valid_png(p), f.in(mode)) << p;
+            if (!f.in(mode)) continue;
+            ++written;
+            EXPECT_EQ(read_png(p).width, 64);
+            EXPECT_EQ(p, aov_path(dir.path / "aov", dir.path / "frame.png", f.name));
+        }
+        EXPECT_EQ(written, mode == EdgeMode::Classic ? 6u : 11u);
+        fs::remove_all(dir.path / "aov");
+    }
+}
+
+TEST(FrameRenderer, ABadCameraWritesNothing) {
+    test_support::TempDir dir("frame_camera");
+    const Scene teapot = load("teapot.obj");
+    FrameOptions o;
+    o.settings.width = 32;
+    o.settings.height = 24;
+    o.aov_dir = dir.path / "aov";
+    FrameRenderer fr;
+    Warnings w;
+    const CameraSpec degenerate{{0, 0, 0}, {0, 0, 0}, {0, 1, 0}};  // gaze at the eye
+    EXPECT_THROW(fr.render(teapot, degenerate, dir.path / "frame.png", o, w), Error);
+    EXPECT_FALSE(fs::exists(dir.path / "frame.png"));
+    EXPECT_FALSE(fs::exists(dir.path / "aov"));
+}
+
+TEST(FrameRenderer, CameraIsTheOverrideElseTheScenesElseAutomatic) {
+    Scene teapot = load("teapot.obj");
+    FrameOptions o;
+    const CameraSpec automatic = choose_camera(teapot, o);
+    const CameraSpec block{{1, 2, 3}, {0, 0, 0}, {0, 1, 0}};
+    teapot.camera = block;
+    EXPECT_EQ(choose_camera(teapot, o).eye, block.eye);
+    o.camera = CameraSpec{{4, 5, 6}, {0, 0, 0}, {0, 1, 0}};
+    EXPECT_EQ(choose_camera(teapot, o).eye, Vec3f(4, 5, 6));
+    EXPECT_NE(automatic.eye, block.eye);
+}
+
+// Frames with the same triangles refit the previous frame's BVH (kMaxRefitsInARow in a row,
+// then a rebuild); the images must be exactly those of a fresh build per frame. The teapot's
+// vertices swirl more each frame, so the refitted tree drifts far from a built one.
+TEST(FrameRenderer, RefittedFramesEqualRebuiltFrames) {
+    test_support::TempDir dir("render_refit");
+    const Scene teapot = load("teapot.obj");
+    FrameOptions o;
+    o.settings.width = 96;
+    o.settings.height = 64;
+    o.settings.threads = 1;
+    const CameraSpec camera = choose_camera(teapot, o);
+    FrameRenderer reused;
+    const int frames = 2 * AnimationAccel::kMaxRefitsInARow + 3;  // refits, a rebuild, more refits
+    for (int f = 0; f < frames; ++f) {
+        const Scene scene = twisted_teapot(teapot, f);
+        for (EdgeMode mode : {EdgeMode::Classic, EdgeMode::Robust}) {
+            o.settings.edges = mode;
+            Warnings w;
+            FrameRenderer fresh;
+            fresh.render(scene, camera, dir.path / "fresh.png", o, w);
+            reused.render(scene, camera, dir.path / "reused.png", o, w);
+            EXPECT_FALSE(fresh.accel().refitted());
+            ASSERT_TRUE(same_pixels(dir.path / "fresh.png", dir.path / "reused.png"))
+                << "frame " << f << (mode == EdgeMode::Classic ? " classic" : " robust");
+        }
+    }
+}
+
+TEST(AnimationAccel, RefitsTheSameTrianglesAndRebuildsEverySixteenthFrame) {
+    const Scene teapot = load("teapot.obj");
+    AnimationAccel accel;
+    const Bvh::Config config;
+    std::vector<bool> refitted;
+    for (int f = 0; f < 2 * (AnimationAccel::kMaxRefitsInARow + 1) + 1; ++f) {
+        accel.update(twisted_teapot(teapot, f), config);
+        refitted.push_back(accel.refitted());
+    }
+    for (std::size_t f = 0; f < refitted.size(); ++f)
+        EXPECT_EQ(refitted[f], f % (AnimationAccel::kMaxRefitsInARow + 1) != 0) << f;
+    // Other triangles, or other BVH settings: a build.
+    Scene fewer = teapot;
+    fewer.tri_positions.pop_back();
+    fewer.tri_normals.pop_back();
+    fewer.tri_texcoords.pop_back();
+    fewer.tri_material.pop_back();
+    fewer.tri_object.pop_back();
+    accel.update(fewer, config);
+    EXPECT_FALSE(accel.refitted());
+    Bvh::Config other;
+    other.max_leaf_size = config.max_leaf_size + 1;
+    accel.update(fewer, other);
+    EXPECT_FALSE(accel.refitted());
+    accel.update(fewer, other);
+    EXPECT_TRUE(accel.refitted());
+}
+
+TEST(FrameBytes, CountTheRendererAndTheEncodingWithRoomToSpare) {
+    FrameOptions o;
+    o.settings.width = 1280;
+    o.settings.height = 720;
+    const std::uint64_t pixels = 1280ull * 720;
+    const std::uint64_t renderer = frame_buffer_bytes(o.render_settings());
+    EXPECT_GT(frame_bytes(o), renderer + pixels * 3);
+    // Feature images count only when they are written.
+    o.aov_dir = "aov";
+    EXPECT_TRUE(o.render_settings().feature_images);
+    EXPECT_GT(frame_buffer_bytes(o.render_settings()), renderer);
+    EXPECT_GT(frame_bytes(o), pixels * 196);  // measured peak with feature images: 196 bytes/pixel
+    o.settings.width = o.settings.height = 2147483647;
+    EXPECT_EQ(frame_bytes(o), UINT64_MAX);
+}
