@@ -4,7 +4,8 @@
 #include "commands.h"
 #include "toonray/anim/batch.h"
 #include "toonray/core/limits.h"
-#include "toonray/render/render_file.h"
+#include "toonray/frame/frame_renderer.h"
+#include "toonray/scene/obj_loader.h"
 
 namespace toonray::cli {
 namespace {
@@ -15,15 +16,17 @@ struct RenderCommandArgs {
 };
 
 int run_render(const RenderCommandArgs& args) {
-    FileRenderOptions options = args.render.resolve();
+    FrameOptions options = args.render.resolve();
     {  // The frame buffers come first: the loader counts them in its memory estimate.
         Limits l = limits();
-        l.reserved_memory = plan_frame_jobs(options.settings, 1, 1).frame_bytes;
+        l.reserved_memory = plan_frame_jobs(options, 1, 1).frame_bytes;
         set_limits(l);
     }
     Warnings warnings;
-    FileRenderer renderer;
-    renderer.render(args.input, args.output, options, warnings);
+    Scene scene;
+    load_obj(args.input, scene, warnings);
+    FrameRenderer renderer;
+    renderer.render(scene, choose_camera(scene, options), args.output, options, warnings);
     print_warnings(warnings);
     return 0;
 }

@@ -8,6 +8,7 @@
 #include "toonray/anim/piano_movie.h"
 #include "toonray/core/limits.h"
 #include "toonray/core/parse.h"
+#include "toonray/frame/lights.h"
 #include "toonray/score/score_io.h"
 
 namespace toonray::cli {
@@ -84,8 +85,8 @@ void RenderArgs::add_to(CLI::App& app) {
         ->capture_default_str();
 }
 
-FileRenderOptions RenderArgs::resolve() const {
-    FileRenderOptions o;
+FrameOptions RenderArgs::resolve() const {
+    FrameOptions o;
     ImageSize s = parse_image_size(size, "--size");
     o.settings.width = s.width;
     o.settings.height = s.height;

@@ -10,7 +10,7 @@
 
 #include "toonray/core/error.h"
 #include "toonray/media/audio.h"
-#include "toonray/render/render_file.h"
+#include "toonray/frame/frame_renderer.h"
 #include "toonray/score/score.h"
 
 namespace toonray::cli {
@@ -40,7 +40,7 @@ struct RenderArgs {
     std::string aov_dir;
 
     void add_to(CLI::App& app);
-    [[nodiscard]] FileRenderOptions resolve() const;
+    [[nodiscard]] FrameOptions resolve() const;
 };
 
 /// Limits on what inputs may ask for (docs/robustness.md), as text until validated.
