@@ -88,7 +88,8 @@ std::span<const FeatureImage> feature_images();
 /// Bytes of the buffers Renderer keeps for a frame with `settings`: the G-buffer at the mode's
 /// samples, the line seeds and (for very wide lines) the full distance image in robust mode,
 /// classic mode's maps, the final image, and the feature images when settings.feature_images
-/// asks for them. Per-thread scratch rows and tiles are not counted. Saturates at UINT64_MAX.
+/// asks for them. Per-thread scratch rows and tiles are not counted. Saturates at UINT64_MAX;
+/// throws Error for a robust sample count that samples_per_side rejects.
 [[nodiscard]] std::uint64_t frame_buffer_bytes(const RenderSettings& settings);
 
 /// Sizes the G-buffer for a frame of width x height pixels with sub x sub samples each, for
@@ -104,8 +105,9 @@ void shade_tile(const ShadingContext& ctx, const ViewPlane& view, const RenderSe
 /// Renders frames, keeping its buffers between calls so an animation allocates once.
 class Renderer {
 public:
-    /// Renders the final image. Never throws for a valid scene, camera and settings; the
-    /// camera must already have been validated (make_view_plane throws on a bad one).
+    /// Renders the final image. `textures` are the decoded textures of the scene's materials
+    /// (null: none). Never throws for a valid scene, camera and settings; the camera must
+    /// already have been validated (make_view_plane throws on a bad one).
     const ImageRgb8& render(const Scene& scene, const TriangleAccel& accel, const CameraSpec& camera,
                             const RenderSettings& settings, const TextureSet* textures = nullptr);
 
@@ -115,8 +117,6 @@ public:
     [[nodiscard]] const Aovs& aovs() const;
     /// The single point light of the last frame (settings.light or the default).
     [[nodiscard]] Vec3f light() const { return light_; }
-    /// All lights of the last frame.
-    [[nodiscard]] const std::vector<Light>& lights() const { return lights_; }
     /// Robust mode: the line seeds of the last frame on the fine grid (LineType bits).
     [[nodiscard]] const Image<std::uint8_t>& line_seeds() const { return seeds_; }
 
