@@ -234,7 +234,7 @@ std::vector<Ray> shadow_rays(const Mesh& m, const ViewPlane& view, const Hits& p
     return rays;
 }
 
-size_t trace_shadows_closest(const TriangleAccel& accel, const std::vector<Ray>& rays) {
+[[gnu::noinline]] size_t trace_shadows_closest(const TriangleAccel& accel, const std::vector<Ray>& rays) {
     size_t blocked = 0;
     for (const Ray& r : rays) {
         Hit hit;
@@ -243,7 +243,7 @@ size_t trace_shadows_closest(const TriangleAccel& accel, const std::vector<Ray>&
     return blocked;
 }
 
-size_t trace_shadows_any(const TriangleAccel& accel, const std::vector<Ray>& rays) {
+[[gnu::noinline]] size_t trace_shadows_any(const TriangleAccel& accel, const std::vector<Ray>& rays) {
     size_t blocked = 0;
     for (const Ray& r : rays) blocked += accel.occluded(r);
     return blocked;

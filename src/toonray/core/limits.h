@@ -60,8 +60,6 @@ void set_limits(const Limits& limits);
 /// Frame buffers of one frame of `pixels` pixels at `samples` samples per pixel: the G-buffer
 /// (per sample), the feature images, the final image and its PNG encoding.
 [[nodiscard]] std::uint64_t frame_buffer_bytes(std::uint64_t pixels, int samples);
-/// A loaded scene with its BVH: attribute arrays, triangle arrays, and the BVH build.
-[[nodiscard]] std::uint64_t scene_bytes(std::uint64_t vertices, std::uint64_t triangles);
 
 /// Throws Error("WHAT needs about X of memory, more than the limit of Y (--max-memory ...)")
 /// when `bytes` exceeds limits().max_memory. `advice` is appended when not empty.

@@ -63,4 +63,10 @@ struct Scene {
     void clear();
 };
 
+/// Memory for a scene of `vertices` attribute values and `triangles` triangles while it is
+/// rendered, saturating at the largest value: its arrays, and what rendering builds from it
+/// (the BVH build, the packed triangles and the automatic camera's corner list). Deliberately
+/// generous, as the estimates of core/limits.h are.
+[[nodiscard]] std::uint64_t scene_bytes(std::uint64_t vertices, std::uint64_t triangles);
+
 }  // namespace toonray
