@@ -72,7 +72,9 @@ void expect_agrees(const Soup& s, int rays, unsigned seed, int check) {
                 const bool expected = accel.intersect(ray, hit);
                 const bool got = accel.occluded(ray);
                 ASSERT_EQ(got, expected) << "ray " << i << " tmax " << tmax;
-                if (i % check == 0) ASSERT_EQ(got, brute_force_occluded(s, ray)) << "ray " << i << " tmax " << tmax;
+                if (i % check == 0) {
+                    ASSERT_EQ(got, brute_force_occluded(s, ray)) << "ray " << i << " tmax " << tmax;
+                }
                 (got ? occluded : clear)++;
             }
         }
