@@ -35,6 +35,7 @@ inline bool resolve_index(long long idx, std::size_t count, std::uint32_t& out) 
     return false;
 }
 
+/// A face corner: its position, texture coordinate and normal indices (kNoIndex when absent).
 struct Corner {
     std::uint32_t v, t, n;
 };

@@ -65,6 +65,102 @@ void reserve_for(std::string_view text, Scene& scene, const Limits& limits) {
     scene.tri_object.reserve(f);
 }
 
+/// The corners of an 'f' statement in any form, with a precise message for each malformed or
+/// out-of-range index.
+void read_face_corners(const LineParser& parse, Tokens& t, const Scene& scene, std::vector<Corner>& corners) {
+    corners.clear();
+    while (!t.at_end()) {
+        std::string_view tok = t.next();
+        const char* p = tok.data();
+        const char* e = p + tok.size();
+        long long idx[3] = {0, 0, 0};
+        bool present[3] = {false, false, false};
+        for (int slot = 0; slot < 3; ++slot) {
+            if (p < e && *p != '/') {
+                const char* q = p;
+                if (parse_index(q, e, idx[slot]) && (q == e || *q == '/')) {
+                    present[slot] = true;
+                    p = q;
+                    if (p < e) {
+                        if (slot == 2) parse.fail(fmt::format("malformed face corner '{}'", tok));
+                        ++p;
+                    }
+                    continue;
+                }
+                // Slow path, for its precise messages.
+                auto [ptr, ec] = std::from_chars(p, e, idx[slot]);
+                if (ec == std::errc::result_out_of_range && (ptr == e || *ptr == '/'))
+                    parse.fail(fmt::format("face {} index in '{}' out of range",
+                                           slot == 0 ? "vertex" : slot == 1 ? "texture" : "normal", tok));
+                if (ec != std::errc() || (ptr != e && *ptr != '/'))
+                    parse.fail(fmt::format("malformed face corner '{}'", tok));
+                present[slot] = true;
+                p = ptr;
+            }
+            if (p < e) {
+                if (*p != '/' || slot == 2)
+                    parse.fail(fmt::format("malformed face corner '{}'", tok));
+                ++p;
+            }
+        }
+        if (!present[0]) parse.fail(fmt::format("face corner '{}' has no vertex index", tok));
+        Corner c{0, kNoIndex, kNoIndex};
+        if (!resolve_index(idx[0], scene.positions.size(), c.v))
+            parse.fail(idx[0] == 0 ? fmt::format("face vertex index 0 in '{}' (OBJ indices start at 1)", tok)
+                                   : fmt::format("face vertex index {} out of range ({} vertices defined so far)",
+                                                 idx[0], scene.positions.size()));
+        if (present[1] && !resolve_index(idx[1], scene.texcoords.size(), c.t))
+            parse.fail(fmt::format("face texture index {} out of range ({} defined so far)",
+                                   idx[1], scene.texcoords.size()));
+        if (present[2] && !resolve_index(idx[2], scene.normals.size(), c.n))
+            parse.fail(fmt::format("face normal index {} out of range ({} defined so far)",
+                                   idx[2], scene.normals.size()));
+        corners.push_back(c);
+    }
+    if (corners.size() < 3) parse.fail(fmt::format("face needs at least 3 corners, has {}", corners.size()));
+}
+
+/// The camera block statement `c eye gaze up`: the indices of two vertices and a normal.
+CameraSpec read_camera(const LineParser& parse, Tokens& t, const Scene& scene) {
+    long long idx[3];
+    for (long long& i : idx) {
+        std::string_view tok = t.next();
+        auto [ptr, ec] = std::from_chars(tok.data(), tok.data() + tok.size(), i);
+        if (tok.empty() || ec != std::errc() || ptr != tok.data() + tok.size())
+            parse.fail("camera statement needs three indices: c eye gaze up");
+    }
+    if (!t.at_end()) parse.fail("camera statement has more than three indices: c eye gaze up");
+    std::uint32_t eye, gaze, up;
+    if (!resolve_index(idx[0], scene.positions.size(), eye))
+        parse.fail(fmt::format("camera eye index {} out of range ({} vertices defined so far)",
+                               idx[0], scene.positions.size()));
+    if (!resolve_index(idx[1], scene.positions.size(), gaze))
+        parse.fail(fmt::format("camera gaze index {} out of range ({} vertices defined so far)",
+                               idx[1], scene.positions.size()));
+    if (!resolve_index(idx[2], scene.normals.size(), up))
+        parse.fail(fmt::format("camera up index {} out of range ({} normals defined so far)",
+                               idx[2], scene.normals.size()));
+    CameraSpec cam{scene.positions[eye], scene.positions[gaze], scene.normals[up]};
+    try {
+        validate_camera(cam);
+    } catch (const Error& e) {
+        parse.fail(e.what());
+    }
+    return cam;
+}
+
+/// Statements that are accepted and ignored: smoothing groups are implied by vn; lines,
+/// points and free-form geometry are not rendered.
+bool is_ignored_statement(std::string_view kw) {
+    return kw == "s" || kw == "l" || kw == "p" || kw == "vp" || kw == "cstype" ||
+           kw == "deg" || kw == "curv" || kw == "curv2" || kw == "surf" || kw == "parm" ||
+           kw == "end" || kw == "mg" || kw == "lod" || kw == "usemap" || kw == "maplib" ||
+           kw == "shadow_obj" || kw == "trace_obj" || kw == "bevel" || kw == "c_interp" ||
+           kw == "d_interp" || kw == "ctech" || kw == "stech" || kw == "trim" ||
+           kw == "hole" || kw == "scrv" || kw == "sp" || kw == "con" || kw == "bmat" ||
+           kw == "step";
+}
+
 }  // namespace
 
 void parse_obj(std::string_view text, const std::filesystem::path& path, Scene& scene,
@@ -148,8 +244,8 @@ void parse_obj(std::string_view text, const std::filesystem::path& path, Scene& 
     };
 
     for (;;) {
-        // The common statements in their plain form, straight from the text (see
-        // read_numbers_line). A line longer than the limit goes the general way, which reports it.
+        // The common statements in their plain form, straight from the text (obj_fast_path.h).
+        // A line longer than the limit goes the general way, which reports it.
         const char* begin = reader.cursor();
         const char* end = reader.end();
         if (end - begin >= 2 && (begin[0] == 'v' || begin[0] == 'f')) {
@@ -197,57 +293,7 @@ void parse_obj(std::string_view text, const std::filesystem::path& path, Scene& 
             // Optional w (or vertex colour) values are accepted and ignored, but must be numbers.
             while (!t.at_end()) parse.number(t, kw);
         } else if (kw == "f") {
-            corners.clear();
-            while (!t.at_end()) {
-                std::string_view tok = t.next();
-                const char* p = tok.data();
-                const char* e = p + tok.size();
-                long long idx[3] = {0, 0, 0};
-                bool present[3] = {false, false, false};
-                for (int slot = 0; slot < 3; ++slot) {
-                    if (p < e && *p != '/') {
-                        const char* q = p;
-                        if (parse_index(q, e, idx[slot]) && (q == e || *q == '/')) {
-                            present[slot] = true;
-                            p = q;
-                            if (p < e) {
-                                if (slot == 2) parse.fail(fmt::format("malformed face corner '{}'", tok));
-                                ++p;
-                            }
-                            continue;
-                        }
-                        // Slow path, for its precise messages.
-                        auto [ptr, ec] = std::from_chars(p, e, idx[slot]);
-                        if (ec == std::errc::result_out_of_range && (ptr == e || *ptr == '/'))
-                            parse.fail(fmt::format("face {} index in '{}' out of range",
-                                                   slot == 0 ? "vertex" : slot == 1 ? "texture" : "normal", tok));
-                        if (ec != std::errc() || (ptr != e && *ptr != '/'))
-                            parse.fail(fmt::format("malformed face corner '{}'", tok));
-                        present[slot] = true;
-                        p = ptr;
-                    }
-                    if (p < e) {
-                        if (*p != '/' || slot == 2)
-                            parse.fail(fmt::format("malformed face corner '{}'", tok));
-                        ++p;
-                    }
-                }
-                if (!present[0]) parse.fail(fmt::format("face corner '{}' has no vertex index", tok));
-                Corner c{0, kNoIndex, kNoIndex};
-                if (!resolve_index(idx[0], scene.positions.size(), c.v))
-                    parse.fail(idx[0] == 0 ? fmt::format("face vertex index 0 in '{}' (OBJ indices start at 1)", tok)
-                                           : fmt::format("face vertex index {} out of range ({} vertices defined so far)",
-                                                         idx[0], scene.positions.size()));
-                if (present[1] && !resolve_index(idx[1], scene.texcoords.size(), c.t))
-                    parse.fail(fmt::format("face texture index {} out of range ({} defined so far)",
-                                           idx[1], scene.texcoords.size()));
-                if (present[2] && !resolve_index(idx[2], scene.normals.size(), c.n))
-                    parse.fail(fmt::format("face normal index {} out of range ({} defined so far)",
-                                           idx[2], scene.normals.size()));
-                corners.push_back(c);
-            }
-            if (corners.size() < 3)
-                parse.fail(fmt::format("face needs at least 3 corners, has {}", corners.size()));
+            read_face_corners(parse, t, scene, corners);
             add_face(parse);
         } else if (kw == "vn") {
             adding_normal(parse);
@@ -288,43 +334,10 @@ void parse_obj(std::string_view text, const std::filesystem::path& path, Scene& 
             }
             index_materials();
         } else if (kw == "c") {
-            long long idx[3];
-            for (long long& i : idx) {
-                std::string_view tok = t.next();
-                auto [ptr, ec] = std::from_chars(tok.data(), tok.data() + tok.size(), i);
-                if (tok.empty() || ec != std::errc() || ptr != tok.data() + tok.size())
-                    parse.fail("camera statement needs three indices: c eye gaze up");
-            }
-            if (!t.at_end()) parse.fail("camera statement has more than three indices: c eye gaze up");
-            std::uint32_t eye, gaze, up;
-            if (!resolve_index(idx[0], scene.positions.size(), eye))
-                parse.fail(fmt::format("camera eye index {} out of range ({} vertices defined so far)",
-                                       idx[0], scene.positions.size()));
-            if (!resolve_index(idx[1], scene.positions.size(), gaze))
-                parse.fail(fmt::format("camera gaze index {} out of range ({} vertices defined so far)",
-                                       idx[1], scene.positions.size()));
-            if (!resolve_index(idx[2], scene.normals.size(), up))
-                parse.fail(fmt::format("camera up index {} out of range ({} normals defined so far)",
-                                       idx[2], scene.normals.size()));
-            CameraSpec cam{scene.positions[eye], scene.positions[gaze], scene.normals[up]};
-            try {
-                validate_camera(cam);
-            } catch (const Error& e) {
-                parse.fail(e.what());
-            }
-            scene.camera = cam;
-        } else if (kw == "s" || kw == "l" || kw == "p" || kw == "vp" || kw == "cstype" ||
-                   kw == "deg" || kw == "curv" || kw == "curv2" || kw == "surf" || kw == "parm" ||
-                   kw == "end" || kw == "mg" || kw == "lod" || kw == "usemap" || kw == "maplib" ||
-                   kw == "shadow_obj" || kw == "trace_obj" || kw == "bevel" || kw == "c_interp" ||
-                   kw == "d_interp" || kw == "ctech" || kw == "stech" || kw == "trim" ||
-                   kw == "hole" || kw == "scrv" || kw == "sp" || kw == "con" || kw == "bmat" ||
-                   kw == "step") {
-            // Accepted: smoothing groups are implied by vn; lines, points and free-form
-            // geometry are not rendered.
-        } else {
-            if (warned_statements.size() < 10'000 && warned_statements.emplace(std::string(kw), 0).second)
-                warn.add(located(file, line_number, fmt::format("unknown statement '{}' ignored", kw)));
+            scene.camera = read_camera(parse, t, scene);
+        } else if (!is_ignored_statement(kw) && warned_statements.size() < 10'000 &&
+                   warned_statements.emplace(std::string(kw), 0).second) {
+            warn.add(located(file, line_number, fmt::format("unknown statement '{}' ignored", kw)));
         }
     }
     check_estimate(LineParser(file, 0));
