@@ -33,6 +33,13 @@ void validate_camera(const CameraSpec& camera) {
     const double sine = std::sqrt(cx * cx + cy * cy + cz * cz) / (view * up);
     if (!(up > 0) || !(sine > kMinUpSine))
         throw Error("invalid camera: up vector is zero or parallel to the view direction");
+    // The same in the float arithmetic that builds the view plane, where tiny lengths underflow
+    // to zero.
+    const Vec3f view_dir = camera.gaze - camera.eye;
+    const float view_len = length(view_dir), up_len = length(camera.up);
+    if (!(view_len > 0)) throw Error("invalid camera: eye and gaze point are the same point");
+    if (!(up_len > 0) || !(length(cross(view_dir, camera.up)) > static_cast<float>(kMinUpSine) * view_len * up_len))
+        throw Error("invalid camera: up vector is zero or parallel to the view direction");
 }
 
 ViewPlane make_view_plane(const CameraSpec& camera, int width, int height) {

@@ -40,8 +40,8 @@ inline constexpr double kMinUpSine = 1e-3;
 
 /// Throws Error("invalid camera: ...") unless eye, gaze and up are finite, eye != gaze,
 /// |gaze - eye| and |up| are at most kMaxCameraLength, up is not zero, and the sine of its angle
-/// to the view direction exceeds kMinUpSine (checked in double precision). Every camera that
-/// passes gives make_view_plane finite vectors.
+/// to the view direction exceeds kMinUpSine (checked in double precision, and again in float
+/// where tiny lengths underflow). Every camera that passes gives make_view_plane finite vectors.
 void validate_camera(const CameraSpec& camera);
 
 /// Builds the view plane exactly as the seed defines it:
