@@ -15,16 +15,15 @@ namespace toonray::wavefront {
 
 inline bool is_digit(char c) { return static_cast<unsigned char>(c - '0') < 10; }
 inline bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v'; }
-/// The separators within a line of the plain statement forms (obj_fast_path.h).
+/// Blanks: the separators of a line's tokens in the plain statement forms.
 inline bool is_blank(char c) { return c == ' ' || c == '\t'; }
 
 /// Splits text into logical lines: a line ends at LF, CRLF or a lone CR (old Mac files; as
 /// tinyobjloader reads them), lines ending in a backslash are joined, and physical lines are
 /// counted for messages. Comments are left to the callers ('#' starts one). A UTF-8 byte-order
 /// mark at the start is skipped. A line longer than `max_line` bytes throws
-/// LimitError(Limit::LineBytes).
-/// parse_obj reads its common statements straight from the text (cursor(), consumed_line());
-/// everything else goes through next().
+/// LimitError(Limit::LineBytes). A caller may also read plain physical lines straight from the
+/// text (cursor(), consumed_line()) and leave the others to next().
 class LineReader {
 public:
     LineReader(std::string_view text, std::string_view file, std::uint64_t max_line);
