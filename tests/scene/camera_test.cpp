@@ -108,7 +108,8 @@ TEST(ValidateCamera, NamesWhatIsWrong) {
     EXPECT_EQ(camera_error({{0, 0, 0}, {0, 0, -3e7f}, {0, 1, 0}}),
               "invalid camera: the gaze point is 3e+07 from the eye (at most 1e6; the distance sets the field of "
               "view, 1 gives 90 degrees)");
-    EXPECT_EQ(camera_error({{0, 0, 0}, {0, 0, -1}, {0, 2e6f, 0}}), "invalid camera: up vector of length 2e+06 (at most 1e6)");
+    EXPECT_EQ(camera_error({{0, 0, 0}, {0, 0, -1}, {0, 2e6f, 0}}),
+              "invalid camera: up vector of length 2e+06 (at most 1e6)");
     // Up 0.05 degrees from the view direction is too close; 0.1 degrees is enough.
     const float a = 0.05f * 3.14159265f / 180.0f, b = 0.1f * 3.14159265f / 180.0f;
     EXPECT_NE(camera_error({{0, 0, 0}, {0, 0, -1}, {0, std::sin(a), -std::cos(a)}}), "(valid)");

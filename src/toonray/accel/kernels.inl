@@ -10,10 +10,10 @@
 // watertight_test() itself. A hit is taken by BestHit's rule, so the result is the lowest
 // (t, triangle index) over the triangles whose test passes, which does not depend on traversal
 // order. occluded1 stops at any lane that BestHit would take as a first hit (0 < t < tmax), so
-// it answers exactly whether intersect1 finds one. Box culling is conservative: the far distance is widened by kBoxSlack as before; the
-// AVX2/AVX-512 single-ray box test uses FMA with its rounding error folded into the constants;
-// interval (frustum) tests bound the per-ray slab distances exactly (float multiplication is
-// monotonic); and NaN distances never cull.
+// it answers exactly whether intersect1 finds one. Box culling is conservative: the far
+// distance is widened by kBoxSlack as before; the AVX2/AVX-512 single-ray box test uses FMA
+// with its rounding error folded into the constants; interval (frustum) tests bound the per-ray
+// slab distances exactly (float multiplication is monotonic); and NaN distances never cull.
 
 constexpr int kNearLo[3] = {0, 8, 16};   // offsets of lo[axis] in a WideNode, in floats
 constexpr int kNearHi[3] = {24, 32, 40};  // offsets of hi[axis]

@@ -1,7 +1,8 @@
 #pragma once
 /// Closest-hit and occlusion ray queries against a triangle mesh: the binary BVH of bvh.h,
 /// collapsed into an 8-wide tree traversed with SIMD (AVX2 when the CPU has it, SSE4.2
-/// otherwise), single rays and coherent tiles of rays from one origin. docs/accel.md describes the design.
+/// otherwise), single rays and coherent tiles of rays from one origin. docs/accel.md describes
+/// the design.
 
 #include <array>
 #include <cstdint>
