@@ -11,15 +11,18 @@
 //   ours tile     trace_primary (the renderer's path: 16x16 tiles, packets/frustums), threads = 1
 //   embree 1      rtcIntersect1 (default build quality)
 //   embree 8      rtcIntersect8, 4x2-pixel packets, RTC_INTERSECT_CONTEXT_FLAG_COHERENT
-// and build times: ours (TriangleAccel::build) and Embree (rtcCommitScene, default quality),
-// each on 1 thread and on all threads.
+// shadow rays from every primary hit towards two point lights, timed with
+// TriangleAccel::intersect (closest hit) and TriangleAccel::occluded (any hit); and build times:
+// ours (TriangleAccel::build) and Embree (rtcCommitScene, default quality), each on 1 thread and
+// on all threads.
 //
 // Checks before timing (the exit status is 1 when one fails; --quick runs only them, small):
 // trace_primary's directions are bit-identical to normalize(pixel_point - eye); ours single and
 // ours tile are bit-identical (t, prim, u, v) to the accelerator before the rewrite
 // (bench/accel_legacy.*, kept verbatim) on every ray; against Embree, the same triangle at a
 // distance within 1e-4 relative, or another triangle at that distance (a tie on a shared edge
-// or coincident faces, which the two break differently), on >= 99.99% of the rays.
+// or coincident faces, which the two break differently), on >= 99.99% of the rays; occluded
+// and intersect agree on every shadow ray.
 // TOONRAY_ACCEL_ISA=sse4.2|avx2|avx512 chooses our kernels; EMBREE_CONFIG is passed to Embree.
 //
 // Built as `toonray_accel_bench` when Embree is installed (bench/CMakeLists.txt); CTest runs
@@ -200,6 +203,51 @@ private:
     RTCScene scene_ = nullptr;
     std::vector<float> verts_;
 };
+
+// Shadow rays as the renderer casts them (render/shading.cpp): from each primary hit, offset
+// along the geometric normal (turned to face the eye), towards a point light, tmax its distance.
+// Two lights: the renderer's default (beside the eye: few points are shadowed) and one above the
+// scene (many are).
+// `primary` holds trace_ours_tile's hits and directions.
+std::vector<Ray> shadow_rays(const Mesh& m, const ViewPlane& view, const Hits& primary) {
+    BBox box;
+    for (const Vec3f& p : m.positions) box.extend(p);
+    const float radius = box.empty() ? 1.0f : 0.5f * length(box.extent());
+    const Vec3f lights[2] = {view.eye + (view.up + view.right) * (0.5f * radius),
+                             box.center() + Vec3f(0.3f, 2.0f, 0.2f) * radius};
+    std::vector<Ray> rays;
+    for (size_t i = 0; i < primary.hit.size(); ++i) {
+        if (!primary.found[i]) continue;
+        const Hit& hit = primary.hit[i];
+        const auto& tri = m.tris[hit.prim];
+        const Vec3f& a = m.positions[tri[0]];
+        Vec3f n = normalize(cross(m.positions[tri[1]] - a, m.positions[tri[2]] - a));
+        const Vec3f p = view.eye + primary.dir[i] * hit.t;
+        if (dot(n, primary.dir[i]) > 0.0f) n = -n;
+        for (const Vec3f& light : lights) {
+            const Vec3f origin = p + n * (1e-4f * std::max(1.0f, hit.t));
+            const Vec3f to_light = light - origin;
+            const float distance = length(to_light);
+            if (distance > 0.0f) rays.push_back(Ray{origin, to_light / distance, distance});
+        }
+    }
+    return rays;
+}
+
+[[gnu::noinline]] size_t trace_shadows_closest(const TriangleAccel& accel, const std::vector<Ray>& rays) {
+    size_t blocked = 0;
+    for (const Ray& r : rays) {
+        Hit hit;
+        blocked += accel.intersect(r, hit);
+    }
+    return blocked;
+}
+
+[[gnu::noinline]] size_t trace_shadows_any(const TriangleAccel& accel, const std::vector<Ray>& rays) {
+    size_t blocked = 0;
+    for (const Ray& r : rays) blocked += accel.occluded(r);
+    return blocked;
+}
 
 void trace_ours_single(const TriangleAccel& accel, const ViewPlane& view, int w, int h, Hits& out) {
     for_each_tile_ray(view, w, h, [&](int x, int y, const Vec3f& dir) {
@@ -488,8 +536,21 @@ int main(int argc, char** argv) {
             if (a.same + a.tie < n * 0.9999) failed = true;
         }
 
+        // Shadow rays: the any-hit query agrees with the closest-hit one on every ray.
+        const std::vector<Ray> shadows = shadow_rays(m, view, tile);
+        size_t blocked = 0, shadow_diffs = 0;
+        for (const Ray& r : shadows) {
+            Hit hit;
+            const bool closest = ours.intersect(r, hit), any = ours.occluded(r);
+            blocked += any;
+            shadow_diffs += closest != any;
+        }
+        std::printf("  shadow rays: %zu, %zu blocked; occluded differs from intersect on %zu\n", shadows.size(),
+                    blocked, shadow_diffs);
+        failed |= shadow_diffs != 0;
+
         // Timing: the variants alternate run by run.
-        std::vector<double> ts, tt, t1, t8, tl;
+        std::vector<double> ts, tt, t1, t8, tl, tsc, tsa;
         for (int r = 0; r < opt.repeats; ++r) {
             auto t0 = Clock::now();
             if (opt.legacy && r < 3) {  // the accelerator before the rewrite, for scale (3 runs)
@@ -502,6 +563,13 @@ int main(int argc, char** argv) {
             t0 = Clock::now();
             trace_ours_tile(ours, view, w, h, tile);
             tt.push_back(seconds_since(t0));
+            t0 = Clock::now();
+            blocked = trace_shadows_closest(ours, shadows);
+            tsc.push_back(seconds_since(t0));
+            t0 = Clock::now();
+            blocked -= trace_shadows_any(ours, shadows);
+            tsa.push_back(seconds_since(t0));
+            failed |= blocked != 0;
             if (opt.only_ours) continue;
             t0 = Clock::now();
             trace_embree1(emb.scene(), view, w, h, e1);
@@ -514,6 +582,10 @@ int main(int argc, char** argv) {
         std::printf("  Mrays/s: ours single %.2f, ours tile %.2f, embree1 %.2f, embree8 %.2f (before the rewrite: "
                     "%.2f)\n",
                     mrays(ts), mrays(tt), mrays(t1), mrays(t8), mrays(tl));
+        if (!tsc.empty() && !shadows.empty())
+            std::printf("  shadow Mrays/s: closest hit (intersect) %.2f, any hit (occluded) %.2f: %.2fx\n",
+                        shadows.size() / median(tsc) * 1e-6, shadows.size() / median(tsa) * 1e-6,
+                        median(tsc) / median(tsa));
 
         double bo1 = 0, be1 = 0, boa = 0, bea = 0;
         if (opt.build) {

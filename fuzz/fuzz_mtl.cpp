@@ -5,7 +5,7 @@
 
 #include "fuzz_util.h"
 #include "toonray/core/error.h"
-#include "toonray/scene/obj_loader.h"
+#include "toonray/scene/mtl_loader.h"
 
 using namespace toonray;
 

@@ -14,6 +14,7 @@
 #include "toonray/accel/triangle_accel.h"
 #include "toonray/scene/camera.h"
 #include "toonray/scene/obj_loader.h"
+#include "accel/isas.h"
 #include "accel/soup.h"
 
 using namespace toonray;
@@ -21,6 +22,8 @@ using namespace toonray;
 namespace {
 
 using test_support::from_obj;
+using test_support::isas;
+using test_support::IsaGuard;
 using test_support::random_soup;
 using test_support::Soup;
 
@@ -62,20 +65,6 @@ Hit brute_force(const Soup& s, const Ray& ray) {
     }
     return best;
 }
-
-// The instruction sets to test: the portable one, and AVX2 and AVX-512 when this CPU has them.
-std::vector<std::string> isas() {
-    std::vector<std::string> out{"sse4.2"};
-    for (const char* isa : {"avx2", "avx512"})
-        if (set_accel_isa(isa)) out.push_back(isa);
-    set_accel_isa("auto");
-    return out;
-}
-
-struct IsaGuard {
-    explicit IsaGuard(const std::string& isa) { EXPECT_TRUE(set_accel_isa(isa)); }
-    ~IsaGuard() { set_accel_isa("auto"); }
-};
 
 // Traces width x height pinhole rays through view (as trace_primary makes them) in tiles of
 // tw x th, and checks every ray: the tile result equals the single-ray result bit for bit, and

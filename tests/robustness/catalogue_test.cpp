@@ -67,9 +67,9 @@ std::vector<BadInput> catalogue() {
          "distance sets the field of view, 1 gives 90 degrees)"},
         // --- limits ---
         {"TooManyTriangles", kRender + "degenerate.obj" + kTo + " --max-triangles 3",
-         "{data}/degenerate.obj:9: more than 3 triangles (the limit; --max-triangles raises it)"},
+         "{data}/degenerate.obj:9: more than 3 triangles (the limit)"},
         {"TooManyVertices", kRender + "degenerate.obj" + kTo + " --max-vertices 4",
-         "{data}/degenerate.obj:6: more than 4 vertices ('v') (the limit; --max-vertices raises it)"},
+         "{data}/degenerate.obj:6: more than 4 vertices ('v') (the limit)"},
         {"InputTooLarge", kRender + "degenerate.obj" + kTo + " --max-input-size 100",
          "{data}/degenerate.obj: 204 bytes, more than the input size limit of 100 bytes (--max-input-size raises it)"},
         {"ImageTooLarge", kRender + "degenerate.obj -o {out}/frame.png --size 20000x20000",

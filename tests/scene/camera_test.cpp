@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <string>
 #include <vector>
 
 #include "toonray/core/error.h"
@@ -83,4 +84,69 @@ TEST(ParseCameraSpec, NineNumbers) {
     EXPECT_EQ(c.up, Vec3f(0, 1, 0));
     EXPECT_THROW(parse_camera_spec("1,2,3"), Error);
     EXPECT_THROW(parse_camera_spec("1,2,3,4,5,6,0,1,x"), Error);
+}
+
+namespace {
+std::string camera_error(const CameraSpec& c) {
+    try {
+        validate_camera(c);
+    } catch (const Error& e) {
+        return e.what();
+    }
+    return "(valid)";
+}
+}  // namespace
+
+TEST(ValidateCamera, NamesWhatIsWrong) {
+    EXPECT_EQ(camera_error({{0, 0, 0}, {0, 0, -1}, {0, 1, 0}}), "(valid)");
+    EXPECT_EQ(camera_error({{0, 0, NAN}, {0, 0, -1}, {0, 1, 0}}), "invalid camera: eye, gaze and up must be finite");
+    EXPECT_EQ(camera_error({{1, 2, 3}, {1, 2, 3}, {0, 1, 0}}), "invalid camera: eye and gaze point are the same point");
+    EXPECT_EQ(camera_error({{0, 0, 0}, {0, 0, -1}, {0, 0, 0}}),
+              "invalid camera: up vector is zero or parallel to the view direction");
+    EXPECT_EQ(camera_error({{0, 0, 0}, {0, 0, -1}, {0, 0, 1}}),
+              "invalid camera: up vector is zero or parallel to the view direction");
+    EXPECT_EQ(camera_error({{0, 0, 0}, {0, 0, -3e7f}, {0, 1, 0}}),
+              "invalid camera: the gaze point is 3e+07 from the eye (at most 1e6; the distance sets the field of "
+              "view, 1 gives 90 degrees)");
+    EXPECT_EQ(camera_error({{0, 0, 0}, {0, 0, -1}, {0, 2e6f, 0}}),
+              "invalid camera: up vector of length 2e+06 (at most 1e6)");
+    // Up 0.05 degrees from the view direction is too close; 0.1 degrees is enough.
+    const float a = 0.05f * 3.14159265f / 180.0f, b = 0.1f * 3.14159265f / 180.0f;
+    EXPECT_NE(camera_error({{0, 0, 0}, {0, 0, -1}, {0, std::sin(a), -std::cos(a)}}), "(valid)");
+    EXPECT_EQ(camera_error({{0, 0, 0}, {0, 0, -1}, {0, std::sin(b), -std::cos(b)}}), "(valid)");
+}
+
+TEST(ValidateCamera, IsWhatMakeViewPlaneChecks) {
+    // Huge values that pass validation give finite view planes; what it refuses, make_view_plane
+    // refuses with the same message.
+    const CameraSpec cameras[] = {{{1e30f, 0, 0}, {1e30f, 0, -1e6f}, {0, 1e6f, 0}},
+                                  {{0, 0, 0}, {0, 0, -1e-3f}, {0, 1e-30f, 0}},
+                                  {{0, 0, 0}, {0, 0, -3e7f}, {0, 1, 0}},
+                                  {{5, 5, 5}, {5, 5, 5}, {0, 1, 0}}};
+    for (const CameraSpec& c : cameras) {
+        const std::string expected = camera_error(c);
+        std::string got = "(valid)";
+        try {
+            const ViewPlane v = make_view_plane(c, 64, 48);
+            EXPECT_TRUE(is_finite(v.upper_left) && is_finite(v.step_x) && is_finite(v.step_y));
+            EXPECT_TRUE(is_finite(v.right) && is_finite(v.up) && is_finite(v.forward));
+        } catch (const Error& e) {
+            got = e.what();
+        }
+        EXPECT_EQ(got, expected);
+    }
+}
+
+TEST(ParseCameraSpec, MessagesQuoteTheText) {
+    auto error_of = [](const std::string& text) {
+        try {
+            (void)parse_camera_spec(text);
+        } catch (const Error& e) {
+            return std::string(e.what());
+        }
+        return std::string("(no error)");
+    };
+    EXPECT_EQ(error_of("1,2,3"), "camera '1,2,3': expected 9 numbers ex,ey,ez,gx,gy,gz,ux,uy,uz, got 3");
+    EXPECT_EQ(error_of("1,2,x"), "camera '1,2,x': malformed number");
+    EXPECT_EQ(error_of("1;2"), "camera '1;2': expected ',' between numbers");
 }

@@ -11,6 +11,7 @@
 #include <fstream>
 
 #include "toonray/core/error.h"
+#include "toonray/scene/mtl_loader.h"
 
 using namespace toonray;
 namespace fs = std::filesystem;

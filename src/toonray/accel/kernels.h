@@ -5,7 +5,7 @@
 
 #include <cstdint>
 
-#include "toonray/accel/triangle_accel.h"
+#include "toonray/accel/ray.h"
 #include "toonray/accel/wide_bvh.h"
 
 namespace toonray::accel {
@@ -21,6 +21,8 @@ struct KernelTable {
     const char* name;
     /// Closest hit of one ray; `stack` holds WideBvh::max_stack entries.
     bool (*intersect1)(const WideBvh& w, const Ray& ray, Hit& hit, std::uint64_t* stack);
+    /// Whether one ray hits any triangle with 0 < t < ray.tmax; `stack` as for intersect1.
+    bool (*occluded1)(const WideBvh& w, const Ray& ray, std::uint64_t* stack);
     /// Closest hits of a width x height (<= 16 x 16) row-major tile of rays from one origin.
     void (*intersect_tile)(const WideBvh& w, const Vec3f& origin, const Vec3f* dirs, int width, int height,
                            float tmax, Hit* hits, bool* found, TileEntry* stack, std::uint64_t* stack1);

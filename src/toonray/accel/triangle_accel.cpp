@@ -114,6 +114,15 @@ bool TriangleAccel::intersect(const Ray& ray, Hit& hit) const {
     return kernels().intersect1(wide_, ray, hit, stack.data());
 }
 
+bool TriangleAccel::occluded(const Ray& ray) const {
+    if (wide_.max_stack <= kFixedStack) {
+        std::uint64_t stack[kFixedStack];
+        return kernels().occluded1(wide_, ray, stack);
+    }
+    std::vector<std::uint64_t> stack(wide_.max_stack);
+    return kernels().occluded1(wide_, ray, stack.data());
+}
+
 void TriangleAccel::intersect_tile(const Vec3f& origin, const Vec3f* dirs, int width, int height, Hit* hits,
                                    bool* found, float tmax) const {
     if (width <= 0 || height <= 0) return;

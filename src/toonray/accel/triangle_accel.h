@@ -1,7 +1,8 @@
 #pragma once
-/// Closest-hit ray queries against a triangle mesh: the binary BVH of bvh.h, collapsed into an
-/// 8-wide tree traversed with SIMD (AVX2 when the CPU has it, SSE4.2 otherwise), single rays
-/// and coherent tiles of rays from one origin. docs/accel.md describes the design.
+/// Closest-hit and occlusion ray queries against a triangle mesh: the binary BVH of bvh.h,
+/// collapsed into an 8-wide tree traversed with SIMD (AVX2 when the CPU has it, SSE4.2
+/// otherwise), single rays and coherent tiles of rays from one origin. docs/accel.md describes
+/// the design.
 
 #include <array>
 #include <cstdint>
@@ -11,27 +12,9 @@
 #include <vector>
 
 #include "toonray/accel/bvh.h"
-#include "toonray/core/math.h"
-
-namespace toonray {
-
-struct Ray {
-    Vec3f origin;
-    Vec3f dir;  ///< need not be unit length; hit distances are in units of |dir|
-    float tmax = std::numeric_limits<float>::infinity();
-};
-
-struct Hit {
-    float t = std::numeric_limits<float>::infinity();
-    std::uint32_t prim = 0xffffffffu;  ///< triangle index in the input order
-    float u = 0, v = 0;                ///< barycentrics of corners 1 and 2
-
-    [[nodiscard]] bool valid() const { return prim != 0xffffffffu; }
-};
-
-}  // namespace toonray
-
+#include "toonray/accel/ray.h"
 #include "toonray/accel/wide_bvh.h"
+#include "toonray/core/math.h"
 
 namespace toonray {
 
@@ -49,6 +32,11 @@ public:
     /// Closest hit with 0 < t < ray.tmax. Returns true and fills `hit` when there is one.
     /// Among hits at the same distance the lowest triangle index wins, whatever the tree.
     bool intersect(const Ray& ray, Hit& hit) const;
+
+    /// Whether any triangle is hit with 0 < t < ray.tmax: exactly when intersect(ray, hit) would
+    /// return true (the same triangle test), but traversal stops at the first such hit, in no
+    /// particular order. For shadow rays.
+    [[nodiscard]] bool occluded(const Ray& ray) const;
 
     /// The closest hits of a grid of rays from one origin: `dirs` holds width x height
     /// directions row by row, and hits/found receive, for each, exactly what

@@ -9,7 +9,8 @@
 #include <cmath>
 #include <utility>
 
-#include "toonray/accel/triangle_accel.h"
+#include "toonray/accel/ray.h"
+#include "toonray/core/index.h"
 
 namespace toonray::accel {
 namespace {
@@ -82,11 +83,11 @@ inline constexpr float kBoxSlack = 1.0f + 1.0f / (1 << 20);
 // the lowest (t, index) pair, whatever order triangles are tested in.
 struct BestHit {
     float t;
-    std::uint32_t prim = 0xffffffffu;
+    std::uint32_t prim = kNoIndex;
     float u = 0, v = 0;
 
     [[nodiscard]] bool takes(float t_new, std::uint32_t prim_new) const {
-        return t_new < t || (t_new == t && prim != 0xffffffffu && prim_new < prim);
+        return t_new < t || (t_new == t && prim != kNoIndex && prim_new < prim);
     }
     void take(float t_new, std::uint32_t prim_new, float u_new, float v_new) {
         t = t_new;

@@ -29,7 +29,7 @@ void WideBvh::build(const Bvh& bvh, std::span<const BBox> boxes, std::span<const
         const float nan = std::numeric_limits<float>::quiet_NaN();
         for (auto& corner : empty.v)
             for (auto& axis : corner) std::fill(std::begin(axis), std::end(axis), nan);
-        std::fill(std::begin(empty.prim), std::end(empty.prim), kNoPrim);
+        std::fill(std::begin(empty.prim), std::end(empty.prim), kNoIndex);
     }
     std::uint32_t next_slot = 0;
     // Leaves are packed in the order they are made (depth-first through the wide tree).
@@ -137,22 +137,22 @@ void WideBvh::build(const Bvh& bvh, std::span<const BBox> boxes, std::span<const
     // and inner nodes (binary node ids).
     struct Slot {
         BvhNode leaf;
-        std::uint32_t inner;  // binary node, or kEmptyChild for a leaf
+        std::uint32_t inner;  // binary node, or kNoIndex for a leaf
     };
     auto gather = [&](auto&& self, std::uint32_t n, int i, Slot* out, int& len) -> void {
         const BvhNode& b = bvh.nodes[n];
         if (b.is_leaf()) {
             if ((flags[n] & kSpread) && static_cast<std::uint32_t>(i) >= b.count) {
                 for (std::uint32_t k = 0; k < b.count; ++k)
-                    out[len++] = {BvhNode{tri_box(bvh.prim_indices[b.first + k]), b.first + k, 1}, kEmptyChild};
+                    out[len++] = {BvhNode{tri_box(bvh.prim_indices[b.first + k]), b.first + k, 1}, kNoIndex};
             } else {
-                out[len++] = {b, kEmptyChild};
+                out[len++] = {b, kNoIndex};
             }
             return;
         }
         while (i > 1 && split[n][i - 1] == 0) --i;
         if (i <= 1) {
-            out[len++] = {range(n), (flags[n] & kAsLeaf) ? kEmptyChild : n};
+            out[len++] = {range(n), (flags[n] & kAsLeaf) ? kNoIndex : n};
             return;
         }
         const int k = split[n][i - 1];
@@ -196,7 +196,7 @@ void WideBvh::build(const Bvh& bvh, std::span<const BBox> boxes, std::span<const
                 w.lo[a][i] = box.lo[a];
                 w.hi[a][i] = box.hi[a];
             }
-            if (ch[i].inner == kEmptyChild) {
+            if (ch[i].inner == kNoIndex) {
                 w.child[i] = make_leaf(ch[i].leaf);
             } else {
                 w.child[i] = static_cast<std::uint32_t>(nodes.size());

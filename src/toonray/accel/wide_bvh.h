@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "toonray/accel/bvh.h"
+#include "toonray/core/index.h"
 #include "toonray/core/math.h"
 
 namespace toonray::accel {
@@ -22,7 +23,6 @@ inline constexpr std::uint32_t kLeafCountShift = 27;
 inline constexpr std::uint32_t kMaxSlots = 1u << kLeafCountShift;  ///< 134 million triangles
 inline constexpr std::uint32_t kLeafEnd = 0x80000000u;  ///< in TriBlock::prim: last triangle of its leaf
 inline constexpr std::uint32_t kEmptyChild = 0xffffffffu;
-inline constexpr std::uint32_t kNoPrim = 0xffffffffu;
 
 [[nodiscard]] inline bool is_leaf(std::uint32_t ref) { return (ref & kLeafBit) != 0; }
 [[nodiscard]] inline std::uint32_t leaf_first(std::uint32_t ref) { return ref & (kMaxSlots - 1); }
@@ -40,7 +40,7 @@ static_assert(sizeof(WideNode) == 256);
 
 /// Four triangle slots, structure of arrays. Leaves are packed one after another with no gaps;
 /// the slots after the last leaf (and two whole blocks after it, which 8-wide loads may touch)
-/// have NaN corners, which fail every test, and prim == kNoPrim.
+/// have NaN corners, which fail every test, and prim == kNoIndex.
 struct alignas(16) TriBlock {
     float v[3][3][4];         ///< [corner][axis][lane]
     std::uint32_t prim[4];    ///< triangle index in the input order, | kLeafEnd on a leaf's last

@@ -78,15 +78,6 @@ const Limits& limits() { return process_limits(); }
 
 void set_limits(const Limits& limits) { process_limits() = limits; }
 
-std::uint64_t scene_bytes(std::uint64_t vertices, std::uint64_t triangles) {
-    // Per vertex: the position and, at worst, a normal and a texture coordinate. Per triangle:
-    // 5 index arrays (44 bytes), the BVH build (boxes, centres, indices, nodes: ~100 bytes),
-    // the packed triangles (36 bytes) and the corner list the automatic camera gathers (36
-    // bytes). Measured: a 2M-triangle, 1M-vertex grid peaks at 431 MB including its 55 MB of
-    // text; this estimates 518 MB.
-    return add_sat(mul_sat(vertices, 12 + 12 + 8), mul_sat(triangles, 44 + 100 + 36 + 36));
-}
-
 void check_memory(std::uint64_t bytes, std::string_view what, std::string_view advice) {
     const std::uint64_t limit = limits().max_memory;
     if (bytes <= limit) return;

@@ -53,12 +53,10 @@ struct Limits {
 /// Replaces the process-wide limits. Call before starting threads that read inputs.
 void set_limits(const Limits& limits);
 
-// --- Memory estimates ------------------------------------------------------------------------
-// Deliberately generous: they count the buffers a frame keeps plus the temporaries of building
-// it, so that a frame within the estimate does not run out of memory.
-
-/// A loaded scene with its BVH: attribute arrays, triangle arrays, and the BVH build.
-[[nodiscard]] std::uint64_t scene_bytes(std::uint64_t vertices, std::uint64_t triangles);
+// --- Memory -----------------------------------------------------------------------------------
+// Each module estimates the memory of its own buffers (render: frame_buffer_bytes; scene:
+// scene_bytes), deliberately generously: the buffers a frame keeps plus the temporaries of
+// building it, so that a frame within the estimate does not run out of memory.
 
 /// Throws Error("WHAT needs about X of memory, more than the limit of Y (--max-memory ...)")
 /// when `bytes` exceeds limits().max_memory. `advice` is appended when not empty.

@@ -114,9 +114,7 @@ namespace {
         if (s.shadows && l_dot_n > 0.0f) {
             // Leave the surface along its normal to avoid hitting it again.
             Vec3f origin = p + n * (1e-4f * std::max(1.0f, hit.t));
-            Ray shadow{origin, to_light, distance};
-            Hit blocker;
-            if (ctx.accel.intersect(shadow, blocker)) continue;
+            if (ctx.accel.occluded(Ray{origin, to_light, distance})) continue;
         }
         diffuse += light.intensity * std::max(0.0f, l_dot_n);
         if (s.specular && material.ns > 0.0f && (material.ks.x > 0 || material.ks.y > 0 || material.ks.z > 0)) {

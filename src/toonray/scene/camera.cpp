@@ -9,18 +9,44 @@
 
 namespace toonray {
 
-ViewPlane make_view_plane(const CameraSpec& camera, int width, int height) {
+void validate_camera(const CameraSpec& camera) {
     if (!is_finite(camera.eye) || !is_finite(camera.gaze) || !is_finite(camera.up))
         throw Error("invalid camera: eye, gaze and up must be finite");
+    // In double precision, so that large values cannot overflow into a camera that passes here
+    // and yields NaN rays in make_view_plane's float arithmetic.
+    const double vx = double{camera.gaze.x} - camera.eye.x, vy = double{camera.gaze.y} - camera.eye.y,
+                 vz = double{camera.gaze.z} - camera.eye.z;
+    const double ux = camera.up.x, uy = camera.up.y, uz = camera.up.z;
+    const double view = std::sqrt(vx * vx + vy * vy + vz * vz);
+    const double up = std::sqrt(ux * ux + uy * uy + uz * uz);
+    if (!(view > 0)) throw Error("invalid camera: eye and gaze point are the same point");
+    // |gaze - eye| sets the field of view (2 atan(1 / |gaze - eye|)) and up is a direction:
+    // beyond 1e6 neither means anything, and the float arithmetic overflows.
+    if (view > kMaxCameraLength)
+        throw Error(fmt::format("invalid camera: the gaze point is {:g} from the eye (at most 1e6; the "
+                                "distance sets the field of view, 1 gives 90 degrees)",
+                                view));
+    if (up > kMaxCameraLength) throw Error(fmt::format("invalid camera: up vector of length {:g} (at most 1e6)", up));
+    // The sine of the angle between up and the view direction; below ~0.06 degrees the view's
+    // right vector is unusable.
+    const double cx = vy * uz - vz * uy, cy = vz * ux - vx * uz, cz = vx * uy - vy * ux;
+    const double sine = std::sqrt(cx * cx + cy * cy + cz * cz) / (view * up);
+    if (!(up > 0) || !(sine > kMinUpSine))
+        throw Error("invalid camera: up vector is zero or parallel to the view direction");
+    // The same in the float arithmetic that builds the view plane, where tiny lengths underflow
+    // to zero.
+    const Vec3f view_dir = camera.gaze - camera.eye;
+    const float view_len = length(view_dir), up_len = length(camera.up);
+    if (!(view_len > 0)) throw Error("invalid camera: eye and gaze point are the same point");
+    if (!(up_len > 0) || !(length(cross(view_dir, camera.up)) > static_cast<float>(kMinUpSine) * view_len * up_len))
+        throw Error("invalid camera: up vector is zero or parallel to the view direction");
+}
+
+ViewPlane make_view_plane(const CameraSpec& camera, int width, int height) {
+    validate_camera(camera);
     Vec3f view_dir = camera.gaze - camera.eye;
     float view_len = length(view_dir);
-    if (!(view_len > 0)) throw Error("invalid camera: eye and gaze point are the same point");
-    float up_len = length(camera.up);
-    if (!(up_len > 0)) throw Error("invalid camera: up vector is zero");
     Vec3f side = cross(view_dir, camera.up);
-    // sin of the angle between view direction and up; below ~0.06 degrees it is unusable.
-    if (!(length(side) > 1e-3f * view_len * up_len))
-        throw Error("invalid camera: up vector is parallel to the view direction");
 
     const float ratio = static_cast<float>(height) / static_cast<float>(width);
     Vec3f center = camera.eye + view_dir;
@@ -88,16 +114,16 @@ CameraSpec parse_camera_spec(const std::string& text) {
         float v;
         auto [next, ec] = std::from_chars(p, end, v);
         if (ec != std::errc() || !std::isfinite(v))
-            throw Error(fmt::format("--camera: malformed number in '{}'", text));
+            throw Error(fmt::format("camera '{}': malformed number", text));
         values.push_back(v);
         p = next;
         if (p < end) {
-            if (*p != ',') throw Error(fmt::format("--camera: expected ',' in '{}'", text));
+            if (*p != ',') throw Error(fmt::format("camera '{}': expected ',' between numbers", text));
             ++p;
         }
     }
     if (values.size() != 9)
-        throw Error(fmt::format("--camera: expected 9 numbers ex,ey,ez,gx,gy,gz,ux,uy,uz, got {}",
+        throw Error(fmt::format("camera '{}': expected 9 numbers ex,ey,ez,gx,gy,gz,ux,uy,uz, got {}", text,
                                 values.size()));
     return {{values[0], values[1], values[2]}, {values[3], values[4], values[5]},
             {values[6], values[7], values[8]}};

@@ -33,12 +33,23 @@ struct ViewPlane {
     }
 };
 
+/// Largest |gaze - eye| and |up| a camera may have.
+inline constexpr double kMaxCameraLength = 1e6;
+/// Smallest sine of the angle between up and the view direction (about 0.06 degrees).
+inline constexpr double kMinUpSine = 1e-3;
+
+/// Throws Error("invalid camera: ...") unless eye, gaze and up are finite, eye != gaze,
+/// |gaze - eye| and |up| are at most kMaxCameraLength, up is not zero, and the sine of its angle
+/// to the view direction exceeds kMinUpSine (checked in double precision, and again in float
+/// where tiny lengths underflow). Every camera that passes gives make_view_plane finite vectors.
+void validate_camera(const CameraSpec& camera);
+
 /// Builds the view plane exactly as the seed defines it:
 /// viewDir = gaze - eye; center = eye + viewDir; ratio = h / w; right = normalize(viewDir x up);
 /// upVec = ratio * up; UL = center + upVec - right, UR = center + upVec + right,
 /// LL = center - right - upVec. (As in the seed, `up` is used as given: it should be a unit
 /// vector orthogonal to the view direction, which is what exporters write.)
-/// Throws Error when eye == gaze, up is zero or parallel to the view direction, or a value is not finite.
+/// Throws validate_camera's Error for an invalid camera.
 ViewPlane make_view_plane(const CameraSpec& camera, int width, int height);
 
 /// A camera that frames the points: looks at the centre of their bounds from the front-right
@@ -46,7 +57,7 @@ ViewPlane make_view_plane(const CameraSpec& camera, int width, int height);
 /// every point stays inside the image with a 5% margin. No points: frames the unit cube.
 CameraSpec auto_camera(std::span<const Vec3f> points, int width, int height);
 
-/// Parses "ex,ey,ez,gx,gy,gz,ux,uy,uz" (as given to --camera). Throws Error when malformed.
+/// Parses "ex,ey,ez,gx,gy,gz,ux,uy,uz". Throws Error("camera 'TEXT': ...") when malformed.
 CameraSpec parse_camera_spec(const std::string& text);
 
 }  // namespace toonray

@@ -1,5 +1,6 @@
 #pragma once
-/// Wavefront OBJ and MTL reading, written for speed (one pass, no per-line allocation).
+/// Wavefront OBJ reading, with the MTL libraries a file names, written for speed (one pass, no
+/// per-line allocation).
 ///
 /// Reads: v (optional w or colour values ignored), vt, vn, f with 3 or more corners in all four
 /// index forms (v, v/vt, v//vn, v/vt/vn), negative (relative) indices, o, g, usemtl, mtllib
@@ -12,7 +13,6 @@
 #include <cstddef>
 #include <filesystem>
 #include <string_view>
-#include <vector>
 
 #include "toonray/core/error.h"
 #include "toonray/core/limits.h"
@@ -29,18 +29,14 @@ struct ObjOptions {
 
 /// Loads an OBJ file and the MTL files it names (each once). Clears `scene` first but keeps its
 /// allocations, so a batch of frames reuses memory. Throws Error("file:line: reason") on
-/// malformed input or an exceeded limit; a missing MTL file or unknown material is a warning
-/// (at most 100 warnings per file, then a count of the rest).
+/// malformed input, LimitError when the input exceeds a limit of `options.limits`; a missing
+/// MTL file or unknown material is a warning (at most 100 warnings per file, then a count of
+/// the rest).
 void load_obj(const std::filesystem::path& path, Scene& scene, Warnings& warnings,
               const ObjOptions& options = {});
 
 /// Parses OBJ text already in memory; `path` names it in messages and anchors mtllib paths.
 void parse_obj(std::string_view text, const std::filesystem::path& path, Scene& scene,
                Warnings& warnings, const ObjOptions& options = {});
-
-/// Parses MTL text, appending its materials. A name already in `materials` (defined earlier in
-/// this text or in an earlier library) keeps its first definition, with a warning.
-void parse_mtl(std::string_view text, const std::filesystem::path& path,
-               std::vector<Material>& materials, Warnings& warnings);
 
 }  // namespace toonray

@@ -1,5 +1,7 @@
 #include "toonray/scene/scene.h"
 
+#include <limits>
+
 namespace toonray {
 
 BBox Scene::bounds() const {
@@ -21,6 +23,20 @@ void Scene::clear() {
     materials.assign(1, Material{"(default)"});
     objects.assign(1, "(default)");
     camera.reset();
+}
+
+std::uint64_t scene_bytes(std::uint64_t vertices, std::uint64_t triangles) {
+    // Per vertex: the position and, at worst, a normal and a texture coordinate. Per triangle:
+    // 5 index arrays (44 bytes), the BVH build (boxes, centres, indices, nodes: ~100 bytes),
+    // the packed triangles (36 bytes) and the corner list the automatic camera gathers (36
+    // bytes). Measured: a 2M-triangle, 1M-vertex grid peaks at 431 MB including its 55 MB of
+    // text; this estimates 518 MB.
+    std::uint64_t vertex_bytes, triangle_bytes, sum;
+    if (__builtin_mul_overflow(vertices, std::uint64_t{12 + 12 + 8}, &vertex_bytes) ||
+        __builtin_mul_overflow(triangles, std::uint64_t{44 + 100 + 36 + 36}, &triangle_bytes) ||
+        __builtin_add_overflow(vertex_bytes, triangle_bytes, &sum))
+        return std::numeric_limits<std::uint64_t>::max();
+    return sum;
 }
 
 }  // namespace toonray

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "toonray/core/bbox.h"
+#include "toonray/core/index.h"
 #include "toonray/core/math.h"
 #include "toonray/scene/camera.h"
 
@@ -26,8 +27,6 @@ struct Material {
     int illum = 2;
     std::string map_kd;  ///< texture path as written in the MTL, resolved relative to it
 };
-
-inline constexpr std::uint32_t kNoIndex = 0xffffffffu;
 
 /// Triangles with per-corner indices into shared attribute arrays. Material 0 is always the
 /// default material and object 0 the default object, so every triangle has both.
@@ -63,5 +62,11 @@ struct Scene {
     }
     void clear();
 };
+
+/// Memory for a scene of `vertices` attribute values and `triangles` triangles while it is
+/// rendered, saturating at the largest value: its arrays, and what rendering builds from it
+/// (the BVH build, the packed triangles and the automatic camera's corner list). Deliberately
+/// generous, as the estimates of core/limits.h are.
+[[nodiscard]] std::uint64_t scene_bytes(std::uint64_t vertices, std::uint64_t triangles);
 
 }  // namespace toonray
