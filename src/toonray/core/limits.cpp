@@ -1,5 +1,7 @@
 #include "toonray/core/limits.h"
 
+#include "toonray/core/saturating.h"
+
 #include <unistd.h>
 
 #include <charconv>
@@ -15,17 +17,6 @@ namespace {
 Limits& process_limits() {
     static Limits limits;
     return limits;
-}
-
-/// Multiplies without overflow: saturates at the largest value.
-std::uint64_t mul_sat(std::uint64_t a, std::uint64_t b) {
-    std::uint64_t r;
-    return __builtin_mul_overflow(a, b, &r) ? std::numeric_limits<std::uint64_t>::max() : r;
-}
-
-std::uint64_t add_sat(std::uint64_t a, std::uint64_t b) {
-    std::uint64_t r;
-    return __builtin_add_overflow(a, b, &r) ? std::numeric_limits<std::uint64_t>::max() : r;
 }
 
 /// A non-negative number with an optional suffix from `units` (each a power of `base`).
@@ -71,7 +62,7 @@ std::uint64_t Limits::default_max_memory() {
     const long pages = ::sysconf(_SC_PHYS_PAGES);
     const long page_size = ::sysconf(_SC_PAGE_SIZE);
     if (pages <= 0 || page_size <= 0) return 8 * kGiB;
-    return mul_sat(static_cast<std::uint64_t>(pages), static_cast<std::uint64_t>(page_size)) / 4 * 3;
+    return mul_saturated(static_cast<std::uint64_t>(pages), static_cast<std::uint64_t>(page_size)) / 4 * 3;
 }
 
 const Limits& limits() { return process_limits(); }

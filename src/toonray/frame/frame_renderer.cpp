@@ -1,15 +1,11 @@
 #include "toonray/frame/frame_renderer.h"
 
+#include "toonray/core/saturating.h"
+
 #include <variant>
 #include <vector>
 
 namespace toonray {
-namespace {
-
-std::uint64_t add_saturated(std::uint64_t a, std::uint64_t b) { return a > UINT64_MAX - b ? UINT64_MAX : a + b; }
-
-}  // namespace
-
 RenderSettings FrameOptions::render_settings() const {
     RenderSettings s = settings;
     s.feature_images = aov_dir.has_value();

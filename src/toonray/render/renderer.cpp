@@ -7,6 +7,7 @@
 
 #include "toonray/core/error.h"
 #include "toonray/core/parallel.h"
+#include "toonray/core/saturating.h"
 #include "toonray/render/classic.h"
 #include "toonray/render/trace.h"
 
@@ -86,11 +87,6 @@ std::span<const FeatureImage> feature_images() {
 }
 
 namespace {
-
-std::uint64_t add_saturated(std::uint64_t a, std::uint64_t b) { return a > UINT64_MAX - b ? UINT64_MAX : a + b; }
-std::uint64_t mul_saturated(std::uint64_t a, std::uint64_t b) {
-    return a != 0 && b > UINT64_MAX / a ? UINT64_MAX : a * b;
-}
 
 // Bytes per pixel of the feature images of a line mode, from the table.
 std::uint64_t feature_bytes_per_pixel(EdgeMode mode) {
