@@ -17,10 +17,6 @@ namespace {
 
 constexpr double kDegrees = std::numbers::pi / 180.0;
 
-/// Below this sine of the angle between up and the view direction a camera is unusable; the
-/// same threshold make_view_plane applies (about 0.06 degrees).
-constexpr double kParallelSine = 1e-3;
-
 /// Ranges that keep the spline's double arithmetic and the float camera finite.
 constexpr double kMaxKeyTime = 1e9;   // seconds, about 32 years
 constexpr double kMinKeyGap = 1e-6;   // seconds between keys
@@ -83,7 +79,7 @@ CameraSpec camera_spec(const CameraPose& pose) {
     const Vec3d eye = to_d(pose.eye);
     const Frame f = make_frame(eye, to_d(pose.target), to_d(pose.up));
     if (!(f.view_length > 0)) throw Error("camera: eye and target are the same point");
-    if (!(f.up_sine > kParallelSine)) throw Error("camera: up is parallel to the view direction");
+    if (!(f.up_sine > kMinUpSine)) throw Error("camera: up is parallel to the view direction");
     const double distance = 1.0 / std::tan(0.5 * pose.fov * kDegrees);
     const Vec3d gaze = {eye.x + f.dir.x * distance, eye.y + f.dir.y * distance,
                         eye.z + f.dir.z * distance};
@@ -121,7 +117,7 @@ CameraPath::CameraPath(std::vector<CameraKey> keys, std::optional<double> loop_p
         const Frame f = make_frame(to_d(k.eye), to_d(k.target), to_d(k.up));
         if (!(f.view_length > 1e-6)) fail("eye and target are the same point");
         if (!(f.up_length > 1e-6)) fail("up vector is zero");
-        if (!(f.up_sine > kParallelSine)) fail("up is parallel to the view direction (eye to target)");
+        if (!(f.up_sine > kMinUpSine)) fail("up is parallel to the view direction (eye to target)");
     }
     if (period_) {
         const double span = keys_.back().time - keys_.front().time;
@@ -241,7 +237,7 @@ void CameraPath::validate_between_keys() const {
                 problem = "the eye reaches the target";
             } else if (!(f.up_length > 1e-3)) {
                 problem = "the up vector vanishes (the keys' ups point in opposite directions)";
-            } else if (!(f.up_sine > kParallelSine)) {
+            } else if (!(f.up_sine > kMinUpSine)) {
                 problem = "up turns parallel to the view direction";
             }
             if (!problem.empty())

@@ -43,7 +43,7 @@ void FrameRenderer::render(const Scene& scene, const CameraSpec& camera, const s
                            const FrameOptions& options, Warnings& warnings) {
     const RenderSettings settings = options.render_settings();
     // Validate the camera before any work so a bad one fails with nothing written.
-    make_view_plane(camera, settings.width, settings.height);
+    validate_camera(camera);
     const TriangleAccel& accel = accel_.update(scene, options.bvh);
     const TextureSet* textures = settings.shading.textures ? &textures_.load(scene, warnings) : nullptr;
     const ImageRgb8& image = renderer_.render(scene, accel, camera, settings, textures);
