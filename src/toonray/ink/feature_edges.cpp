@@ -1,0 +1,328 @@
+#include "toonray/ink/feature_edges.h"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <numbers>
+#include <tuple>
+
+#include "toonray/ink/chunks.h"
+
+namespace toonray::ink {
+
+const char* edge_type_name(EdgeType type) {
+    switch (type) {
+        case EdgeType::Silhouette: return "silhouette";
+        case EdgeType::Border: return "border";
+        case EdgeType::Crease: return "crease";
+        case EdgeType::Material: return "material";
+        case EdgeType::Intersection: return "intersection";
+    }
+    return "?";
+}
+
+namespace {
+
+std::uint32_t float_bits(float f) { return std::bit_cast<std::uint32_t>(f + 0.0f); }  // -0 + 0 = +0
+
+bool same_position(const Vec3f& a, const Vec3f& b) {
+    return float_bits(a.x) == float_bits(b.x) && float_bits(a.y) == float_bits(b.y) && float_bits(a.z) == float_bits(b.z);
+}
+
+// Lexicographic order of positions: orders an edge's ends the same way from either triangle, so
+// that a point computed on it is the same bits from both.
+bool position_less(const Vec3f& a, const Vec3f& b) {
+    return std::tie(a.x, a.y, a.z) < std::tie(b.x, b.y, b.z);
+}
+
+// Unit geometric normal (p1 - p0) x (p2 - p0), or zero for a degenerate triangle.
+Vec3f face_normal(const Scene& scene, std::size_t t) {
+    const auto& v = scene.tri_positions[t];
+    const Vec3f n = cross(scene.positions[v[1]] - scene.positions[v[0]], scene.positions[v[2]] - scene.positions[v[0]]);
+    const float len = length(n);
+    if (!(len > 0.0f) || !std::isfinite(len)) return Vec3f(0.0f);
+    return n / len;
+}
+
+bool has_corner_normals(const Scene& scene, std::size_t t) {
+    if (t >= scene.tri_normals.size()) return false;
+    for (std::uint32_t n : scene.tri_normals[t])
+        if (n == kNoIndex || n >= scene.normals.size()) return false;
+    return true;
+}
+
+std::array<Vec3f, 3> corners(const Scene& scene, std::size_t t) {
+    const auto& v = scene.tri_positions[t];
+    return {scene.positions[v[0]], scene.positions[v[1]], scene.positions[v[2]]};
+}
+
+}  // namespace
+
+WeldedMesh weld_vertices(const Scene& scene) {
+    const std::size_t n = scene.triangle_count();
+    struct Corner {
+        std::uint32_t object, x, y, z, corner;
+    };
+    std::vector<Corner> list;
+    list.reserve(n * 3);
+    for (std::size_t t = 0; t < n; ++t)
+        for (int k = 0; k < 3; ++k) {
+            const Vec3f& p = scene.positions[scene.tri_positions[t][k]];
+            list.push_back({scene.tri_object[t], float_bits(p.x), float_bits(p.y), float_bits(p.z),
+                            static_cast<std::uint32_t>(t * 3 + k)});
+        }
+    auto key = [](const Corner& c) { return std::tie(c.object, c.x, c.y, c.z); };
+    std::sort(list.begin(), list.end(), [&](const Corner& a, const Corner& b) {
+        return std::tie(a.object, a.x, a.y, a.z, a.corner) < std::tie(b.object, b.x, b.y, b.z, b.corner);
+    });
+    WeldedMesh mesh;
+    mesh.tri_vertices.resize(n);
+    for (std::size_t i = 0; i < list.size(); ++i) {
+        if (i == 0 || key(list[i]) != key(list[i - 1]))
+            mesh.vertex_position.push_back(scene.tri_positions[list[i].corner / 3][list[i].corner % 3]);
+        mesh.tri_vertices[list[i].corner / 3][list[i].corner % 3] =
+            static_cast<std::uint32_t>(mesh.vertex_position.size() - 1);
+    }
+    // Triangles around each vertex, by counting sort (in triangle order; a triangle with a
+    // repeated corner counts once at that vertex).
+    auto distinct = [&](std::size_t t, int k) {
+        const auto& w = mesh.tri_vertices[t];
+        for (int i = 0; i < k; ++i)
+            if (w[i] == w[k]) return false;
+        return true;
+    };
+    mesh.ring_offsets.assign(mesh.vertex_count() + 1, 0);
+    for (std::size_t t = 0; t < n; ++t)
+        for (int k = 0; k < 3; ++k)
+            if (distinct(t, k)) ++mesh.ring_offsets[mesh.tri_vertices[t][k] + 1];
+    for (std::size_t v = 0; v < mesh.vertex_count(); ++v) mesh.ring_offsets[v + 1] += mesh.ring_offsets[v];
+    mesh.ring_triangles.resize(mesh.ring_offsets.back());
+    std::vector<std::uint32_t> fill(mesh.ring_offsets.begin(), mesh.ring_offsets.end() - 1);
+    for (std::size_t t = 0; t < n; ++t)
+        for (int k = 0; k < 3; ++k)
+            if (distinct(t, k)) mesh.ring_triangles[fill[mesh.tri_vertices[t][k]]++] = static_cast<std::uint32_t>(t);
+    return mesh;
+}
+
+bool intersect_triangles(const std::array<Vec3f, 3>& a, const std::array<Vec3f, 3>& b, TriangleCrossing& out) {
+    const Vec3f na = cross(a[1] - a[0], a[2] - a[0]);
+    const Vec3f nb = cross(b[1] - b[0], b[2] - b[0]);
+    float da[3], db[3];
+    for (int k = 0; k < 3; ++k) {
+        da[k] = dot(nb, a[k] - b[0]);
+        db[k] = dot(na, b[k] - a[0]);
+    }
+    auto proper = [](const float* d) {
+        const bool pos = d[0] > 0 || d[1] > 0 || d[2] > 0;
+        const bool neg = d[0] < 0 || d[1] < 0 || d[2] < 0;
+        return pos && neg;
+    };
+    if (!proper(da) || !proper(db)) return false;
+    const Vec3f dir = cross(na, nb);
+    // The two points where a triangle's edges cross the other's plane (a corner on the plane
+    // counts with the positive side, so exactly two edges change side), as positions along dir.
+    struct Crossing {
+        Vec3f p;
+        float s;
+        int e0, e1;
+    };
+    auto crossings = [&](const std::array<Vec3f, 3>& tri, const float* d, Crossing* c) {
+        int n = 0;
+        for (int k = 0; k < 3 && n < 2; ++k) {
+            int u = k, v = (k + 1) % 3;
+            if ((d[u] >= 0) == (d[v] >= 0)) continue;
+            if (position_less(tri[v], tri[u])) std::swap(u, v);
+            const float t = d[u] / (d[u] - d[v]);
+            const Vec3f p = tri[u] + (tri[v] - tri[u]) * t;
+            c[n++] = {p, dot(p, dir), std::min(u, v), std::max(u, v)};
+        }
+        if (n == 2 && c[1].s < c[0].s) std::swap(c[0], c[1]);
+        return n == 2;
+    };
+    Crossing ca[2], cb[2];
+    if (!crossings(a, da, ca) || !crossings(b, db, cb)) return false;
+    // The segment is the overlap of the two intervals on the common line.
+    const Crossing& lo = ca[0].s >= cb[0].s ? ca[0] : cb[0];
+    const Crossing& hi = ca[1].s <= cb[1].s ? ca[1] : cb[1];
+    if (!(lo.s < hi.s)) return false;
+    const bool lo_b = &lo == &cb[0], hi_b = &hi == &cb[1];
+    out.p[0] = lo.p;
+    out.p[1] = hi.p;
+    out.edge[0][0] = lo.e0;
+    out.edge[0][1] = lo.e1;
+    out.edge[1][0] = hi.e0;
+    out.edge[1][1] = hi.e1;
+    out.on_b[0] = lo_b;
+    out.on_b[1] = hi_b;
+    return true;
+}
+
+std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedMesh& mesh, const Bvh& bvh,
+                                               const Vec3f& eye, const FeatureEdgeSettings& settings, int threads) {
+    const std::size_t n = scene.triangle_count();
+    std::vector<Vec3f> normal(n);
+    for (std::size_t t = 0; t < n; ++t) normal[t] = face_normal(scene, t);
+    auto usable = [&](std::size_t t) { return normal[t] != Vec3f(0.0f); };
+    std::vector<FeatureSegment> segments;
+
+    // Mesh edges: every triangle side as (lower welded id, higher, triangle, forward), sorted so
+    // that the sides of one edge are adjacent.
+    struct Side {
+        std::uint32_t lo, hi, tri;
+        bool forward;  // lo -> hi in the triangle's winding
+        int corner;    // the corner the side starts from in the winding
+    };
+    std::vector<Side> sides;
+    sides.reserve(n * 3);
+    for (std::size_t t = 0; t < n; ++t) {
+        if (!usable(t)) continue;
+        const auto& w = mesh.tri_vertices[t];
+        for (int k = 0; k < 3; ++k) {
+            const std::uint32_t u = w[k], v = w[(k + 1) % 3];
+            if (u == v) continue;
+            sides.push_back({std::min(u, v), std::max(u, v), static_cast<std::uint32_t>(t), u < v, k});
+        }
+    }
+    std::sort(sides.begin(), sides.end(),
+              [](const Side& a, const Side& b) { return std::tie(a.lo, a.hi, a.tri) < std::tie(b.lo, b.hi, b.tri); });
+    const float cos_crease = std::cos(settings.crease_angle * std::numbers::pi_v<float> / 180.0f);
+    // Shading is smooth across a side shared by two triangles when both have a normal at every
+    // corner and the same normals at the side's two ends.
+    auto corner_normal = [&](std::uint32_t t, std::uint32_t welded) {
+        for (int k = 0; k < 3; ++k)
+            if (mesh.tri_vertices[t][k] == welded) return scene.normals[scene.tri_normals[t][k]];
+        return Vec3f(0.0f);
+    };
+    auto smooth_across = [&](const Side& s0, const Side& s1) {
+        if (!has_corner_normals(scene, s0.tri) || !has_corner_normals(scene, s1.tri)) return false;
+        return corner_normal(s0.tri, s0.lo) == corner_normal(s1.tri, s1.lo) &&
+               corner_normal(s0.tri, s0.hi) == corner_normal(s1.tri, s1.hi);
+    };
+    for (std::size_t i = 0; i < sides.size();) {
+        std::size_t j = i + 1;
+        while (j < sides.size() && sides[j].lo == sides[i].lo && sides[j].hi == sides[i].hi) ++j;
+        const Side& s0 = sides[i];
+        FeatureSegment seg;
+        seg.p0 = scene.positions[mesh.vertex_position[s0.lo]];
+        seg.p1 = scene.positions[mesh.vertex_position[s0.hi]];
+        seg.key0 = {s0.lo, kNoIndex, kNoIndex};
+        seg.key1 = {s0.hi, kNoIndex, kNoIndex};
+        seg.faces = {s0.tri, j - i > 1 ? sides[i + 1].tri : kNoIndex};
+        bool emit = false;
+        if (j - i != 2) {
+            seg.type = EdgeType::Border;
+            emit = settings.borders;
+        } else {
+            const Side& s1 = sides[i + 1];
+            const Vec3f n0 = normal[s0.tri];
+            // Consistently wound neighbours run the shared side in opposite directions.
+            const Vec3f n1 = s0.forward != s1.forward ? normal[s1.tri] : -normal[s1.tri];
+            const bool front0 = dot(n0, eye - seg.p0) > 0, front1 = dot(n1, eye - seg.p0) > 0;
+            const bool smooth = settings.smooth_contours && smooth_across(s0, s1);
+            if (settings.silhouettes && front0 != front1 && !smooth) {
+                seg.type = EdgeType::Silhouette;
+                emit = true;
+            } else if (settings.creases && dot(n0, n1) < cos_crease) {
+                seg.type = EdgeType::Crease;
+                emit = true;
+            } else if (settings.materials && scene.tri_material[s0.tri] != scene.tri_material[s1.tri]) {
+                seg.type = EdgeType::Material;
+                emit = true;
+            }
+        }
+        if (emit) segments.push_back(seg);
+        i = j;
+    }
+
+    // Smooth contours: where n . (p - eye), interpolated linearly from the corners, is zero.
+    if (settings.silhouettes && settings.smooth_contours) {
+        for (std::size_t t = 0; t < n; ++t) {
+            if (!usable(t) || !has_corner_normals(scene, t)) continue;
+            const auto p = corners(scene, t);
+            float g[3];
+            for (int k = 0; k < 3; ++k) {
+                // Unit normals: the zero's position depends on their lengths.
+                const Vec3f nk = scene.normals[scene.tri_normals[t][k]];
+                const float len = length(nk);
+                g[k] = dot(nk, p[k] - eye) / (len > 0.0f ? len : 1.0f);
+            }
+            FeatureSegment seg;
+            seg.type = EdgeType::Silhouette;
+            seg.smooth = true;
+            seg.faces = {static_cast<std::uint32_t>(t), kNoIndex};
+            int found = 0;
+            for (int k = 0; k < 3; ++k) {
+                int u = k, v = (k + 1) % 3;
+                if ((g[u] >= 0) == (g[v] >= 0)) continue;
+                std::uint32_t wu = mesh.tri_vertices[t][u], wv = mesh.tri_vertices[t][v];
+                if (wv < wu) {
+                    std::swap(u, v);
+                    std::swap(wu, wv);
+                }
+                const Vec3f q = p[u] + (p[v] - p[u]) * (g[u] / (g[u] - g[v]));
+                (found == 0 ? seg.p0 : seg.p1) = q;
+                (found == 0 ? seg.key0 : seg.key1) = {wu, wv, kNoIndex};
+                ++found;
+            }
+            if (found == 2 && seg.p0 != seg.p1) segments.push_back(seg);
+        }
+    }
+
+    // Intersection lines: each triangle against the triangles whose boxes overlap its own.
+    if (settings.intersections && !bvh.nodes.empty()) {
+        auto found = gather_chunks<FeatureSegment>(static_cast<int>(n), 256, threads,
+                                                   [&](int t0, int t1, std::vector<FeatureSegment>& out) {
+            std::vector<std::uint32_t> stack, candidates;
+            for (int ti = t0; ti < t1; ++ti) {
+                const auto t = static_cast<std::uint32_t>(ti);
+                if (!usable(t)) continue;
+                const auto a = corners(scene, t);
+                BBox box;
+                for (const Vec3f& p : a) box.extend(p);
+                candidates.clear();
+                stack.assign(1, 0);
+                while (!stack.empty()) {
+                    const BvhNode& node = bvh.nodes[stack.back()];
+                    stack.pop_back();
+                    if (node.bounds.lo.x > box.hi.x || node.bounds.hi.x < box.lo.x || node.bounds.lo.y > box.hi.y ||
+                        node.bounds.hi.y < box.lo.y || node.bounds.lo.z > box.hi.z || node.bounds.hi.z < box.lo.z)
+                        continue;
+                    if (node.is_leaf()) {
+                        for (std::uint32_t i = node.first; i < node.first + node.count; ++i)
+                            if (bvh.prim_indices[i] > t) candidates.push_back(bvh.prim_indices[i]);
+                    } else {
+                        stack.push_back(node.first);
+                        stack.push_back(node.first + 1);
+                    }
+                }
+                std::sort(candidates.begin(), candidates.end());
+                for (std::uint32_t u : candidates) {
+                    if (!usable(u)) continue;
+                    const auto b = corners(scene, u);
+                    bool shared = false;
+                    for (const Vec3f& pa : a)
+                        for (const Vec3f& pb : b) shared = shared || same_position(pa, pb);
+                    if (shared) continue;
+                    TriangleCrossing c;
+                    if (!intersect_triangles(a, b, c)) continue;
+                    FeatureSegment seg;
+                    seg.type = EdgeType::Intersection;
+                    seg.p0 = c.p[0];
+                    seg.p1 = c.p[1];
+                    seg.faces = {t, u};
+                    for (int e = 0; e < 2; ++e) {
+                        const std::uint32_t on = c.on_b[e] ? u : t, other = c.on_b[e] ? t : u;
+                        std::uint32_t w0 = mesh.tri_vertices[on][c.edge[e][0]], w1 = mesh.tri_vertices[on][c.edge[e][1]];
+                        if (w1 < w0) std::swap(w0, w1);
+                        (e == 0 ? seg.key0 : seg.key1) = {w0, w1, other};
+                    }
+                    out.push_back(seg);
+                }
+            }
+        });
+        segments.insert(segments.end(), found.begin(), found.end());
+    }
+    return segments;
+}
+
+}  // namespace toonray::ink

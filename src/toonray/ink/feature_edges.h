@@ -1,0 +1,95 @@
+#pragma once
+/// Feature edges of a triangle scene seen from an eye: the lines of `--edges ink`, found on the
+/// geometry rather than in pixel buffers.
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "toonray/accel/bvh.h"
+#include "toonray/core/math.h"
+#include "toonray/scene/scene.h"
+
+namespace toonray::ink {
+
+/// What makes a segment a line. One type per segment: where an edge is several at once, the
+/// first in this order wins (a silhouette crease is drawn as silhouette).
+enum class EdgeType : std::uint8_t {
+    Silhouette,    ///< polygonal contour (front face next to back face) or smooth contour
+    Border,        ///< an edge with one face (or more than two: non-manifold)
+    Crease,        ///< geometric normals of the two faces differ by more than the crease angle
+    Material,      ///< the two faces have different materials
+    Intersection,  ///< where two triangles cross
+};
+inline constexpr int kEdgeTypeCount = 5;
+/// "silhouette", "border", "crease", "material", "intersection".
+const char* edge_type_name(EdgeType type);
+
+/// Identifies a segment's endpoint so that segments meeting there can be chained without
+/// comparing floats: a welded vertex {v, kNoIndex, kNoIndex}; a point on the welded edge
+/// (a < b) {a, b, kNoIndex} (smooth contours); a point where the welded edge (a < b) of one
+/// triangle crosses triangle t {a, b, t} (intersection lines).
+struct EndpointKey {
+    std::uint32_t a = kNoIndex, b = kNoIndex, c = kNoIndex;
+    auto operator<=>(const EndpointKey&) const = default;
+};
+
+struct FeatureSegment {
+    Vec3f p0, p1;
+    EndpointKey key0, key1;
+    EdgeType type = EdgeType::Silhouette;
+    /// Triangles the segment lies on (kNoIndex for none): their own surface must not hide it.
+    std::array<std::uint32_t, 2> faces{kNoIndex, kNoIndex};
+    /// Smooth contours lie inside a triangle of a polygonal approximation of a smooth surface,
+    /// where the facets around it may graze the line of sight: the triangles sharing a vertex
+    /// with `faces[0]` are ignored as occluders too (see visibility.h).
+    bool smooth = false;
+};
+
+struct FeatureEdgeSettings {
+    float crease_angle = 40.0f;  ///< degrees between the faces' geometric normals
+    bool silhouettes = true;
+    bool borders = true;
+    bool creases = true;
+    bool materials = true;
+    bool intersections = true;
+    /// Smooth contours (Hertzmann & Zorin 2000) on triangles with a normal at every corner,
+    /// instead of polygonal silhouettes on the edges where shading is smooth.
+    bool smooth_contours = true;
+};
+
+/// Vertices welded by exact position within each object: two triangle corners share a welded
+/// vertex when they belong to the same object and their positions are bitwise equal (-0 = +0).
+/// Split normals and texture seams then make no false borders.
+struct WeldedMesh {
+    std::vector<std::array<std::uint32_t, 3>> tri_vertices;  ///< welded ids per corner
+    std::vector<std::uint32_t> vertex_position;              ///< a position index per welded id
+    /// Triangles around each welded vertex: ring_offsets has one more entry than vertices.
+    std::vector<std::uint32_t> ring_offsets, ring_triangles;
+
+    [[nodiscard]] std::size_t vertex_count() const { return vertex_position.size(); }
+};
+
+[[nodiscard]] WeldedMesh weld_vertices(const Scene& scene);
+
+/// All feature segments of the scene seen from `eye`, in a fixed order (mesh edges by welded
+/// vertex pair, then smooth contours by triangle, then intersection lines by triangle pair),
+/// whatever the thread count. `bvh` is a BVH over the scene's triangles (TriangleAccel::bvh())
+/// for the intersection lines.
+[[nodiscard]] std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedMesh& mesh,
+                                                             const Bvh& bvh, const Vec3f& eye,
+                                                             const FeatureEdgeSettings& settings, int threads);
+
+/// The segment where triangles (a0, a1, a2) and (b0, b1, b2) cross, if they do properly (each
+/// has corners strictly on both sides of the other's plane; coplanar or touching pairs give
+/// none). Each endpoint is where an edge of one crosses the other; `edge` gets that edge's
+/// corner numbers (0-2) and `on_b` whether the edge belongs to b.
+struct TriangleCrossing {
+    Vec3f p[2];
+    int edge[2][2];
+    bool on_b[2];
+};
+[[nodiscard]] bool intersect_triangles(const std::array<Vec3f, 3>& a, const std::array<Vec3f, 3>& b,
+                                       TriangleCrossing& out);
+
+}  // namespace toonray::ink

@@ -1,0 +1,196 @@
+#include "toonray/ink/feature_edges.h"
+
+#include <gtest/gtest.h>
+
+#include <map>
+
+#include "ink/ink_scenes.h"
+
+namespace toonray {
+namespace {
+
+using ink::EdgeType;
+using ink::FeatureSegment;
+using test_support::add_box;
+using test_support::add_quad;
+using test_support::add_sphere;
+using test_support::build_accel;
+
+std::vector<FeatureSegment> edges_of(const Scene& s, const Vec3f& eye, const ink::FeatureEdgeSettings& settings = {},
+                                     int threads = 1) {
+    const TriangleAccel accel = build_accel(s);
+    return ink::find_feature_edges(s, ink::weld_vertices(s), accel.bvh(), eye, settings, threads);
+}
+
+std::map<EdgeType, int> count_types(const std::vector<FeatureSegment>& segments) {
+    std::map<EdgeType, int> n;
+    for (const auto& s : segments) ++n[s.type];
+    return n;
+}
+
+TEST(WeldVertices, JoinsEqualPositionsWithinAnObjectOnly) {
+    Scene s;
+    add_box(s, Vec3f(0.0f), Vec3f(1.0f), 0);  // 24 vertices, 8 positions
+    add_box(s, Vec3f(0.0f), Vec3f(1.0f), 1);  // the same positions in another object
+    const ink::WeldedMesh mesh = ink::weld_vertices(s);
+    EXPECT_EQ(mesh.vertex_count(), 16u);
+    // Every corner of a box touches 3 faces, 6 triangles at most; 4 or 5 with this split.
+    for (std::size_t v = 0; v < mesh.vertex_count(); ++v) {
+        const auto n = mesh.ring_offsets[v + 1] - mesh.ring_offsets[v];
+        EXPECT_GE(n, 3u);
+        EXPECT_LE(n, 6u);
+    }
+}
+
+TEST(FeatureEdges, BoxWithSplitVerticesHasCreasesAndSilhouettesButNoBorders) {
+    Scene s;
+    add_box(s, Vec3f(-1.0f), Vec3f(1.0f));
+    // From a general direction three faces are seen: 6 silhouette edges, 3 visible creases and
+    // 3 creases between back faces.
+    const auto n = count_types(edges_of(s, Vec3f(5.0f, 4.0f, 3.0f)));
+    EXPECT_EQ(n.count(EdgeType::Border), 0u);
+    EXPECT_EQ(n.at(EdgeType::Silhouette), 6);
+    EXPECT_EQ(n.at(EdgeType::Crease), 6);
+    // The diagonals of the faces are flat: no line.
+    EXPECT_EQ(n.size(), 2u);
+}
+
+TEST(FeatureEdges, CreaseAngleIsAThreshold) {
+    // Two quads folded by 30 degrees along x = 0.
+    Scene s;
+    const float a = 30.0f * std::numbers::pi_v<float> / 180.0f;
+    add_quad(s, Vec3f(-1, 0, 0), Vec3f(0, 0, 0), Vec3f(0, 1, 0), Vec3f(-1, 1, 0));
+    const std::uint32_t base = static_cast<std::uint32_t>(s.positions.size());
+    s.positions.push_back(Vec3f(std::cos(a), 0, std::sin(a)));
+    s.positions.push_back(Vec3f(std::cos(a), 1, std::sin(a)));
+    s.add_triangle({1, base, base + 1}, 0, 0);
+    s.add_triangle({1, base + 1, 2}, 0, 0);
+    const Vec3f eye(0, 0.5f, 5);
+    ink::FeatureEdgeSettings settings;
+    settings.crease_angle = 40.0f;
+    EXPECT_EQ(count_types(edges_of(s, eye, settings)).count(EdgeType::Crease), 0u);
+    settings.crease_angle = 20.0f;
+    EXPECT_EQ(count_types(edges_of(s, eye, settings)).at(EdgeType::Crease), 1);
+    EXPECT_EQ(count_types(edges_of(s, eye, settings)).at(EdgeType::Border), 6);
+}
+
+TEST(FeatureEdges, MaterialBoundaryBetweenFlatFaces) {
+    Scene s;
+    s.materials.emplace_back("red");
+    const std::uint32_t a = test_support::add_vertex(s, Vec3f(0, 0, 0)), b = test_support::add_vertex(s, Vec3f(1, 0, 0)),
+                        c = test_support::add_vertex(s, Vec3f(1, 1, 0)), d = test_support::add_vertex(s, Vec3f(0, 1, 0));
+    s.add_triangle({a, b, c}, 0, 0);
+    s.add_triangle({a, c, d}, 1, 0);
+    const auto segments = edges_of(s, Vec3f(0.5f, 0.5f, 3.0f));
+    const auto n = count_types(segments);
+    EXPECT_EQ(n.at(EdgeType::Material), 1);
+    EXPECT_EQ(n.at(EdgeType::Border), 4);
+    for (const auto& seg : segments)
+        if (seg.type == EdgeType::Material) {
+            EXPECT_EQ(seg.faces[0], 0u);
+            EXPECT_EQ(seg.faces[1], 1u);
+        }
+}
+
+TEST(FeatureEdges, SmoothContourOfASphereLiesOnTheTrueContour) {
+    Scene s;
+    add_sphere(s, Vec3f(0.0f), 1.0f, 48, 96);
+    const Vec3f eye(0.3f, 0.5f, 4.0f);
+    const auto segments = edges_of(s, eye);
+    // Smooth shading everywhere: no polygonal silhouettes, only smooth contours.
+    int smooth = 0;
+    for (const auto& seg : segments) {
+        ASSERT_EQ(seg.type, EdgeType::Silhouette);
+        ASSERT_TRUE(seg.smooth);
+        ++smooth;
+        // The exact sphere's contour: p . (p - eye) = 0 for |p| = 1; a facet is off by less
+        // than its size (about 2 pi / 96).
+        for (const Vec3f& p : {seg.p0, seg.p1})
+            EXPECT_LT(std::abs(dot(normalize(p), normalize(p - eye))), 0.05f);
+        EXPECT_NE(seg.key0, seg.key1);
+    }
+    EXPECT_GT(smooth, 96);
+    // The contour is closed: every endpoint key is used by exactly two segments.
+    std::map<ink::EndpointKey, int> uses;
+    for (const auto& seg : segments) {
+        ++uses[seg.key0];
+        ++uses[seg.key1];
+    }
+    for (const auto& [key, n] : uses) EXPECT_EQ(n, 2);
+}
+
+TEST(FeatureEdges, PolygonalSilhouetteWithoutVertexNormals) {
+    Scene s;
+    add_sphere(s, Vec3f(0.0f), 1.0f, 12, 24);
+    for (auto& n : s.tri_normals) n = {kNoIndex, kNoIndex, kNoIndex};
+    const auto segments = edges_of(s, Vec3f(0.3f, 0.5f, 4.0f));
+    int silhouettes = 0;
+    for (const auto& seg : segments) {
+        EXPECT_FALSE(seg.smooth);
+        if (seg.type == EdgeType::Silhouette) ++silhouettes;
+    }
+    EXPECT_GE(silhouettes, 24);
+}
+
+TEST(IntersectTriangles, CrossingTrianglesGiveTheOverlapOfTheirSpans) {
+    const std::array<Vec3f, 3> a{Vec3f(-1, -1, 0), Vec3f(1, -1, 0), Vec3f(0, 1, 0)};  // z = 0
+    const std::array<Vec3f, 3> b{Vec3f(0, -2, -1), Vec3f(0, 2, -1), Vec3f(0, 0, 1)};  // x = 0
+    ink::TriangleCrossing c;
+    ASSERT_TRUE(ink::intersect_triangles(a, b, c));
+    // On the line x = z = 0: a spans y in [-1, 1]; b at z = 0 spans y in [-1, 1].
+    for (const Vec3f& p : c.p) {
+        EXPECT_NEAR(p.x, 0.0f, 1e-6f);
+        EXPECT_NEAR(p.z, 0.0f, 1e-6f);
+    }
+    EXPECT_NEAR(std::min(c.p[0].y, c.p[1].y), -1.0f, 1e-6f);
+    EXPECT_NEAR(std::max(c.p[0].y, c.p[1].y), 1.0f, 1e-6f);
+    // Touching (a corner on the plane, nothing across it) and parallel pairs do not cross.
+    const std::array<Vec3f, 3> touching{Vec3f(0, 0, 0), Vec3f(1, 0, 1), Vec3f(0, 1, 1)};
+    EXPECT_FALSE(ink::intersect_triangles(a, touching, c));
+    const std::array<Vec3f, 3> above{Vec3f(-1, -1, 1), Vec3f(1, -1, 1), Vec3f(0, 1, 1)};
+    EXPECT_FALSE(ink::intersect_triangles(a, above, c));
+}
+
+TEST(FeatureEdges, IntersectionLinesBetweenObjectsAndChainableKeys) {
+    // A box pushed half-way through a large quad: the quad cuts it along a square loop. (The
+    // quad's diagonal misses the box's corners: a loop through the corner where two triangles
+    // of each meet has endpoints that do not chain.)
+    Scene s;
+    add_box(s, Vec3f(-0.5f), Vec3f(0.5f), 1);
+    add_quad(s, Vec3f(-2, -2.3f, 0.1f), Vec3f(2, -2, 0.1f), Vec3f(2, 2.3f, 0.1f), Vec3f(-2, 2, 0.1f), 0, 2);
+    ink::FeatureEdgeSettings settings;
+    const auto segments = edges_of(s, Vec3f(1, 2, 5), settings);
+    std::map<ink::EndpointKey, int> uses;
+    float total = 0;
+    for (const auto& seg : segments) {
+        if (seg.type != EdgeType::Intersection) continue;
+        EXPECT_NEAR(seg.p0.z, 0.1f, 1e-6f);
+        EXPECT_NEAR(seg.p1.z, 0.1f, 1e-6f);
+        total += length(seg.p1 - seg.p0);
+        ++uses[seg.key0];
+        ++uses[seg.key1];
+    }
+    EXPECT_NEAR(total, 4.0f, 1e-4f);  // the square's perimeter
+    for (const auto& [key, n] : uses) EXPECT_EQ(n, 2) << key.a << " " << key.b << " " << key.c;
+}
+
+TEST(FeatureEdges, SameForAnyThreadCount) {
+    Scene s = test_support::random_scene(600, 7);
+    add_sphere(s, Vec3f(0.2f), 0.5f, 16, 32, 1);
+    const Vec3f eye(3, 2, 4);
+    const auto one = edges_of(s, eye, {}, 1);
+    const auto many = edges_of(s, eye, {}, 4);
+    ASSERT_EQ(one.size(), many.size());
+    int intersections = 0;
+    for (std::size_t i = 0; i < one.size(); ++i) {
+        EXPECT_EQ(one[i].p0, many[i].p0);
+        EXPECT_EQ(one[i].p1, many[i].p1);
+        EXPECT_EQ(one[i].type, many[i].type);
+        EXPECT_EQ(one[i].key0, many[i].key0);
+        intersections += one[i].type == EdgeType::Intersection;
+    }
+    EXPECT_GT(intersections, 50);  // a dense soup crosses itself a lot
+}
+
+}  // namespace
+}  // namespace toonray
