@@ -1,0 +1,163 @@
+#include "toonray/ink/visibility.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "toonray/ink/chunks.h"
+
+namespace toonray::ink {
+
+std::vector<std::uint32_t> ignored_triangles(const FeatureSegment& segment, const WeldedMesh& mesh) {
+    std::vector<std::uint32_t> out;
+    for (std::uint32_t f : segment.faces)
+        if (f != kNoIndex) out.push_back(f);
+    if (segment.smooth && segment.faces[0] != kNoIndex)
+        for (std::uint32_t v : mesh.tri_vertices[segment.faces[0]])
+            out.insert(out.end(), mesh.ring_triangles.begin() + mesh.ring_offsets[v],
+                       mesh.ring_triangles.begin() + mesh.ring_offsets[v + 1]);
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+    return out;
+}
+
+int count_occluders(const TriangleAccel& accel, const Vec3f& point, const Vec3f& eye,
+                    std::span<const std::uint32_t> ignored, const VisibilitySettings& settings) {
+    // The ray runs from the point (t = 0) to the eye (t = 1); after each hit it starts again
+    // just past it, so every surface on the way is met once.
+    const Vec3f dir = eye - point;
+    const float t_end = 1.0f - settings.self_epsilon;
+    const float skip = settings.self_epsilon * 0.01f;
+    float t = settings.self_epsilon;
+    int count = 0;
+    // A bound on the queries, in case a hit ever failed to move the start forward.
+    for (int query = 0; query < 4 * settings.max_invisibility + 64 && t < t_end; ++query) {
+        Hit hit;
+        if (!accel.intersect(Ray{point + dir * t, dir, t_end - t}, hit)) break;
+        if (!std::binary_search(ignored.begin(), ignored.end(), hit.prim))
+            if (++count >= settings.max_invisibility) break;
+        t += hit.t + skip;
+    }
+    return count;
+}
+
+namespace {
+
+// The part of one segment inside the view, as a line on the image: A + (B - A) s for s in
+// [s_lo, s_hi], and the map from s back to the segment's parameter.
+struct ClippedSegment {
+    float ta = 0, tb = 1;  // the segment's parameters at A and B
+    float za = 1, zb = 1;  // depths at A and B
+    Point2 a, b;
+    float s_lo = 0, s_hi = 1;
+
+    [[nodiscard]] float t_of(float s) const {
+        // Depth is linear along the segment and 1/depth along its image.
+        const float u = s * za / ((1.0f - s) * zb + s * za);
+        return ta + (tb - ta) * u;
+    }
+    [[nodiscard]] Point2 image(float s) const { return {a.x + (b.x - a.x) * s, a.y + (b.y - a.y) * s}; }
+};
+
+bool clip_to_view(const FeatureSegment& seg, const ScreenProjection& view, float margin, ClippedSegment& c) {
+    const float z0 = view.depth(seg.p0), z1 = view.depth(seg.p1), near = view.near_depth();
+    if (!(z0 >= near || z1 >= near)) return false;  // also rejects NaN
+    if (z0 < near) c.ta = (near - z0) / (z1 - z0);
+    if (z1 < near) c.tb = (near - z0) / (z1 - z0);
+    auto at = [&](float t) { return seg.p0 + (seg.p1 - seg.p0) * t; };
+    c.za = z0 + (z1 - z0) * c.ta;
+    c.zb = z0 + (z1 - z0) * c.tb;
+    c.a = view.project(at(c.ta));
+    c.b = view.project(at(c.tb));
+    // Liang-Barsky against the image grown by the margin.
+    const float d[2] = {c.b.x - c.a.x, c.b.y - c.a.y};
+    const float o[2] = {c.a.x, c.a.y};
+    const float lo[2] = {-margin, -margin};
+    const float hi[2] = {static_cast<float>(view.width()) + margin, static_cast<float>(view.height()) + margin};
+    for (int axis = 0; axis < 2; ++axis) {
+        if (d[axis] == 0.0f) {
+            if (o[axis] < lo[axis] || o[axis] > hi[axis]) return false;
+            continue;
+        }
+        float s0 = (lo[axis] - o[axis]) / d[axis], s1 = (hi[axis] - o[axis]) / d[axis];
+        if (s0 > s1) std::swap(s0, s1);
+        c.s_lo = std::max(c.s_lo, s0);
+        c.s_hi = std::min(c.s_hi, s1);
+    }
+    return c.s_lo < c.s_hi;
+}
+
+}  // namespace
+
+std::vector<EdgePiece> split_by_visibility(std::span<const FeatureSegment> segments, const VisibilityContext& context,
+                                           const VisibilitySettings& settings, int threads) {
+    const ScreenProjection& view = context.view;
+    return gather_chunks<EdgePiece>(
+        static_cast<int>(segments.size()), 32, threads, [&](int i0, int i1, std::vector<EdgePiece>& out) {
+            std::vector<float> cuts;
+            std::vector<int> states;
+            for (int i = i0; i < i1; ++i) {
+                const FeatureSegment& seg = segments[static_cast<std::size_t>(i)];
+                ClippedSegment c;
+                if (!clip_to_view(seg, view, settings.margin, c)) continue;
+                const std::vector<std::uint32_t> ignored = ignored_triangles(seg, context.mesh);
+                auto state_at = [&](float s) {
+                    const float t = c.t_of(s);
+                    return count_occluders(context.accel, seg.p0 + (seg.p1 - seg.p0) * t, view.eye(), ignored, settings);
+                };
+                // Samples at the middles of n equal steps of at most `step` pixels; a change
+                // between two samples is found by bisection.
+                const float image_length = std::hypot(c.b.x - c.a.x, c.b.y - c.a.y);
+                const float span = c.s_hi - c.s_lo;
+                const int n = std::max(1, static_cast<int>(std::ceil(image_length * span / settings.step)));
+                cuts.assign(1, c.s_lo);
+                states.clear();
+                int previous = 0;
+                float previous_s = 0;
+                for (int k = 0; k < n; ++k) {
+                    const float s = c.s_lo + span * (static_cast<float>(k) + 0.5f) / static_cast<float>(n);
+                    const int state = state_at(s);
+                    if (k > 0 && state != previous) {
+                        float lo = previous_s, hi = s;
+                        while ((hi - lo) * image_length > settings.precision) {
+                            const float mid = 0.5f * (lo + hi);
+                            if (mid <= lo || mid >= hi) break;
+                            (state_at(mid) == previous ? lo : hi) = mid;
+                        }
+                        cuts.push_back(0.5f * (lo + hi));
+                        states.push_back(previous);
+                    }
+                    previous = state;
+                    previous_s = s;
+                }
+                states.push_back(previous);
+                cuts.push_back(c.s_hi);
+                for (std::size_t k = 0; k < states.size(); ++k) {
+                    EdgePiece piece;
+                    piece.segment = static_cast<std::uint32_t>(i);
+                    piece.type = seg.type;
+                    piece.invisibility = states[k];
+                    const float s0 = cuts[k], s1 = cuts[k + 1];
+                    piece.t0 = c.t_of(s0);
+                    piece.t1 = c.t_of(s1);
+                    if (k == 0 && c.s_lo == 0.0f) piece.t0 = c.ta;  // exactly, so that the key below holds
+                    if (k + 1 == states.size() && c.s_hi == 1.0f) piece.t1 = c.tb;
+                    if (!(piece.t0 < piece.t1)) continue;
+                    piece.p0 = seg.p0 + (seg.p1 - seg.p0) * piece.t0;
+                    piece.p1 = seg.p0 + (seg.p1 - seg.p0) * piece.t1;
+                    piece.s0 = c.image(s0);
+                    piece.s1 = c.image(s1);
+                    if (piece.t0 == 0.0f) {
+                        piece.p0 = seg.p0;
+                        piece.key0 = seg.key0;
+                    }
+                    if (piece.t1 == 1.0f) {
+                        piece.p1 = seg.p1;
+                        piece.key1 = seg.key1;
+                    }
+                    out.push_back(piece);
+                }
+            }
+        });
+}
+
+}  // namespace toonray::ink

@@ -1,0 +1,69 @@
+#pragma once
+/// Exact visibility of feature segments: each segment is cut where its visibility changes, as
+/// seen by rays from points on it toward the eye, and each piece gets its quantitative
+/// invisibility (the number of surfaces between it and the eye; Appel 1967).
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "toonray/accel/triangle_accel.h"
+#include "toonray/ink/feature_edges.h"
+#include "toonray/ink/screen.h"
+
+namespace toonray::ink {
+
+struct VisibilitySettings {
+    float step = 1.0f;           ///< pixels between samples along a segment's image
+    float precision = 1.0f / 16;  ///< change points are refined by bisection to this many pixels
+    /// A ray from a point toward the eye ignores hits closer to the point than this fraction
+    /// of the distance to the eye, so that the surface a line lies on does not hide it.
+    float self_epsilon = 1e-4f;
+    /// Occluders counted at most: 1 tells only visible (0) from hidden (1); more costs a ray
+    /// query per extra surface on hidden points.
+    int max_invisibility = 255;
+    /// Segments are clipped to the image grown by this many pixels on each side.
+    float margin = 4.0f;
+};
+
+/// A part of a feature segment with one visibility.
+struct EdgePiece {
+    std::uint32_t segment = 0;  ///< index into the segments
+    float t0 = 0, t1 = 1;       ///< parameters along the segment (p0 + (p1 - p0) t), t0 < t1
+    Vec3f p0, p1;               ///< the piece's ends in the world
+    Point2 s0, s1;              ///< and on the image
+    /// The segment's keys where the piece ends at the segment's own ends; kNoIndex keys where
+    /// it was cut (by visibility or clipping).
+    EndpointKey key0, key1;
+    EdgeType type = EdgeType::Silhouette;
+    int invisibility = 0;  ///< occluding surfaces, at most VisibilitySettings::max_invisibility
+    [[nodiscard]] bool visible() const { return invisibility == 0; }
+};
+
+/// Everything a visibility query needs: the scene's triangles in an accelerator, the welded
+/// mesh (for the rings ignored around smooth contours) and the view.
+struct VisibilityContext {
+    const Scene& scene;
+    const WeldedMesh& mesh;
+    const TriangleAccel& accel;
+    const ScreenProjection& view;
+};
+
+/// Triangles whose hits do not count against `segment`: its faces, and for a smooth contour
+/// every triangle sharing a vertex with its face. Sorted.
+[[nodiscard]] std::vector<std::uint32_t> ignored_triangles(const FeatureSegment& segment, const WeldedMesh& mesh);
+
+/// Surfaces between `point` and the eye: hits of the segment from point to eye with parameter
+/// in (self_epsilon, 1 - self_epsilon), not on an `ignored` triangle (sorted), at most
+/// max_invisibility. Hits closer together than a hundredth of self_epsilon count once.
+[[nodiscard]] int count_occluders(const TriangleAccel& accel, const Vec3f& point, const Vec3f& eye,
+                                  std::span<const std::uint32_t> ignored, const VisibilitySettings& settings);
+
+/// The segments cut into pieces of constant visibility, in segment order and along each
+/// segment, the same for any thread count. Parts behind the eye or outside the image (grown by
+/// the margin) are left out.
+[[nodiscard]] std::vector<EdgePiece> split_by_visibility(std::span<const FeatureSegment> segments,
+                                                         const VisibilityContext& context,
+                                                         const VisibilitySettings& settings, int threads);
+
+}  // namespace toonray::ink
