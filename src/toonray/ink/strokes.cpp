@@ -1,0 +1,187 @@
+#include "toonray/ink/strokes.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <tuple>
+
+namespace toonray::ink {
+
+namespace {
+
+float distance(const Point2& a, const Point2& b) { return std::hypot(a.x - b.x, a.y - b.y); }
+
+float distance_to_segment(const Point2& p, const Point2& a, const Point2& b) {
+    const float dx = b.x - a.x, dy = b.y - a.y;
+    const float len2 = dx * dx + dy * dy;
+    float t = len2 > 0.0f ? ((p.x - a.x) * dx + (p.y - a.y) * dy) / len2 : 0.0f;
+    t = std::clamp(t, 0.0f, 1.0f);
+    return std::hypot(p.x - (a.x + dx * t), p.y - (a.y + dy * t));
+}
+
+void douglas_peucker(std::span<const Point2> points, std::size_t first, std::size_t last, float tolerance,
+                     std::vector<bool>& keep) {
+    if (last <= first + 1) return;
+    float worst = -1.0f;
+    std::size_t at = first;
+    for (std::size_t i = first + 1; i < last; ++i) {
+        const float d = distance_to_segment(points[i], points[first], points[last]);
+        if (d > worst) {
+            worst = d;
+            at = i;
+        }
+    }
+    if (worst <= tolerance) return;
+    keep[at] = true;
+    douglas_peucker(points, first, at, tolerance, keep);
+    douglas_peucker(points, at, last, tolerance, keep);
+}
+
+bool has_key(const EndpointKey& k) { return k.a != kNoIndex; }
+
+// A piece as the chainer sees it: the pieces of a segment with one visibility, merged.
+struct Link {
+    EdgeType type;
+    bool visible;
+    Point2 s0, s1;
+    EndpointKey key0, key1;
+};
+
+}  // namespace
+
+float polyline_length(std::span<const Point2> points) {
+    float total = 0.0f;
+    for (std::size_t i = 1; i < points.size(); ++i) total += distance(points[i - 1], points[i]);
+    return total;
+}
+
+std::vector<Point2> simplify_polyline(std::span<const Point2> points, float tolerance) {
+    if (points.size() <= 2 || !(tolerance > 0.0f)) return {points.begin(), points.end()};
+    std::vector<bool> keep(points.size(), false);
+    keep.front() = keep.back() = true;
+    douglas_peucker(points, 0, points.size() - 1, tolerance, keep);
+    std::vector<Point2> out;
+    for (std::size_t i = 0; i < points.size(); ++i)
+        if (keep[i]) out.push_back(points[i]);
+    return out;
+}
+
+std::vector<Stroke> chain_pieces(std::span<const EdgePiece> pieces, const ChainSettings& settings) {
+    // 1. Per segment: absorb sub-pixel pieces into their neighbours, then merge runs of one
+    //    visibility into links.
+    std::vector<Link> links;
+    for (std::size_t i = 0; i < pieces.size();) {
+        std::size_t j = i + 1;
+        while (j < pieces.size() && pieces[j].segment == pieces[i].segment) ++j;
+        std::vector<bool> visible;
+        for (std::size_t k = i; k < j; ++k) visible.push_back(pieces[k].visible());
+        const std::size_t n = j - i;
+        if (n > 1)
+            for (std::size_t k = 0; k < n; ++k) {
+                const EdgePiece& p = pieces[i + k];
+                if (distance(p.s0, p.s1) >= settings.min_piece) continue;
+                const bool before = k > 0 ? visible[k - 1] : visible[k + 1];
+                const bool after = k + 1 < n ? visible[k + 1] : visible[k - 1];
+                // Only when cut from both sides, and contiguous with them (not cut by clipping).
+                const bool contiguous = (k == 0 || pieces[i + k - 1].t1 == p.t0) && (k + 1 == n || pieces[i + k + 1].t0 == p.t1);
+                if (before == after && before != visible[k] && contiguous) visible[k] = before;
+            }
+        for (std::size_t k = 0; k < n; ++k) {
+            const EdgePiece& p = pieces[i + k];
+            if (!visible[k] && !settings.hidden) continue;
+            if (k > 0 && visible[k] == visible[k - 1] && pieces[i + k - 1].t1 == p.t0 && !links.empty()) {
+                links.back().s1 = p.s1;
+                links.back().key1 = p.key1;
+                continue;
+            }
+            links.push_back({p.type, visible[k], p.s0, p.s1, p.key0, p.key1});
+        }
+        i = j;
+    }
+
+    // 2. Link ends by key.
+    struct End {
+        EndpointKey key;
+        std::uint32_t link;
+        std::uint8_t side;  // 0: s0/key0, 1: s1/key1
+    };
+    std::vector<End> ends;
+    for (std::size_t l = 0; l < links.size(); ++l) {
+        if (has_key(links[l].key0)) ends.push_back({links[l].key0, static_cast<std::uint32_t>(l), 0});
+        if (has_key(links[l].key1)) ends.push_back({links[l].key1, static_cast<std::uint32_t>(l), 1});
+    }
+    std::sort(ends.begin(), ends.end(),
+              [](const End& a, const End& b) { return std::tie(a.key, a.link, a.side) < std::tie(b.key, b.link, b.side); });
+    auto ends_at = [&](const EndpointKey& key) {
+        auto lo = std::lower_bound(ends.begin(), ends.end(), key, [](const End& e, const EndpointKey& k) { return e.key < k; });
+        auto hi = std::upper_bound(ends.begin(), ends.end(), key, [](const EndpointKey& k, const End& e) { return k < e.key; });
+        return std::span<const End>(&*lo, static_cast<std::size_t>(hi - lo));
+    };
+    const float cos_max_turn = std::cos(settings.max_turn * std::numbers::pi_v<float> / 180.0f);
+
+    std::vector<bool> used(links.size(), false);
+    std::vector<Stroke> strokes;
+    for (std::size_t start = 0; start < links.size(); ++start) {
+        if (used[start]) continue;
+        used[start] = true;
+        const Link& first = links[start];
+        // Points from the start's s0 through its s1, grown at the back; then the front.
+        std::vector<Point2> forward{first.s0, first.s1}, backward;
+        bool closed = false;
+        for (int direction = 0; direction < 2 && !closed; ++direction) {
+            std::vector<Point2>& pts = direction == 0 ? forward : backward;
+            EndpointKey key = direction == 0 ? first.key1 : first.key0;
+            Point2 tip = direction == 0 ? first.s1 : first.s0;
+            Point2 previous = direction == 0 ? first.s0 : first.s1;
+            while (has_key(key)) {
+                // Unused matching links at this key; a link touching it with both ends counts once.
+                const End* best = nullptr;
+                int candidates = 0;
+                float best_cos = -2.0f;
+                const float hx = tip.x - previous.x, hy = tip.y - previous.y;
+                const float hlen = std::hypot(hx, hy);
+                std::uint32_t last_link = kNoIndex;
+                for (const End& e : ends_at(key)) {
+                    const Link& l = links[e.link];
+                    if (used[e.link] || l.type != first.type || l.visible != first.visible || e.link == last_link) continue;
+                    last_link = e.link;
+                    ++candidates;
+                    const Point2 next = e.side == 0 ? l.s1 : l.s0;
+                    const float nx = next.x - tip.x, ny = next.y - tip.y;
+                    const float nlen = std::hypot(nx, ny);
+                    const float c = hlen > 0 && nlen > 0 ? (hx * nx + hy * ny) / (hlen * nlen) : 1.0f;
+                    if (c > best_cos) {
+                        best_cos = c;
+                        best = &e;
+                    }
+                }
+                if (candidates == 0 && direction == 0 && key == first.key0) closed = true;
+                if (!best || (candidates > 1 && best_cos < cos_max_turn)) break;
+                used[best->link] = true;
+                const Link& l = links[best->link];
+                previous = tip;
+                tip = best->side == 0 ? l.s1 : l.s0;
+                key = best->side == 0 ? l.key1 : l.key0;
+                pts.push_back(tip);
+            }
+        }
+        std::vector<Point2> points(backward.rbegin(), backward.rend());
+        points.insert(points.end(), forward.begin(), forward.end());
+        if (closed) points.back() = points.front();
+        // Thin out points closer than min_spacing, keeping both ends.
+        std::vector<Point2> spaced{points.front()};
+        for (std::size_t i = 1; i + 1 < points.size(); ++i)
+            if (distance(points[i], spaced.back()) >= settings.min_spacing) spaced.push_back(points[i]);
+        spaced.push_back(points.back());
+        Stroke stroke;
+        stroke.type = first.type;
+        stroke.visible = first.visible;
+        stroke.closed = closed;
+        stroke.points = simplify_polyline(spaced, settings.simplify);
+        if (stroke.visible && settings.min_length > 0.0f && polyline_length(stroke.points) < settings.min_length) continue;
+        strokes.push_back(std::move(stroke));
+    }
+    return strokes;
+}
+
+}  // namespace toonray::ink

@@ -1,0 +1,53 @@
+#pragma once
+/// Chaining: visible (or hidden) edge pieces joined into strokes, the polylines that are drawn
+/// and written to SVG.
+
+#include <span>
+#include <vector>
+
+#include "toonray/ink/visibility.h"
+
+namespace toonray::ink {
+
+struct Stroke {
+    EdgeType type = EdgeType::Silhouette;
+    bool visible = true;
+    std::vector<Point2> points;  ///< on the image, in pixels; at least two
+    bool closed = false;         ///< the last point is the first (a loop)
+};
+
+struct ChainSettings {
+    /// A piece whose image is shorter than this (pixels), between pieces of the other
+    /// visibility on the same segment (or at its end), takes its neighbours' visibility: a
+    /// visibility change that flickers on and off within a pixel draws no dot and no gap.
+    float min_piece = 1.0f;
+    /// At a junction (more than one unused piece to continue with), a stroke goes on with the
+    /// straightest piece only if it turns by at most this many degrees.
+    float max_turn = 60.0f;
+    /// Points closer than this (pixels) to the previous kept point are dropped (ends are kept).
+    float min_spacing = 1.0f;
+    /// Douglas-Peucker tolerance in pixels; 0 keeps every point.
+    float simplify = 0.1f;
+    /// Visible strokes shorter than this (pixels, along the polyline) are dropped; 0 keeps all.
+    float min_length = 0.0f;
+    bool hidden = false;  ///< also chain the hidden pieces (into strokes with visible = false)
+};
+
+/// Chains pieces into strokes. The rule: pieces chain when they have the same type and the
+/// same visibility (visible, or hidden at any depth) and meet at the same endpoint key (a
+/// welded vertex, or the same point on a welded edge). A stroke is started from each unused
+/// piece in order, and grown at its end and then at its start: at a key with exactly one other
+/// unused matching piece it continues with it, whatever the angle; with several, it continues
+/// with the straightest on the image if that turns by at most max_turn, else it stops. A
+/// stroke that comes back to its start is closed. Strokes come out in the order of their
+/// first pieces (so deterministic).
+[[nodiscard]] std::vector<Stroke> chain_pieces(std::span<const EdgePiece> pieces, const ChainSettings& settings);
+
+/// Douglas-Peucker: the fewest points of `points` (ends kept) such that every dropped point
+/// is within `tolerance` of the simplified polyline.
+[[nodiscard]] std::vector<Point2> simplify_polyline(std::span<const Point2> points, float tolerance);
+
+/// Length of a polyline in pixels.
+[[nodiscard]] float polyline_length(std::span<const Point2> points);
+
+}  // namespace toonray::ink
