@@ -32,6 +32,8 @@ test_packages=(
   slurm-wlm munge
   # the Blender add-on is tested in a real, headless Blender
   blender
+  # the ink lines' SVG is checked against a real SVG renderer (rsvg-convert)
+  librsvg2-bin
 )
 # Cross building for 64-bit ARM: the libraries toonray and its unit tests link, for arm64.
 aarch64_packages=(

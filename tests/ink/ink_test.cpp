@@ -1,0 +1,140 @@
+#include "toonray/ink/ink.h"
+
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+
+#include "ink/ink_scenes.h"
+#include "support/test_support.h"
+#include "toonray/ink/svg.h"
+#include "toonray/io/png.h"
+#include "toonray/scene/obj_loader.h"
+
+namespace toonray {
+namespace {
+
+struct Teapot {
+    Scene scene;
+    TriangleAccel accel;
+    CameraSpec camera;
+    Teapot(int w, int h) {
+        Warnings warnings;
+        load_obj(std::string(TOONRAY_TEST_DATA_DIR) + "/teapot.obj", scene, warnings);
+        accel.build(scene.positions, scene.tri_positions);
+        std::vector<Vec3f> used;
+        for (const auto& t : scene.tri_positions)
+            for (std::uint32_t v : t) used.push_back(scene.positions[v]);
+        camera = auto_camera(used, w, h);
+    }
+};
+
+// Share of the line pixels of `a` within 1.5 px of a line pixel of `b`.
+double agreement(const std::vector<bool>& a, const std::vector<bool>& b, int w, int h) {
+    long lines = 0, near = 0;
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            if (!a[static_cast<std::size_t>(y) * w + x]) continue;
+            ++lines;
+            bool found = false;
+            for (int dy = -1; dy <= 1 && !found; ++dy)
+                for (int dx = -1; dx <= 1 && !found; ++dx) {  // 1.5 px: the 8 neighbours
+                    const int nx = x + dx, ny = y + dy;
+                    found = nx >= 0 && ny >= 0 && nx < w && ny < h && b[static_cast<std::size_t>(ny) * w + nx];
+                }
+            near += found;
+        }
+    return lines ? static_cast<double>(near) / static_cast<double>(lines) : 0.0;
+}
+
+TEST(InkLines, TeapotHasLinesOfEveryStageAndIsThreadIndependent) {
+    const Teapot t(640, 360);
+    ink::InkLines one, many;
+    ink::draw_ink_lines(t.scene, t.accel, t.camera, 640, 360, {}, 1, one);
+    ink::draw_ink_lines(t.scene, t.accel, t.camera, 640, 360, {}, 4, many);
+    EXPECT_GT(one.segments.size(), 100u);
+    EXPECT_GT(one.pieces.size(), 100u);
+    EXPECT_GT(one.strokes.size(), 5u);
+    ASSERT_EQ(one.coverage.size(), many.coverage.size());
+    for (std::size_t i = 0; i < one.coverage.size(); ++i) ASSERT_EQ(one.coverage.data()[i], many.coverage.data()[i]);
+    // The teapot has no vertex normals: its outline is made of polygonal silhouettes, and it
+    // covers a good part of the frame's lines.
+    int silhouettes = 0;
+    for (const auto& s : one.strokes) silhouettes += s.type == ink::EdgeType::Silhouette && s.visible;
+    EXPECT_GT(silhouettes, 0);
+    long covered = 0;
+    for (std::size_t i = 0; i < one.coverage.size(); ++i) covered += one.coverage.data()[i] > 0.5f;
+    EXPECT_GT(covered, 1000);
+}
+
+TEST(InkSvg, ParsesAsXmlWithTheLayersAndGroups) {
+    const Teapot t(640, 360);
+    ink::InkSettings settings;
+    settings.chain.hidden = true;
+    ink::InkLines lines;
+    ink::draw_ink_lines(t.scene, t.accel, t.camera, 640, 360, settings, 1, lines);
+    test_support::TempDir dir("ink_svg");
+    ink::SvgSettings svg;
+    svg.width = 640;
+    svg.height = 360;
+    svg.thickness = ink::stroke_thickness(settings.width, 360);
+    svg.hidden = true;
+    ink::write_svg(dir / "teapot.svg", lines.strokes, svg);
+    const std::string check = std::string("python3 ") + TOONRAY_TESTS_DIR + "/ink/check_svg.py " +
+                              (dir / "teapot.svg").string() + " 640 360 1 10";
+    EXPECT_EQ(std::system(check.c_str()), 0) << check;
+    // Without hidden lines there is only the visible layer.
+    svg.hidden = false;
+    ink::write_svg(dir / "visible.svg", lines.strokes, svg);
+    const std::string check_visible = std::string("python3 ") + TOONRAY_TESTS_DIR + "/ink/check_svg.py " +
+                                      (dir / "visible.svg").string() + " 640 360 0 10";
+    EXPECT_EQ(std::system(check_visible.c_str()), 0) << check_visible;
+    // The text itself: one path per visible stroke.
+    const std::string text = ink::svg_text(lines.strokes, svg);
+    std::size_t paths = 0;
+    for (std::size_t at = text.find("<path"); at != std::string::npos; at = text.find("<path", at + 1)) ++paths;
+    std::size_t visible = 0;
+    for (const auto& s : lines.strokes) visible += s.visible;
+    EXPECT_EQ(paths, visible);
+}
+
+// A real SVG renderer draws the file like toonray's own coverage: at least 90% of each
+// image's line pixels lie within 1.5 px of the other's.
+TEST(InkSvg, RsvgDrawsWhatToonrayDraws) {
+    if (std::system("rsvg-convert --version > /dev/null 2>&1") != 0)
+        GTEST_SKIP() << "rsvg-convert (librsvg2-bin) is not installed";
+    const int w = 1280, h = 720;
+    const Teapot t(w, h);
+    ink::InkLines lines;
+    ink::draw_ink_lines(t.scene, t.accel, t.camera, w, h, {}, 0, lines);
+    test_support::TempDir dir("ink_rsvg");
+    ink::SvgSettings svg;
+    svg.width = w;
+    svg.height = h;
+    svg.thickness = ink::stroke_thickness(2.0f, h);
+    ink::write_svg(dir / "teapot.svg", lines.strokes, svg);
+    const std::string convert = "rsvg-convert -b white -o " + (dir / "teapot.png").string() + " " +
+                                (dir / "teapot.svg").string();
+    ASSERT_EQ(std::system(convert.c_str()), 0) << convert;
+    const DecodedPng png = read_png(dir / "teapot.png");
+    ASSERT_EQ(png.width, w);
+    ASSERT_EQ(png.height, h);
+    std::vector<bool> ours(static_cast<std::size_t>(w) * h), theirs(ours.size());
+    long ours_count = 0, theirs_count = 0;
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            const std::size_t i = static_cast<std::size_t>(y) * w + x;
+            ours[i] = lines.coverage(x, y) > 0.5f;
+            theirs[i] = png.rgb(x, y)[0] < 128;
+            ours_count += ours[i];
+            theirs_count += theirs[i];
+        }
+    EXPECT_GT(ours_count, 2000);
+    EXPECT_NEAR(static_cast<double>(theirs_count) / ours_count, 1.0, 0.2);
+    EXPECT_GE(agreement(ours, theirs, w, h), 0.9);
+    EXPECT_GE(agreement(theirs, ours, w, h), 0.9);
+}
+
+}  // namespace
+}  // namespace toonray
