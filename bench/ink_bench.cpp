@@ -1,0 +1,190 @@
+// toonray_ink_bench: the stages of `--edges ink` (feature edges, visibility, chaining, drawing)
+// timed on one thread against a whole classic frame and a robust frame of the same view, with
+// medians of repeated runs after a warm-up. It also counts specks (8-connected groups of at
+// most 12 pixels darker than 8% luminance) in the ink line image and in the robust `_edges`
+// image, and with --out writes both, the ink lines over the cel colours, and the SVG.
+//
+// Usage: toonray_ink_bench [--repeats N] [--size WxH] [--out DIR] [--quick] scene.obj ...
+// With no scenes: tests/data/teapot.obj. --quick runs each stage once and checks that the
+// ink lines do not depend on the thread count (CTest: ink_bench_quick).
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "toonray/core/error.h"
+#include "toonray/ink/ink.h"
+#include "toonray/ink/svg.h"
+#include "toonray/io/png.h"
+#include "toonray/render/render_file.h"
+#include "toonray/render/renderer.h"
+#include "toonray/scene/obj_loader.h"
+
+namespace toonray::bench {
+namespace {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+double median(std::vector<double> v) {
+    std::sort(v.begin(), v.end());
+    return v.empty() ? 0.0 : (v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]));
+}
+
+int count_specks(const ImageGray8& lines) {
+    const int w = lines.width(), h = lines.height();
+    std::vector<std::uint8_t> seen(static_cast<std::size_t>(w) * h, 0);
+    auto dark = [&](int x, int y) { return lines(x, y) < 0.08f * 255.0f; };
+    int specks = 0;
+    std::vector<std::pair<int, int>> stack;
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            if (seen[static_cast<std::size_t>(y) * w + x] || !dark(x, y)) continue;
+            int size = 0;
+            stack.assign(1, {x, y});
+            seen[static_cast<std::size_t>(y) * w + x] = 1;
+            while (!stack.empty()) {
+                const auto [cx, cy] = stack.back();
+                stack.pop_back();
+                ++size;
+                for (int dy = -1; dy <= 1; ++dy)
+                    for (int dx = -1; dx <= 1; ++dx) {
+                        const int nx = cx + dx, ny = cy + dy;
+                        if (nx < 0 || ny < 0 || nx >= w || ny >= h) continue;
+                        auto& flag = seen[static_cast<std::size_t>(ny) * w + nx];
+                        if (flag || !dark(nx, ny)) continue;
+                        flag = 1;
+                        stack.push_back({nx, ny});
+                    }
+            }
+            specks += size <= 12;
+        }
+    return specks;
+}
+
+struct Options {
+    int repeats = 7;
+    int width = 1280, height = 720;
+    bool quick = false;
+    std::optional<fs::path> out;
+    std::vector<fs::path> scenes;
+};
+
+int run(const Options& options) {
+    fmt::print("| scene | triangles | classic frame | robust frame | ink: edges | visibility | chaining | drawing | "
+               "ink lines | classic + ink lines / classic | specks robust / ink |\n");
+    fmt::print("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+    int failures = 0;
+    for (const fs::path& path : options.scenes) {
+        Scene scene;
+        Warnings warnings;
+        load_obj(path, scene, warnings);
+        TriangleAccel accel;
+        accel.build(scene.positions, scene.tri_positions);
+        FileRenderOptions file_options;
+        file_options.settings.width = options.width;
+        file_options.settings.height = options.height;
+        const CameraSpec camera = choose_camera(scene, file_options);
+        const int repeats = options.quick ? 1 : options.repeats;
+
+        // Whole frames on one thread: trace, shade, lines, compose.
+        auto time_frame = [&](EdgeMode mode, Renderer& renderer) {
+            RenderSettings settings = file_options.settings;
+            settings.edges = mode;
+            settings.threads = 1;
+            std::vector<double> t;
+            for (int i = 0; i <= repeats; ++i) {
+                const auto start = Clock::now();
+                renderer.render(scene, accel, camera, settings);
+                if (i > 0 || repeats == 0) t.push_back(std::chrono::duration<double>(Clock::now() - start).count());
+            }
+            return median(t);
+        };
+        Renderer classic, robust;
+        const double classic_s = time_frame(EdgeMode::Classic, classic);
+        const double robust_s = time_frame(EdgeMode::Robust, robust);
+
+        ink::InkLines lines;
+        std::vector<double> edges, visibility, chaining, drawing, total;
+        for (int i = 0; i <= repeats; ++i) {
+            ink::draw_ink_lines(scene, accel, camera, options.width, options.height, {}, 1, lines);
+            if (i == 0 && repeats > 0) continue;
+            edges.push_back(lines.timings.edges);
+            visibility.push_back(lines.timings.visibility);
+            chaining.push_back(lines.timings.chaining);
+            drawing.push_back(lines.timings.drawing);
+            total.push_back(lines.timings.edges + lines.timings.visibility + lines.timings.chaining +
+                            lines.timings.drawing);
+        }
+        if (options.quick) {
+            ink::InkLines threaded;
+            ink::draw_ink_lines(scene, accel, camera, options.width, options.height, {}, 0, threaded);
+            if (!std::equal(lines.coverage.data(), lines.coverage.data() + lines.coverage.size(), threaded.coverage.data())) {
+                fmt::print(stderr, "{}: ink lines differ between one thread and all threads\n", path.string());
+                ++failures;
+            }
+        }
+        ImageGray8 ink_gray;
+        ink::coverage_to_gray(lines.coverage, ink_gray);
+        const int ink_specks = count_specks(ink_gray);
+        const int robust_specks = count_specks(robust.aovs().edges);
+        auto ms = [](double s) { return fmt::format("{:.1f} ms", s * 1e3); };
+        fmt::print("| {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.2f} | {} / {} |\n", path.filename().string(),
+                   scene.triangle_count(), ms(classic_s), ms(robust_s), ms(median(edges)), ms(median(visibility)),
+                   ms(median(chaining)), ms(median(drawing)), ms(median(total)),
+                   (classic_s + median(total)) / classic_s, robust_specks, ink_specks);
+        if (options.out) {
+            fs::create_directories(*options.out);
+            const std::string stem = path.stem().string();
+            ImageRgb8 composite = classic.aovs().cel;
+            ink::composite_lines(lines.coverage, Vec3f(0.0f), composite);
+            write_png(*options.out / (stem + "_ink.png"), composite);
+            write_png(*options.out / (stem + "_ink_edges.png"), ink_gray);
+            write_png(*options.out / (stem + "_robust_edges.png"), robust.aovs().edges);
+            ink::SvgSettings svg;
+            svg.width = options.width;
+            svg.height = options.height;
+            svg.thickness = ink::stroke_thickness(2.0f, options.height);
+            ink::write_svg(*options.out / (stem + "_ink.svg"), lines.strokes, svg);
+        }
+    }
+    return failures ? 1 : 0;
+}
+
+}  // namespace
+}  // namespace toonray::bench
+
+int main(int argc, char** argv) {
+    using namespace toonray::bench;
+    Options options;
+    try {
+        for (int i = 1; i < argc; ++i) {
+            const std::string arg = argv[i];
+            auto value = [&]() -> std::string {
+                if (i + 1 >= argc) throw toonray::Error(arg + " needs a value");
+                return argv[++i];
+            };
+            if (arg == "--repeats") options.repeats = std::stoi(value());
+            else if (arg == "--size") {
+                const std::string v = value();
+                const auto x = v.find('x');
+                if (x == std::string::npos) throw toonray::Error("--size takes WxH");
+                options.width = std::stoi(v.substr(0, x));
+                options.height = std::stoi(v.substr(x + 1));
+            } else if (arg == "--out") options.out = value();
+            else if (arg == "--quick") options.quick = true;
+            else if (!arg.empty() && arg[0] == '-') throw toonray::Error("unknown option " + arg);
+            else options.scenes.emplace_back(arg);
+        }
+        if (options.scenes.empty()) options.scenes.emplace_back(TOONRAY_BENCH_DATA_DIR "/teapot.obj");
+        return run(options);
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "toonray_ink_bench: %s\n", e.what());
+        return 2;
+    }
+}
