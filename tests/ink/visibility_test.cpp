@@ -142,6 +142,35 @@ TEST(Visibility, SameForAnyThreadCount) {
     }
 }
 
+TEST(Visibility, LinesOnTheFarSideOfClosedSolidsAreHiddenWithoutRays) {
+    Scene s;
+    test_support::add_box(s, Vec3f(-1.0f), Vec3f(0.0f), 0);
+    test_support::add_box(s, Vec3f(0.2f), Vec3f(1.0f), 1);
+    test_support::add_box(s, Vec3f(-0.5f, 0.3f, -0.5f), Vec3f(0.6f, 0.5f, 0.4f), 2);  // crosses box 1
+    // An open box (no top) is not closed: its far edges may be seen from inside.
+    Scene open_box;
+    test_support::add_box(open_box, Vec3f(-0.5f), Vec3f(0.5f));
+    open_box.tri_positions.erase(open_box.tri_positions.begin() + 6, open_box.tri_positions.begin() + 8);
+    open_box.tri_normals.resize(10), open_box.tri_texcoords.resize(10), open_box.tri_material.resize(10),
+        open_box.tri_object.resize(10);
+    const CameraSpec camera{Vec3f(2.5f, 2.0f, 3.0f), Vec3f(1.8f, 1.4f, 2.2f), normalize(Vec3f(-0.3f, 1.0f, -0.3f))};
+    const Frame f(std::move(s), camera, 320, 240);
+    int certain = 0;
+    for (const auto& seg : f.segments) certain += seg.certainly_hidden;
+    EXPECT_GE(certain, 9);  // three far edges of each box at least
+    // Traced, every piece of those segments is hidden.
+    const auto traced = ink::split_by_visibility(f.segments, f.context(), {}, 1);
+    for (const auto& p : traced)
+        if (f.segments[p.segment].certainly_hidden) EXPECT_GT(p.invisibility, 0) << p.segment;
+    ink::VisibilitySettings binary;
+    binary.max_invisibility = 1;
+    for (const auto& p : ink::split_by_visibility(f.segments, f.context(), binary, 1))
+        if (f.segments[p.segment].certainly_hidden) EXPECT_EQ(p.invisibility, 1);
+    const Frame g(std::move(open_box), CameraSpec{Vec3f(0.3f, 3.0f, 0.2f), Vec3f(0.3f, 2.0f, 0.2f), Vec3f(0, 0, -1)}, 320,
+                  240);
+    for (const auto& seg : g.segments) EXPECT_FALSE(seg.certainly_hidden);
+}
+
 TEST(Visibility, PartsBehindTheEyeOrOffTheImageAreLeftOut) {
     Scene s;
     // A long border line from behind the eye to far in front, and one far to the side.

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <map>
 #include <cmath>
 #include <numbers>
 #include <tuple>
@@ -24,10 +25,6 @@ const char* edge_type_name(EdgeType type) {
 namespace {
 
 std::uint32_t float_bits(float f) { return std::bit_cast<std::uint32_t>(f + 0.0f); }  // -0 + 0 = +0
-
-bool same_position(const Vec3f& a, const Vec3f& b) {
-    return float_bits(a.x) == float_bits(b.x) && float_bits(a.y) == float_bits(b.y) && float_bits(a.z) == float_bits(b.z);
-}
 
 // Lexicographic order of positions: orders an edge's ends the same way from either triangle, so
 // that a point computed on it is the same bits from both.
@@ -60,29 +57,43 @@ std::array<Vec3f, 3> corners(const Scene& scene, std::size_t t) {
 
 WeldedMesh weld_vertices(const Scene& scene) {
     const std::size_t n = scene.triangle_count();
-    struct Corner {
-        std::uint32_t object, x, y, z, corner;
+    // Positions with the same bits share a canonical index, the lowest among them.
+    std::vector<std::uint32_t> order(scene.positions.size()), canonical(scene.positions.size());
+    for (std::size_t i = 0; i < order.size(); ++i) order[i] = static_cast<std::uint32_t>(i);
+    auto bits = [&](std::uint32_t i) {
+        const Vec3f& p = scene.positions[i];
+        return std::tuple(float_bits(p.x), float_bits(p.y), float_bits(p.z));
     };
-    std::vector<Corner> list;
-    list.reserve(n * 3);
-    for (std::size_t t = 0; t < n; ++t)
-        for (int k = 0; k < 3; ++k) {
-            const Vec3f& p = scene.positions[scene.tri_positions[t][k]];
-            list.push_back({scene.tri_object[t], float_bits(p.x), float_bits(p.y), float_bits(p.z),
-                            static_cast<std::uint32_t>(t * 3 + k)});
-        }
-    auto key = [](const Corner& c) { return std::tie(c.object, c.x, c.y, c.z); };
-    std::sort(list.begin(), list.end(), [&](const Corner& a, const Corner& b) {
-        return std::tie(a.object, a.x, a.y, a.z, a.corner) < std::tie(b.object, b.x, b.y, b.z, b.corner);
+    std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
+        return std::tuple_cat(bits(a), std::tuple(a)) < std::tuple_cat(bits(b), std::tuple(b));
     });
+    for (std::size_t i = 0; i < order.size(); ++i)
+        canonical[order[i]] = i > 0 && bits(order[i]) == bits(order[i - 1]) ? canonical[order[i - 1]] : order[i];
+    // Welded ids in order of first use by the triangles: one per (object, canonical position).
+    // Most positions belong to one object; the few shared by several look the rest up.
     WeldedMesh mesh;
     mesh.tri_vertices.resize(n);
-    for (std::size_t i = 0; i < list.size(); ++i) {
-        if (i == 0 || key(list[i]) != key(list[i - 1]))
-            mesh.vertex_position.push_back(scene.tri_positions[list[i].corner / 3][list[i].corner % 3]);
-        mesh.tri_vertices[list[i].corner / 3][list[i].corner % 3] =
-            static_cast<std::uint32_t>(mesh.vertex_position.size() - 1);
-    }
+    std::vector<std::uint32_t> id_of(scene.positions.size(), kNoIndex), object_of(scene.positions.size());
+    std::map<std::pair<std::uint32_t, std::uint32_t>, std::uint32_t> shared;
+    auto new_id = [&](std::uint32_t c) {
+        mesh.vertex_position.push_back(c);
+        return static_cast<std::uint32_t>(mesh.vertex_position.size() - 1);
+    };
+    for (std::size_t t = 0; t < n; ++t)
+        for (int k = 0; k < 3; ++k) {
+            const std::uint32_t c = canonical[scene.tri_positions[t][k]], object = scene.tri_object[t];
+            std::uint32_t& id = mesh.tri_vertices[t][k];
+            if (id_of[c] == kNoIndex) {
+                id = id_of[c] = new_id(c);
+                object_of[c] = object;
+            } else if (object_of[c] == object) {
+                id = id_of[c];
+            } else {
+                auto [it, inserted] = shared.try_emplace({object, c}, 0u);
+                if (inserted) it->second = new_id(c);
+                id = it->second;
+            }
+        }
     // Triangles around each vertex, by counting sort (in triangle order; a triangle with a
     // repeated corner counts once at that vertex).
     auto distinct = [&](std::size_t t, int k) {
@@ -198,6 +209,38 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
         return corner_normal(s0.tri, s0.lo) == corner_normal(s1.tri, s1.lo) &&
                corner_normal(s0.tri, s0.hi) == corner_normal(s1.tri, s1.hi);
     };
+    // Objects whose lines on faces turned away from the eye are certainly hidden: closed
+    // (every edge has two faces, wound in opposite directions along it), with a non-zero
+    // volume, and not around the eye. A line of sight from such a line into the eye starts
+    // inside the solid, so it must leave it through the surface on the way.
+    std::size_t objects = scene.objects.size();
+    for (std::size_t t = 0; t < n; ++t) objects = std::max<std::size_t>(objects, scene.tri_object[t] + std::size_t{1});
+    std::vector<std::uint8_t> closed(objects, 1);
+    std::vector<double> volume(objects, 0.0);
+    std::vector<BBox> object_box(objects);
+    for (std::size_t t = 0; t < n; ++t) {
+        const std::uint32_t o = scene.tri_object[t];
+        const auto& w = mesh.tri_vertices[t];
+        if (!usable(t) || w[0] == w[1] || w[1] == w[2] || w[2] == w[0]) closed[o] = 0;
+        const auto p = corners(scene, t);
+        for (const Vec3f& q : p) object_box[o].extend(q);
+        volume[o] += static_cast<double>(dot(p[0], cross(p[1], p[2])));
+    }
+    for (std::size_t i = 0; i < sides.size();) {
+        std::size_t j = i + 1;
+        while (j < sides.size() && sides[j].lo == sides[i].lo && sides[j].hi == sides[i].hi) ++j;
+        const std::uint32_t o = scene.tri_object[sides[i].tri];
+        if (j - i != 2 || sides[i].forward == sides[i + 1].forward) closed[o] = 0;
+        i = j;
+    }
+    auto eye_outside = [&](const BBox& b) {
+        return eye.x < b.lo.x || eye.y < b.lo.y || eye.z < b.lo.z || eye.x > b.hi.x || eye.y > b.hi.y || eye.z > b.hi.z;
+    };
+    // +1: outward normals are the geometric ones; -1: the object is wound inside out; 0: unknown.
+    std::vector<int> outward(objects, 0);
+    for (std::size_t o = 0; o < objects; ++o)
+        if (closed[o] && volume[o] != 0.0 && eye_outside(object_box[o])) outward[o] = volume[o] > 0.0 ? 1 : -1;
+
     for (std::size_t i = 0; i < sides.size();) {
         std::size_t j = i + 1;
         while (j < sides.size() && sides[j].lo == sides[i].lo && sides[j].hi == sides[i].hi) ++j;
@@ -219,6 +262,9 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
             const Vec3f n1 = s0.forward != s1.forward ? normal[s1.tri] : -normal[s1.tri];
             const bool front0 = dot(n0, eye - seg.p0) > 0, front1 = dot(n1, eye - seg.p0) > 0;
             const bool smooth = settings.smooth_contours && smooth_across(s0, s1);
+            const int out = outward[scene.tri_object[s0.tri]];
+            seg.certainly_hidden = out != 0 && front0 == (out < 0) && front1 == (out < 0) &&
+                                   dot(n0, eye - seg.p0) != 0 && dot(n1, eye - seg.p0) != 0;
             if (settings.silhouettes && front0 != front1 && !smooth) {
                 seg.type = EdgeType::Silhouette;
                 emit = true;
@@ -270,56 +316,73 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
 
     // Intersection lines: each triangle against the triangles whose boxes overlap its own.
     if (settings.intersections && !bvh.nodes.empty()) {
-        auto found = gather_chunks<FeatureSegment>(static_cast<int>(n), 256, threads,
-                                                   [&](int t0, int t1, std::vector<FeatureSegment>& out) {
-            std::vector<std::uint32_t> stack, candidates;
-            for (int ti = t0; ti < t1; ++ti) {
-                const auto t = static_cast<std::uint32_t>(ti);
-                if (!usable(t)) continue;
-                const auto a = corners(scene, t);
-                BBox box;
-                for (const Vec3f& p : a) box.extend(p);
-                candidates.clear();
+        std::vector<BBox> boxes(n);
+        for (std::size_t t = 0; t < n; ++t)
+            for (const Vec3f& p : corners(scene, t)) boxes[t].extend(p);
+        auto overlap = [](const BBox& a, const BBox& b) {
+            return !(a.lo.x > b.hi.x || a.hi.x < b.lo.x || a.lo.y > b.hi.y || a.hi.y < b.lo.y || a.lo.z > b.hi.z ||
+                     a.hi.z < b.lo.z);
+        };
+        // One BVH query per leaf, with the leaf's box: its triangles are near each other, so
+        // they share most candidates. Each pair is tested once, from its lower triangle.
+        std::vector<std::uint32_t> leaves;
+        for (std::size_t i = 0; i < bvh.nodes.size(); ++i)
+            if (bvh.nodes[i].is_leaf()) leaves.push_back(static_cast<std::uint32_t>(i));
+        auto found = gather_chunks<FeatureSegment>(static_cast<int>(leaves.size()), 16, threads,
+                                                   [&](int l0, int l1, std::vector<FeatureSegment>& out) {
+            std::vector<std::uint32_t> stack, near;
+            for (int l = l0; l < l1; ++l) {
+                const BvhNode& leaf = bvh.nodes[leaves[static_cast<std::size_t>(l)]];
+                near.clear();
                 stack.assign(1, 0);
                 while (!stack.empty()) {
                     const BvhNode& node = bvh.nodes[stack.back()];
                     stack.pop_back();
-                    if (node.bounds.lo.x > box.hi.x || node.bounds.hi.x < box.lo.x || node.bounds.lo.y > box.hi.y ||
-                        node.bounds.hi.y < box.lo.y || node.bounds.lo.z > box.hi.z || node.bounds.hi.z < box.lo.z)
-                        continue;
+                    if (!overlap(node.bounds, leaf.bounds)) continue;
                     if (node.is_leaf()) {
-                        for (std::uint32_t i = node.first; i < node.first + node.count; ++i)
-                            if (bvh.prim_indices[i] > t) candidates.push_back(bvh.prim_indices[i]);
+                        near.insert(near.end(), bvh.prim_indices.begin() + node.first,
+                                    bvh.prim_indices.begin() + node.first + node.count);
                     } else {
                         stack.push_back(node.first);
                         stack.push_back(node.first + 1);
                     }
                 }
-                std::sort(candidates.begin(), candidates.end());
-                for (std::uint32_t u : candidates) {
-                    if (!usable(u)) continue;
-                    const auto b = corners(scene, u);
-                    bool shared = false;
-                    for (const Vec3f& pa : a)
-                        for (const Vec3f& pb : b) shared = shared || same_position(pa, pb);
-                    if (shared) continue;
-                    TriangleCrossing c;
-                    if (!intersect_triangles(a, b, c)) continue;
-                    FeatureSegment seg;
-                    seg.type = EdgeType::Intersection;
-                    seg.p0 = c.p[0];
-                    seg.p1 = c.p[1];
-                    seg.faces = {t, u};
-                    for (int e = 0; e < 2; ++e) {
-                        const std::uint32_t on = c.on_b[e] ? u : t, other = c.on_b[e] ? t : u;
-                        std::uint32_t w0 = mesh.tri_vertices[on][c.edge[e][0]], w1 = mesh.tri_vertices[on][c.edge[e][1]];
-                        if (w1 < w0) std::swap(w0, w1);
-                        (e == 0 ? seg.key0 : seg.key1) = {w0, w1, other};
+                std::sort(near.begin(), near.end());
+                for (std::uint32_t i = leaf.first; i < leaf.first + leaf.count; ++i) {
+                    const std::uint32_t t = bvh.prim_indices[i];
+                    if (!usable(t)) continue;
+                    const auto a = corners(scene, t);
+                    const BBox& box = boxes[t];
+                    for (std::uint32_t u : near) {
+                        if (u <= t || !overlap(boxes[u], box) || !usable(u)) continue;
+                        // Triangles sharing a corner position (in any object) touch there: no line.
+                        bool shared = false;
+                        for (std::uint32_t va : mesh.tri_vertices[t])
+                            for (std::uint32_t vb : mesh.tri_vertices[u])
+                                shared = shared || mesh.vertex_position[va] == mesh.vertex_position[vb];
+                        if (shared) continue;
+                        const auto b = corners(scene, u);
+                        TriangleCrossing c;
+                        if (!intersect_triangles(a, b, c)) continue;
+                        FeatureSegment seg;
+                        seg.type = EdgeType::Intersection;
+                        seg.p0 = c.p[0];
+                        seg.p1 = c.p[1];
+                        seg.faces = {t, u};
+                        for (int e = 0; e < 2; ++e) {
+                            const std::uint32_t on = c.on_b[e] ? u : t, other = c.on_b[e] ? t : u;
+                            std::uint32_t w0 = mesh.tri_vertices[on][c.edge[e][0]], w1 = mesh.tri_vertices[on][c.edge[e][1]];
+                            if (w1 < w0) std::swap(w0, w1);
+                            (e == 0 ? seg.key0 : seg.key1) = {w0, w1, other};
+                        }
+                        out.push_back(seg);
                     }
-                    out.push_back(seg);
                 }
             }
         });
+        // In the order of the triangle pairs, whatever the tree.
+        std::sort(found.begin(), found.end(),
+                  [](const FeatureSegment& x, const FeatureSegment& y) { return x.faces < y.faces; });
         segments.insert(segments.end(), found.begin(), found.end());
     }
     return segments;

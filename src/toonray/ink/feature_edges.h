@@ -44,6 +44,10 @@ struct FeatureSegment {
     /// where the facets around it may graze the line of sight: the triangles sharing a vertex
     /// with `faces[0]` are ignored as occluders too (see visibility.h).
     bool smooth = false;
+    /// Both faces turn away from the eye on a closed, consistently wound object that does not
+    /// surround the eye: a line of sight from here starts inside the solid, so at least one
+    /// surface hides the segment, and visibility need not trace it to tell it is hidden.
+    bool certainly_hidden = false;
 };
 
 struct FeatureEdgeSettings {
@@ -60,10 +64,13 @@ struct FeatureEdgeSettings {
 
 /// Vertices welded by exact position within each object: two triangle corners share a welded
 /// vertex when they belong to the same object and their positions are bitwise equal (-0 = +0).
-/// Split normals and texture seams then make no false borders.
+/// Split normals and texture seams then make no false borders. Ids are numbered in order of
+/// first use by the triangles.
 struct WeldedMesh {
     std::vector<std::array<std::uint32_t, 3>> tri_vertices;  ///< welded ids per corner
-    std::vector<std::uint32_t> vertex_position;              ///< a position index per welded id
+    /// Per welded id, the lowest index of the positions with its bits: vertices of different
+    /// objects at the same place have the same one.
+    std::vector<std::uint32_t> vertex_position;
     /// Triangles around each welded vertex: ring_offsets has one more entry than vertices.
     std::vector<std::uint32_t> ring_offsets, ring_triangles;
 

@@ -99,6 +99,24 @@ std::vector<EdgePiece> split_by_visibility(std::span<const FeatureSegment> segme
                 const FeatureSegment& seg = segments[static_cast<std::size_t>(i)];
                 ClippedSegment c;
                 if (!clip_to_view(seg, view, settings.margin, c)) continue;
+                if (seg.certainly_hidden && settings.max_invisibility <= 1) {
+                    // Hidden, and how deep does not matter: no rays.
+                    EdgePiece piece;
+                    piece.segment = static_cast<std::uint32_t>(i);
+                    piece.type = seg.type;
+                    piece.invisibility = 1;
+                    piece.t0 = c.s_lo == 0.0f ? c.ta : c.t_of(c.s_lo);
+                    piece.t1 = c.s_hi == 1.0f ? c.tb : c.t_of(c.s_hi);
+                    if (!(piece.t0 < piece.t1)) continue;
+                    piece.p0 = piece.t0 == 0.0f ? seg.p0 : seg.p0 + (seg.p1 - seg.p0) * piece.t0;
+                    piece.p1 = piece.t1 == 1.0f ? seg.p1 : seg.p0 + (seg.p1 - seg.p0) * piece.t1;
+                    piece.s0 = c.image(c.s_lo);
+                    piece.s1 = c.image(c.s_hi);
+                    if (piece.t0 == 0.0f) piece.key0 = seg.key0;
+                    if (piece.t1 == 1.0f) piece.key1 = seg.key1;
+                    out.push_back(piece);
+                    continue;
+                }
                 const std::vector<std::uint32_t> ignored = ignored_triangles(seg, context.mesh);
                 auto state_at = [&](float s) {
                     const float t = c.t_of(s);
