@@ -37,9 +37,10 @@ void RenderArgs::add_to(CLI::App& app) {
     app.add_option("--background", background, "Background colour r,g,b in [0,1] or #rrggbb")
         ->capture_default_str();
     app.add_option("--edges", edges,
-                   "Line mode: robust (supersampled, plane-aware, resolution-independent lines) or "
-                   "classic (the seed's Sobel pipeline, exactly)")
-        ->check(CLI::IsMember({"robust", "classic"}))
+                   "Line mode: robust (supersampled, plane-aware, resolution-independent lines), "
+                   "classic (the seed's Sobel pipeline, exactly) or ink (lines found on the geometry, "
+                   "with ray-traced visibility, drawn as exact strokes; render --svg writes them)")
+        ->check(CLI::IsMember({"robust", "classic", "ink"}))
         ->capture_default_str();
     app.add_option("--lines", lines,
                    "Robust: line types to draw, from silhouette,crease,depth,object,material (or all, none)")
@@ -73,7 +74,7 @@ void RenderArgs::add_to(CLI::App& app) {
                    "Also write feature images to this directory, named after the output: "
                    "NAME_depth, _normal, _edges, _cel .png, and per mode: classic _edges_depth, "
                    "_edges_normal; robust _lines_silhouette, _lines_crease, _lines_depth, _lines_object, "
-                   "_lines_material, _object_id, _material_id");
+                   "_lines_material, _object_id, _material_id; ink _object_id, _material_id");
     app.add_option("--threads", threads, "Threads to use (0 = all)")
         ->check(CLI::Range(0, 1024))
         ->capture_default_str();
@@ -102,7 +103,7 @@ FrameOptions RenderArgs::resolve() const {
     o.settings.shading.textures = !no_textures;
     if (!camera.empty()) o.camera = parse_camera_spec(camera);
     o.settings.background = parse_colour(background, "--background");
-    o.settings.edges = edges == "classic" ? EdgeMode::Classic : EdgeMode::Robust;
+    o.settings.edges = edges == "classic" ? EdgeMode::Classic : (edges == "ink" ? EdgeMode::Ink : EdgeMode::Robust);
     o.settings.lines.types = parse_line_types(lines);
     o.settings.lines.crease_angle = crease_angle;
     o.settings.lines.depth_threshold = depth_step;

@@ -1,6 +1,7 @@
-// toonray_ink_bench: the stages of `--edges ink` (feature edges, visibility, chaining, drawing)
-// timed on one thread against a whole classic frame and a robust frame of the same view, with
-// medians of repeated runs after a warm-up. It also counts specks (8-connected groups of at
+// toonray_ink_bench: whole `--edges ink` frames (at the default 4 samples per pixel, and at 1
+// like classic) and the ink stages (feature edges, visibility, chaining, drawing) timed on one
+// thread against whole classic and robust frames of the same view, with medians of repeated
+// runs after a warm-up. It also counts specks (8-connected groups of at
 // most 12 pixels darker than 8% luminance) in the ink line image and in the robust `_edges`
 // image, and with --out writes both, the ink lines over the cel colours, and the SVG.
 //
@@ -21,7 +22,8 @@
 #include "toonray/ink/ink.h"
 #include "toonray/ink/svg.h"
 #include "toonray/io/png.h"
-#include "toonray/render/render_file.h"
+#include "toonray/frame/frame_renderer.h"
+#include "toonray/io/file.h"
 #include "toonray/render/renderer.h"
 #include "toonray/scene/obj_loader.h"
 
@@ -76,9 +78,9 @@ struct Options {
 };
 
 int run(const Options& options) {
-    fmt::print("| scene | triangles | classic frame | robust frame | ink: edges | visibility | chaining | drawing | "
-               "ink lines | classic + ink lines / classic | specks robust / ink |\n");
-    fmt::print("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+    fmt::print("| scene | triangles | classic frame | robust frame | ink frame | ink frame, 1 sample | "
+               "ink 1 sample / classic | ink: edges | visibility | chaining | drawing | specks robust / ink |\n");
+    fmt::print("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
     int failures = 0;
     for (const fs::path& path : options.scenes) {
         Scene scene;
@@ -86,16 +88,19 @@ int run(const Options& options) {
         load_obj(path, scene, warnings);
         TriangleAccel accel;
         accel.build(scene.positions, scene.tri_positions);
-        FileRenderOptions file_options;
+        FrameOptions file_options;
         file_options.settings.width = options.width;
         file_options.settings.height = options.height;
         const CameraSpec camera = choose_camera(scene, file_options);
         const int repeats = options.quick ? 1 : options.repeats;
 
         // Whole frames on one thread: trace, shade, lines, compose.
-        auto time_frame = [&](EdgeMode mode, Renderer& renderer) {
+        // Whole frames on one thread: trace, shade, lines, compose. Then once more with the
+        // feature images, which the speck counts and --out read.
+        auto time_frame = [&](EdgeMode mode, Renderer& renderer, int samples = RenderSettings{}.samples) {
             RenderSettings settings = file_options.settings;
             settings.edges = mode;
+            settings.samples = samples;
             settings.threads = 1;
             std::vector<double> t;
             for (int i = 0; i <= repeats; ++i) {
@@ -103,11 +108,16 @@ int run(const Options& options) {
                 renderer.render(scene, accel, camera, settings);
                 if (i > 0 || repeats == 0) t.push_back(std::chrono::duration<double>(Clock::now() - start).count());
             }
+            settings.feature_images = true;
+            renderer.render(scene, accel, camera, settings);
             return median(t);
         };
-        Renderer classic, robust;
+        Renderer classic, robust, inked;
         const double classic_s = time_frame(EdgeMode::Classic, classic);
         const double robust_s = time_frame(EdgeMode::Robust, robust);
+        const double ink_s = time_frame(EdgeMode::Ink, inked);
+        Renderer inked1;
+        const double ink1_s = time_frame(EdgeMode::Ink, inked1, 1);
 
         ink::InkLines lines;
         std::vector<double> edges, visibility, chaining, drawing, total;
@@ -134,23 +144,25 @@ int run(const Options& options) {
         const int ink_specks = count_specks(ink_gray);
         const int robust_specks = count_specks(robust.aovs().edges);
         auto ms = [](double s) { return fmt::format("{:.1f} ms", s * 1e3); };
-        fmt::print("| {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.2f} | {} / {} |\n", path.filename().string(),
-                   scene.triangle_count(), ms(classic_s), ms(robust_s), ms(median(edges)), ms(median(visibility)),
-                   ms(median(chaining)), ms(median(drawing)), ms(median(total)),
-                   (classic_s + median(total)) / classic_s, robust_specks, ink_specks);
+        fmt::print("| {} | {} | {} | {} | {} | {} | {:.2f} | {} | {} | {} | {} | {} / {} |\n", path.filename().string(),
+                   scene.triangle_count(), ms(classic_s), ms(robust_s), ms(ink_s), ms(ink1_s), ink1_s / classic_s,
+                   ms(median(edges)), ms(median(visibility)), ms(median(chaining)), ms(median(drawing)),
+                   robust_specks, ink_specks);
         if (options.out) {
             fs::create_directories(*options.out);
             const std::string stem = path.stem().string();
-            ImageRgb8 composite = classic.aovs().cel;
-            ink::composite_lines(lines.coverage, Vec3f(0.0f), composite);
-            write_png(*options.out / (stem + "_ink.png"), composite);
+            RenderSettings settings = file_options.settings;
+            settings.edges = EdgeMode::Ink;
+            write_png(*options.out / (stem + "_ink.png"), inked.render(scene, accel, camera, settings));
             write_png(*options.out / (stem + "_ink_edges.png"), ink_gray);
             write_png(*options.out / (stem + "_robust_edges.png"), robust.aovs().edges);
             ink::SvgSettings svg;
             svg.width = options.width;
             svg.height = options.height;
             svg.thickness = ink::stroke_thickness(2.0f, options.height);
-            ink::write_svg(*options.out / (stem + "_ink.svg"), lines.strokes, svg);
+            const std::string text = ink::svg_text(lines.strokes, svg);
+            write_file_atomic(*options.out / (stem + "_ink.svg"),
+                              std::span(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()));
         }
     }
     return failures ? 1 : 0;

@@ -124,3 +124,20 @@ TEST(RenderCli, TexturedObjRendersItsTextureAndAMissingOneWarns) {
     EXPECT_EQ(png.rgb(40, 40), (toonray::Rgb8{0, 200, 0}));     // the textured triangle (lower right)
     EXPECT_EQ(png.rgb(22, 22), (toonray::Rgb8{128, 128, 128}));  // the other keeps its Kd
 }
+
+TEST(RenderCli, InkLinesWithSvg) {
+    TempDir dir("cli_ink");
+    CommandResult r = run_toonray("render " + kData + "/teapot.obj -o " + (dir / "t.png").string() +
+                                  " --size 320x180 --edges ink --svg " + (dir / "t.svg").string() + " --svg-hidden --aov " +
+                                  (dir / "aov").string());
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_EQ(read_png(dir / "t.png").width, 320);
+    EXPECT_TRUE(fs::exists(dir / "t.svg"));
+    EXPECT_TRUE(fs::exists(dir / "aov" / "t_edges.png"));
+    EXPECT_FALSE(fs::exists(dir / "aov" / "t_lines_depth.png"));
+    // An SVG needs the ink lines; the message names the flags.
+    r = run_toonray("render " + kData + "/teapot.obj -o " + (dir / "u.png").string() + " --svg " + (dir / "u.svg").string());
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_NE(r.output.find("--svg needs --edges ink"), std::string::npos) << r.output;
+    EXPECT_FALSE(fs::exists(dir / "u.png"));
+}

@@ -6,6 +6,7 @@
 #include <cstring>
 #include <filesystem>
 
+#include "toonray/io/file.h"
 #include "toonray/io/png.h"
 #include "toonray/scene/obj_loader.h"
 #include "support/test_support.h"
@@ -47,7 +48,7 @@ TEST(FrameRenderer, WritesTheImageAndAllFeatureImagesNamedAfterTheOutput) {
     FrameOptions o;
     o.settings.width = 64;
     o.settings.height = 48;
-    for (EdgeMode mode : {EdgeMode::Classic, EdgeMode::Robust}) {
+    for (EdgeMode mode : {EdgeMode::Classic, EdgeMode::Robust, EdgeMode::Ink}) {
         o.settings.edges = mode;
         FrameRenderer fr;
         Warnings w;
@@ -68,8 +69,33 @@ TEST(FrameRenderer, WritesTheImageAndAllFeatureImagesNamedAfterTheOutput) {
             EXPECT_EQ(read_png(p).width, 64);
             EXPECT_EQ(p, aov_path(dir.path / "aov", dir.path / "frame.png", f.name));
         }
-        EXPECT_EQ(written, mode == EdgeMode::Classic ? 6u : 11u);
+        EXPECT_EQ(written, mode == EdgeMode::Robust ? 11u : 6u);
         fs::remove_all(dir.path / "aov");
+    }
+}
+
+TEST(FrameRenderer, WritesTheInkStrokesAsSvg) {
+    test_support::TempDir dir("frame_svg");
+    const Scene teapot = load("teapot.obj");
+    FrameOptions o;
+    o.settings.width = 160;
+    o.settings.height = 90;
+    o.svg = dir.path / "frame.svg";
+    FrameRenderer fr;
+    Warnings w;
+    // Only the ink lines have strokes: asked of another mode, nothing is written.
+    EXPECT_THROW(fr.render(teapot, choose_camera(teapot, o), dir.path / "frame.png", o, w), Error);
+    EXPECT_FALSE(fs::exists(dir.path / "frame.png"));
+    EXPECT_FALSE(fs::exists(dir.path / "frame.svg"));
+    o.settings.edges = EdgeMode::Ink;
+    for (bool hidden : {false, true}) {
+        o.svg_hidden = hidden;
+        fr.render(teapot, choose_camera(teapot, o), dir.path / "frame.png", o, w);
+        const std::string svg = read_file(dir.path / "frame.svg");
+        EXPECT_NE(svg.find("viewBox=\"0 0 160 90\""), std::string::npos);
+        EXPECT_NE(svg.find("<g id=\"visible-silhouette\">"), std::string::npos);
+        EXPECT_EQ(svg.find("<g id=\"hidden\"") != std::string::npos, hidden);
+        EXPECT_NE(svg.find("<path d=\"M"), std::string::npos);
     }
 }
 

@@ -9,11 +9,17 @@
 #include "ink/ink_scenes.h"
 #include "support/test_support.h"
 #include "toonray/ink/svg.h"
+#include "toonray/io/file.h"
 #include "toonray/io/png.h"
 #include "toonray/scene/obj_loader.h"
 
 namespace toonray {
 namespace {
+
+void write_svg(const std::filesystem::path& path, std::span<const ink::Stroke> strokes, const ink::SvgSettings& svg) {
+    const std::string text = ink::svg_text(strokes, svg);
+    write_file_atomic(path, std::span(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()));
+}
 
 struct Teapot {
     Scene scene;
@@ -80,13 +86,13 @@ TEST(InkSvg, ParsesAsXmlWithTheLayersAndGroups) {
     svg.height = 360;
     svg.thickness = ink::stroke_thickness(settings.width, 360);
     svg.hidden = true;
-    ink::write_svg(dir / "teapot.svg", lines.strokes, svg);
+    write_svg(dir / "teapot.svg", lines.strokes, svg);
     const std::string check = std::string("python3 ") + TOONRAY_TESTS_DIR + "/ink/check_svg.py " +
                               (dir / "teapot.svg").string() + " 640 360 1 10";
     EXPECT_EQ(std::system(check.c_str()), 0) << check;
     // Without hidden lines there is only the visible layer.
     svg.hidden = false;
-    ink::write_svg(dir / "visible.svg", lines.strokes, svg);
+    write_svg(dir / "visible.svg", lines.strokes, svg);
     const std::string check_visible = std::string("python3 ") + TOONRAY_TESTS_DIR + "/ink/check_svg.py " +
                                       (dir / "visible.svg").string() + " 640 360 0 10";
     EXPECT_EQ(std::system(check_visible.c_str()), 0) << check_visible;
@@ -113,7 +119,7 @@ TEST(InkSvg, RsvgDrawsWhatToonrayDraws) {
     svg.width = w;
     svg.height = h;
     svg.thickness = ink::stroke_thickness(2.0f, h);
-    ink::write_svg(dir / "teapot.svg", lines.strokes, svg);
+    write_svg(dir / "teapot.svg", lines.strokes, svg);
     const std::string convert = "rsvg-convert -b white -o " + (dir / "teapot.png").string() + " " +
                                 (dir / "teapot.svg").string();
     ASSERT_EQ(std::system(convert.c_str()), 0) << convert;

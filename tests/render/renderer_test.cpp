@@ -268,7 +268,7 @@ TEST(Renderer, FeatureImagesAreComputedOnlyWhenAskedAndChangeNothingElse) {
     Scene s = load("teapot.obj");
     TriangleAccel accel;
     accel.build(s.positions, s.tri_positions);
-    for (EdgeMode mode : {EdgeMode::Classic, EdgeMode::Robust}) {
+    for (EdgeMode mode : {EdgeMode::Classic, EdgeMode::Robust, EdgeMode::Ink}) {
         RenderSettings settings;
         settings.edges = mode;
         settings.width = 160;
@@ -295,11 +295,13 @@ TEST(Renderer, FeatureImagesAreComputedOnlyWhenAskedAndChangeNothingElse) {
 }
 
 TEST(Renderer, FeatureImageTableListsEachModesImages) {
-    std::vector<std::string_view> classic, robust;
+    std::vector<std::string_view> classic, robust, ink;
     for (const FeatureImage& f : feature_images()) {
         if (f.in(EdgeMode::Classic)) classic.push_back(f.name);
         if (f.in(EdgeMode::Robust)) robust.push_back(f.name);
+        if (f.in(EdgeMode::Ink)) ink.push_back(f.name);
     }
+    EXPECT_EQ(ink, (std::vector<std::string_view>{"depth", "normal", "edges", "cel", "object_id", "material_id"}));
     EXPECT_EQ(classic, (std::vector<std::string_view>{"depth", "normal", "edges_depth", "edges_normal", "edges", "cel"}));
     EXPECT_EQ(robust, (std::vector<std::string_view>{"depth", "normal", "edges", "cel", "lines_silhouette",
                                                       "lines_crease", "lines_depth", "lines_object", "lines_material",
@@ -363,4 +365,45 @@ TEST(Renderer, SampleCountsAreSquareGrids) {
     } catch (const Error& e) {
         EXPECT_EQ(std::string(e.what()), "5 samples per pixel: must be 1, 4, 9 or 16 (a square grid per pixel)");
     }
+}
+
+// Ink mode: the cel colours (the mean of each pixel's samples) with the ink coverage
+// composited over them, and the `edges` feature image that coverage, black on white.
+TEST(Renderer, InkLinesAreTheCoverageOverTheCelColours) {
+    Scene s = load("teapot.obj");
+    TriangleAccel accel;
+    accel.build(s.positions, s.tri_positions);
+    RenderSettings settings;
+    settings.edges = EdgeMode::Ink;
+    settings.width = 320;
+    settings.height = 180;
+    settings.feature_images = true;
+    settings.lines.colour = Vec3f(0.2f, 0.0f, 0.0f);
+    const CameraSpec cam = framing_camera(s, settings);
+    Renderer r;
+    const ImageRgb8 image = r.render(s, accel, cam, settings);
+    const ink::InkLines& lines = r.ink_lines();
+    ASSERT_EQ(lines.coverage.width(), 320);
+    ImageRgb8 expected = r.aovs().cel;
+    ink::composite_lines(lines.coverage, settings.lines.colour, expected);
+    ASSERT_EQ(0, std::memcmp(image.data(), expected.data(), image.size() * sizeof(Rgb8)));
+    ImageGray8 gray;
+    ink::coverage_to_gray(lines.coverage, gray);
+    ASSERT_EQ(0, std::memcmp(gray.data(), r.aovs().edges.data(), gray.size()));
+    long line_pixels = 0;
+    for (std::size_t i = 0; i < gray.size(); ++i) line_pixels += gray.data()[i] < 128;
+    EXPECT_GT(line_pixels, 300);
+    // Hidden lines are found for SVG but not drawn; any thread count gives the same pixels.
+    settings.hidden_lines = true;
+    settings.threads = 1;
+    Renderer one;
+    const ImageRgb8 again = one.render(s, accel, cam, settings);
+    EXPECT_EQ(0, std::memcmp(image.data(), again.data(), image.size() * sizeof(Rgb8)));
+    bool hidden = false;
+    for (const auto& stroke : one.ink_lines().strokes) hidden = hidden || !stroke.visible;
+    EXPECT_TRUE(hidden);
+    // Line types map onto the ink's: none draws nothing.
+    settings.lines.types = 0;
+    const ImageRgb8 bare = one.render(s, accel, cam, settings);
+    EXPECT_EQ(0, std::memcmp(bare.data(), one.aovs().cel.data(), bare.size() * sizeof(Rgb8)));
 }

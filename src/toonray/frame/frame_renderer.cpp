@@ -5,12 +5,33 @@
 #include <variant>
 #include <vector>
 
+#include "toonray/core/error.h"
+#include "toonray/ink/svg.h"
+#include "toonray/io/file.h"
+
 namespace toonray {
 RenderSettings FrameOptions::render_settings() const {
     RenderSettings s = settings;
     s.feature_images = aov_dir.has_value();
+    s.hidden_lines = svg.has_value() && svg_hidden;
     return s;
 }
+
+namespace {
+
+// The strokes of the last ink frame as SVG, written atomically.
+void write_svg(const Renderer& renderer, const RenderSettings& settings, const FrameOptions& options) {
+    ink::SvgSettings svg;
+    svg.width = settings.width;
+    svg.height = settings.height;
+    svg.thickness = ink::stroke_thickness(settings.lines.width, settings.height);
+    svg.colour = settings.lines.colour;
+    svg.hidden = options.svg_hidden;
+    const std::string text = ink::svg_text(renderer.ink_lines().strokes, svg);
+    write_file_atomic(*options.svg, std::span(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()));
+}
+
+}  // namespace
 
 CameraSpec choose_camera(const Scene& scene, const FrameOptions& options) {
     if (options.camera) return *options.camera;
@@ -44,6 +65,7 @@ void FrameRenderer::render(const Scene& scene, const CameraSpec& camera, const s
     const RenderSettings settings = options.render_settings();
     // Validate the camera before any work so a bad one fails with nothing written.
     validate_camera(camera);
+    if (options.svg && settings.edges != EdgeMode::Ink) throw Error("an SVG drawing needs the ink line mode");
     const TriangleAccel& accel = accel_.update(scene, options.bvh);
     const TextureSet* textures = settings.shading.textures ? &textures_.load(scene, warnings) : nullptr;
     const ImageRgb8& image = renderer_.render(scene, accel, camera, settings, textures);
@@ -56,6 +78,7 @@ void FrameRenderer::render(const Scene& scene, const CameraSpec& camera, const s
             std::visit([&](auto member) { write_png(path, aovs.*member, options.png); }, feature.image);
         }
     }
+    if (options.svg) write_svg(renderer_, settings, options);
     write_png(output, image, options.png);
 }
 

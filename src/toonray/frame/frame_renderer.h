@@ -20,9 +20,13 @@
 namespace toonray {
 
 struct FrameOptions {
-    RenderSettings settings;  ///< settings.feature_images is set from aov_dir
+    RenderSettings settings;  ///< settings.feature_images is set from aov_dir, hidden_lines from svg
     std::optional<CameraSpec> camera;              ///< overrides the scene's camera block
     std::optional<std::filesystem::path> aov_dir;  ///< write the feature images here
+    /// Ink lines only: also write the strokes as SVG here (ink/svg.h), with hidden lines in a
+    /// layer of their own when svg_hidden.
+    std::optional<std::filesystem::path> svg;
+    bool svg_hidden = false;
     Bvh::Config bvh;
     PngOptions png;
 
@@ -46,8 +50,9 @@ std::filesystem::path aov_path(const std::filesystem::path& dir, const std::file
 class FrameRenderer {
 public:
     /// Renders `scene` seen by `camera` to `output` (and, with options.aov_dir, its feature
-    /// images, created if missing). Throws Error for a bad camera (before anything is written)
-    /// or a failed write; texture problems are appended to `warnings`.
+    /// images, created if missing; with options.svg, the ink strokes). Throws Error for a bad
+    /// camera or an SVG asked of a line mode other than ink (before anything is written) or a
+    /// failed write; texture problems are appended to `warnings`.
     void render(const Scene& scene, const CameraSpec& camera, const std::filesystem::path& output,
                 const FrameOptions& options, Warnings& warnings);
 

@@ -3,10 +3,8 @@
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <cstdint>
 #include <iterator>
 
-#include "toonray/io/file.h"
 
 namespace toonray::ink {
 
@@ -64,11 +62,6 @@ std::string svg_text(std::span<const Stroke> strokes, const SvgSettings& setting
     }
     out += "</svg>\n";
     return out;
-}
-
-void write_svg(const std::filesystem::path& path, std::span<const Stroke> strokes, const SvgSettings& settings) {
-    const std::string text = svg_text(strokes, settings);
-    write_file_atomic(path, std::span(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()));
 }
 
 }  // namespace toonray::ink

@@ -1,7 +1,7 @@
 #pragma once
-/// Strokes as an SVG 1.1 drawing, for plotters and vector editors.
+/// Strokes as an SVG 1.1 drawing, for plotters and vector editors. Writing the file is the
+/// frame layer's (frame/frame_renderer.h): ink, like render, does no file I/O.
 
-#include <filesystem>
 #include <span>
 #include <string>
 
@@ -24,8 +24,5 @@ struct SvgSettings {
 /// stroke a `<path>` in pixel units with round caps and joins; with hidden lines, a
 /// `<g id="hidden">` with `hidden-...` subgroups after it. Coordinates have three decimals.
 [[nodiscard]] std::string svg_text(std::span<const Stroke> strokes, const SvgSettings& settings);
-
-/// Writes svg_text atomically (io/file.h). Throws Error when the file cannot be written.
-void write_svg(const std::filesystem::path& path, std::span<const Stroke> strokes, const SvgSettings& settings);
 
 }  // namespace toonray::ink

@@ -23,9 +23,8 @@ Rgb8 id_colour(std::uint32_t id) {
             static_cast<std::uint8_t>(64 + ((h >> 16) & 127))};
 }
 
-// Depth, normal and id images at pixel resolution from the first sample of each pixel, and the
-// line seeds of each type filtered down.
-void robust_feature_images(const GBuffer& g, const Image<std::uint8_t>& seeds, Aovs& aovs, int threads) {
+// Depth, normal and id images at pixel resolution from the first sample of each pixel.
+void gbuffer_feature_images(const GBuffer& g, Aovs& aovs) {
     const int sub = g.sub;
     const int w = g.view_depth.width() / sub, h = g.view_depth.height() / sub;
     float z_max = 0.0f;
@@ -46,14 +45,49 @@ void robust_feature_images(const GBuffer& g, const Image<std::uint8_t>& seeds, A
             aovs.object_id(x, y) = id_colour(g.object(fx, fy));
             aovs.material_id(x, y) = id_colour(g.material(fx, fy));
         }
-    resolve_seed_type(seeds, kLineSilhouette, sub, aovs.lines_silhouette, threads);
-    resolve_seed_type(seeds, kLineCrease, sub, aovs.lines_crease, threads);
-    resolve_seed_type(seeds, kLineDepth, sub, aovs.lines_depth, threads);
-    resolve_seed_type(seeds, kLineObject, sub, aovs.lines_object, threads);
-    resolve_seed_type(seeds, kLineMaterial, sub, aovs.lines_material, threads);
+}
+
+// gbuffer_feature_images, and the line seeds of each type filtered down.
+void robust_feature_images(const GBuffer& g, const Image<std::uint8_t>& seeds, Aovs& aovs, int threads) {
+    gbuffer_feature_images(g, aovs);
+    resolve_seed_type(seeds, kLineSilhouette, g.sub, aovs.lines_silhouette, threads);
+    resolve_seed_type(seeds, kLineCrease, g.sub, aovs.lines_crease, threads);
+    resolve_seed_type(seeds, kLineDepth, g.sub, aovs.lines_depth, threads);
+    resolve_seed_type(seeds, kLineObject, g.sub, aovs.lines_object, threads);
+    resolve_seed_type(seeds, kLineMaterial, g.sub, aovs.lines_material, threads);
+}
+
+// The mean colour of each pixel's sub x sub samples, as bytes.
+void average_samples(const Image<Vec3f>& fine, int sub, ImageRgb8& out, int threads) {
+    const int w = fine.width() / sub, h = fine.height() / sub;
+    out.reshape(w, h);
+    const float inv_n = 1.0f / static_cast<float>(sub * sub);
+    parallel_for(h, 8, threads, [&](int y0, int y1) {
+        for (int y = y0; y < y1; ++y)
+            for (int x = 0; x < w; ++x) {
+                Vec3f sum(0.0f);
+                for (int j = 0; j < sub; ++j)
+                    for (int i = 0; i < sub; ++i) sum += fine(x * sub + i, y * sub + j);
+                out(x, y) = {to_byte(sum.x * inv_n), to_byte(sum.y * inv_n), to_byte(sum.z * inv_n)};
+            }
+    });
 }
 
 }  // namespace
+
+ink::InkSettings ink_settings(const RenderSettings& settings) {
+    ink::InkSettings s;
+    const unsigned types = settings.lines.types;
+    s.edges.silhouettes = (types & kLineSilhouette) != 0;
+    s.edges.borders = (types & kLineSilhouette) != 0;
+    s.edges.creases = (types & kLineCrease) != 0;
+    s.edges.materials = (types & kLineMaterial) != 0;
+    s.edges.intersections = (types & kLineObject) != 0;
+    s.edges.crease_angle = settings.lines.crease_angle;
+    s.width = settings.lines.width;
+    s.chain.hidden = settings.hidden_lines;
+    return s;
+}
 
 Vec3f default_light(const Scene& scene, const ViewPlane& view) {
     BBox b = scene.bounds();
@@ -69,19 +103,19 @@ int samples_per_side(int samples) {
 
 std::span<const FeatureImage> feature_images() {
     static const FeatureImage kImages[] = {
-        {"depth", true, true, &Aovs::depth},
-        {"normal", true, true, &Aovs::normal},
-        {"edges_depth", true, false, &Aovs::edges_depth},
-        {"edges_normal", true, false, &Aovs::edges_normal},
-        {"edges", true, true, &Aovs::edges},
-        {"cel", true, true, &Aovs::cel},
-        {"lines_silhouette", false, true, &Aovs::lines_silhouette},
-        {"lines_crease", false, true, &Aovs::lines_crease},
-        {"lines_depth", false, true, &Aovs::lines_depth},
-        {"lines_object", false, true, &Aovs::lines_object},
-        {"lines_material", false, true, &Aovs::lines_material},
-        {"object_id", false, true, &Aovs::object_id},
-        {"material_id", false, true, &Aovs::material_id},
+        {"depth", true, true, true, &Aovs::depth},
+        {"normal", true, true, true, &Aovs::normal},
+        {"edges_depth", true, false, false, &Aovs::edges_depth},
+        {"edges_normal", true, false, false, &Aovs::edges_normal},
+        {"edges", true, true, true, &Aovs::edges},
+        {"cel", true, true, true, &Aovs::cel},
+        {"lines_silhouette", false, true, false, &Aovs::lines_silhouette},
+        {"lines_crease", false, true, false, &Aovs::lines_crease},
+        {"lines_depth", false, true, false, &Aovs::lines_depth},
+        {"lines_object", false, true, false, &Aovs::lines_object},
+        {"lines_material", false, true, false, &Aovs::lines_material},
+        {"object_id", false, true, true, &Aovs::object_id},
+        {"material_id", false, true, true, &Aovs::material_id},
     };
     return kImages;
 }
@@ -115,6 +149,13 @@ std::uint64_t frame_buffer_bytes(const RenderSettings& settings) {
     }
     const std::uint64_t samples = static_cast<std::uint64_t>(std::max(settings.samples, 1));
     const int sub = samples_per_side(settings.samples);
+    if (settings.edges == EdgeMode::Ink) {
+        // The G-buffer, the line coverage (a float a pixel) and the final image. The edges,
+        // pieces and strokes grow with the scene, not the image: they are not counted here.
+        const std::uint64_t per_pixel =
+            sizeof(float) + final_image + (settings.feature_images ? feature_bytes_per_pixel(EdgeMode::Ink) : 0);
+        return mul_saturated(pixels, add_saturated(mul_saturated(gbuffer, samples), per_pixel));
+    }
     const float thickness = line_thickness(settings.lines.width, settings.height, sub);
     const std::uint64_t per_sample =
         gbuffer + 1 /* line seed */ + (line_distance_band(thickness) > kMaxDistanceBand ? sizeof(float) : 0);
@@ -222,6 +263,9 @@ const ImageRgb8& Renderer::render(const Scene& scene, const TriangleAccel& accel
     if (settings.edges == EdgeMode::Classic) {
         trace(scene, accel, view, settings, 1, textures);
         render_classic(settings);
+    } else if (settings.edges == EdgeMode::Ink) {
+        trace(scene, accel, view, settings, samples_per_side(settings.samples), textures);
+        render_ink(scene, accel, camera, settings);
     } else {
         trace(scene, accel, view, settings, samples_per_side(settings.samples), textures);
         render_robust(settings);
@@ -250,6 +294,21 @@ void Renderer::render_robust(const RenderSettings& settings) {
     resolve_lines_from_seeds(g.colour, seeds_, thickness, g.sub, settings.lines.colour, final_,
                              features ? &aovs_.cel : nullptr, features ? &aovs_.edges : nullptr, threads);
     if (features) robust_feature_images(g, seeds_, aovs_, threads);
+}
+
+void Renderer::render_ink(const Scene& scene, const TriangleAccel& accel, const CameraSpec& camera,
+                          const RenderSettings& settings) {
+    const int threads = settings.threads;
+    const GBuffer& g = gbuffer_;
+    average_samples(g.colour, g.sub, final_, threads);
+    const bool features = settings.feature_images;
+    if (features) aovs_.cel = final_;
+    ink::draw_ink_lines(scene, accel, camera, settings.width, settings.height, ink_settings(settings), threads, ink_);
+    ink::composite_lines(ink_.coverage, settings.lines.colour, final_);
+    if (features) {
+        ink::coverage_to_gray(ink_.coverage, aovs_.edges);
+        gbuffer_feature_images(g, aovs_);
+    }
 }
 
 }  // namespace toonray

@@ -9,6 +9,7 @@
 
 #include "toonray/accel/triangle_accel.h"
 #include "toonray/core/image.h"
+#include "toonray/ink/ink.h"
 #include "toonray/render/robust.h"
 #include "toonray/render/shading.h"
 #include "toonray/render/trace.h"
@@ -20,6 +21,9 @@ namespace toonray {
 enum class EdgeMode {
     Robust,   ///< the default: supersampled, plane-aware, resolution-independent lines
     Classic,  ///< the seed's pipeline, exactly: Sobel on 8-bit depth and normal maps
+    /// Lines found on the geometry (ink/ink.h): feature edges with ray-traced visibility,
+    /// chained into strokes and drawn with exact coverage over the cel colours; also as SVG.
+    Ink,
 };
 
 struct RenderSettings {
@@ -32,11 +36,14 @@ struct RenderSettings {
     EdgeMode edges = EdgeMode::Robust;
     float depth_threshold = 8.0f;   ///< classic: Sobel magnitude on the 8-bit depth map
     float normal_threshold = 4.0f;  ///< classic: Sobel magnitude on the 8-bit normal map
-    RobustLineSettings lines;       ///< robust: line types, thresholds, width, colour
-    int samples = 4;                ///< robust: samples per pixel on a regular grid (1, 4, 9 or 16)
+    RobustLineSettings lines;       ///< robust and ink: line types, crease angle, width, colour
+    int samples = 4;                ///< robust and ink: samples per pixel on a regular grid (1, 4, 9 or 16)
     int threads = 0;                ///< 0 = all hardware threads
     /// Also compute the feature images (Renderer::aovs). The final image is the same either way.
     bool feature_images = false;
+    /// Ink: also chain the hidden lines into strokes (Renderer::ink_lines, for SVG), with the
+    /// number of surfaces hiding them. They are not drawn: the final image is the same.
+    bool hidden_lines = false;
 };
 
 /// Sub-samples per pixel side for a sample count: 1, 4, 9, 16 -> 1, 2, 3, 4. Throws Error
@@ -63,10 +70,10 @@ struct Aovs {
     ImageRgb8 normal;
     ImageGray8 edges_depth;   ///< classic: Sobel lines of the depth map, black on white
     ImageGray8 edges_normal;  ///< classic: Sobel lines of the normal map
-    ImageGray8 edges;         ///< all lines: classic merged before blur; robust coverage
+    ImageGray8 edges;         ///< all lines: classic merged before blur; robust and ink coverage
     ImageRgb8 cel;            ///< colour without lines
     ImageGray8 lines_silhouette, lines_crease, lines_depth, lines_object, lines_material;  ///< robust
-    ImageRgb8 object_id, material_id;  ///< robust: ids in false colour
+    ImageRgb8 object_id, material_id;  ///< robust and ink: ids in false colour
 };
 
 /// One feature image of Aovs: its name, the line modes that fill it, and which member it is.
@@ -74,15 +81,19 @@ struct FeatureImage {
     std::string_view name;
     bool classic;  ///< filled in EdgeMode::Classic
     bool robust;   ///< filled in EdgeMode::Robust
+    bool ink;      ///< filled in EdgeMode::Ink
     std::variant<ImageGray8 Aovs::*, ImageRgb8 Aovs::*> image;
 
-    [[nodiscard]] bool in(EdgeMode mode) const { return mode == EdgeMode::Classic ? classic : robust; }
+    [[nodiscard]] bool in(EdgeMode mode) const {
+        return mode == EdgeMode::Classic ? classic : (mode == EdgeMode::Robust ? robust : ink);
+    }
 };
 
 /// Every feature image, in the order they are listed and written. Classic: depth, normal,
 /// edges_depth, edges_normal, edges (merged, before blur), cel. Robust: depth, normal, edges
 /// (line coverage), cel, lines_silhouette, lines_crease, lines_depth, lines_object,
-/// lines_material, object_id, material_id.
+/// lines_material, object_id, material_id. Ink: depth, normal, edges (line coverage), cel,
+/// object_id, material_id.
 std::span<const FeatureImage> feature_images();
 
 /// Bytes of the buffers Renderer keeps for a frame with `settings`: the G-buffer at the mode's
@@ -91,6 +102,12 @@ std::span<const FeatureImage> feature_images();
 /// asks for them. Per-thread scratch rows and tiles are not counted. Saturates at UINT64_MAX;
 /// throws Error for a robust sample count that samples_per_side rejects.
 [[nodiscard]] std::uint64_t frame_buffer_bytes(const RenderSettings& settings);
+
+/// The ink lines' settings from a frame's: crease angle and width from `lines`, and its types
+/// mapped to the ink's: silhouette -> silhouettes and borders, crease -> creases, material ->
+/// material boundaries, object -> intersection lines (depth lines are a pixel notion; the
+/// geometry's silhouettes are drawn instead).
+[[nodiscard]] ink::InkSettings ink_settings(const RenderSettings& settings);
 
 /// Sizes the G-buffer for a frame of width x height pixels with sub x sub samples each, for
 /// `mode`'s buffers. The contents are left unspecified until shade_tile has covered every sample.
@@ -119,18 +136,23 @@ public:
     [[nodiscard]] Vec3f light() const { return light_; }
     /// Robust mode: the line seeds of the last frame on the fine grid (LineType bits).
     [[nodiscard]] const Image<std::uint8_t>& line_seeds() const { return seeds_; }
+    /// Ink mode: the last frame's feature edges, pieces, strokes (for SVG) and line coverage.
+    [[nodiscard]] const ink::InkLines& ink_lines() const { return ink_; }
 
 private:
     void trace(const Scene& scene, const TriangleAccel& accel, const ViewPlane& view,
                const RenderSettings& settings, int sub, const TextureSet* textures);
     void render_classic(const RenderSettings& settings);
     void render_robust(const RenderSettings& settings);
+    void render_ink(const Scene& scene, const TriangleAccel& accel, const CameraSpec& camera,
+                    const RenderSettings& settings);
 
     GBuffer gbuffer_;
     Aovs aovs_;  ///< classic mode draws its lines from depth, normal and edges* here
     bool feature_images_ = false;
     ImageRgb8 final_;
     Image<std::uint8_t> seeds_;
+    ink::InkLines ink_;
     Vec3f light_;
     std::vector<Light> lights_;
 };
