@@ -70,7 +70,7 @@ TEST(Visibility, OccluderCutsALineWhereItsEdgesProject) {
 // every triangle, not the accelerator) wherever the true state does not change within 1 px:
 // a piece's ends are within 1/16 px of a change point, but an occluder narrower than the
 // sampling step (a triangle seen edge-on) can hide a line for less than a pixel unnoticed.
-TEST(Visibility, PiecesAgreeWithBruteForceRaysOnRandomScenes) {
+void check_against_brute_force(int max_invisibility) {
     for (unsigned seed : {1u, 2u, 3u}) {
         Scene s = test_support::random_scene(150, seed);
         test_support::add_sphere(s, Vec3f(0.1f, -0.2f, 0.3f), 0.45f, 10, 20, 1);
@@ -78,6 +78,7 @@ TEST(Visibility, PiecesAgreeWithBruteForceRaysOnRandomScenes) {
                                                normalize(Vec3f(-0.2f, 1.0f, -0.1f))},
                       320, 240);
         ink::VisibilitySettings settings;
+        settings.max_invisibility = max_invisibility;
         const auto pieces = ink::split_by_visibility(f.segments, f.context(), settings, 1);
         int checked = 0, hidden = 0, deep = 0, near_change = 0;
         for (const auto& p : pieces) {
@@ -121,24 +122,33 @@ TEST(Visibility, PiecesAgreeWithBruteForceRaysOnRandomScenes) {
         // change within 1 px, most of them flickers narrower than the 1 px sampling step.
         EXPECT_LT(near_change, checked / 5);
         EXPECT_GT(hidden, 50);
-        EXPECT_GT(deep, 10);
+        if (max_invisibility > 1) EXPECT_GT(deep, 10);
         EXPECT_GT(checked - hidden, 50);
     }
 }
+
+TEST(Visibility, PiecesAgreeWithBruteForceRaysOnRandomScenes) { check_against_brute_force(255); }
+
+// Telling only hidden from visible, the samples are traced as packets from the eye.
+TEST(Visibility, HiddenOrNotAgreesWithBruteForceRaysOnRandomScenes) { check_against_brute_force(1); }
 
 TEST(Visibility, SameForAnyThreadCount) {
     Scene s = test_support::random_scene(300, 11);
     const Frame f(std::move(s), CameraSpec{Vec3f(2.5f, 1.5f, 3.5f), Vec3f(1.8f, 1.1f, 2.5f),
                                            normalize(Vec3f(-0.2f, 1.0f, -0.1f))},
                   320, 240);
-    const auto one = ink::split_by_visibility(f.segments, f.context(), {}, 1);
-    const auto many = ink::split_by_visibility(f.segments, f.context(), {}, 4);
-    ASSERT_EQ(one.size(), many.size());
-    for (std::size_t i = 0; i < one.size(); ++i) {
-        EXPECT_EQ(one[i].segment, many[i].segment);
-        EXPECT_EQ(one[i].t0, many[i].t0);
-        EXPECT_EQ(one[i].t1, many[i].t1);
-        EXPECT_EQ(one[i].invisibility, many[i].invisibility);
+    for (int max_invisibility : {255, 1}) {
+        ink::VisibilitySettings settings;
+        settings.max_invisibility = max_invisibility;
+        const auto one = ink::split_by_visibility(f.segments, f.context(), settings, 1);
+        const auto many = ink::split_by_visibility(f.segments, f.context(), settings, 4);
+        ASSERT_EQ(one.size(), many.size());
+        for (std::size_t i = 0; i < one.size(); ++i) {
+            EXPECT_EQ(one[i].segment, many[i].segment);
+            EXPECT_EQ(one[i].t0, many[i].t0);
+            EXPECT_EQ(one[i].t1, many[i].t1);
+            EXPECT_EQ(one[i].invisibility, many[i].invisibility);
+        }
     }
 }
 

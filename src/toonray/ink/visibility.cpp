@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 
 #include "toonray/ink/chunks.h"
 
@@ -41,6 +42,10 @@ int count_occluders(const TriangleAccel& accel, const Vec3f& point, const Vec3f&
 }
 
 namespace {
+
+// Samples traced together are laid out in rows of this many: a packet of 4 x 2 rays is then 8
+// consecutive samples.
+constexpr int kPacketWidth = 4;
 
 // The part of one segment inside the view, as a line on the image: A + (B - A) s for s in
 // [s_lo, s_hi], and the map from s back to the segment's parameter.
@@ -94,7 +99,10 @@ std::vector<EdgePiece> split_by_visibility(std::span<const FeatureSegment> segme
     return gather_chunks<EdgePiece>(
         static_cast<int>(segments.size()), 32, threads, [&](int i0, int i1, std::vector<EdgePiece>& out) {
             std::vector<float> cuts;
-            std::vector<int> states;
+            std::vector<int> states, sample_states;
+            std::vector<Vec3f> dirs, points;
+            std::vector<Hit> hits;
+            std::unique_ptr<bool[]> found;
             for (int i = i0; i < i1; ++i) {
                 const FeatureSegment& seg = segments[static_cast<std::size_t>(i)];
                 ClippedSegment c;
@@ -127,13 +135,47 @@ std::vector<EdgePiece> split_by_visibility(std::span<const FeatureSegment> segme
                 const float image_length = std::hypot(c.b.x - c.a.x, c.b.y - c.a.y);
                 const float span = c.s_hi - c.s_lo;
                 const int n = std::max(1, static_cast<int>(std::ceil(image_length * span / settings.step)));
+                auto sample_s = [&](int k) { return c.s_lo + span * (static_cast<float>(k) + 0.5f) / static_cast<float>(n); };
+                sample_states.resize(static_cast<std::size_t>(n));
+                if (settings.max_invisibility <= 1) {
+                    // Only hidden or not: the samples' rays are traced together, from the eye (one
+                    // origin, so a coherent packet) to each point at parameter 1. A first hit before
+                    // 1 - self_epsilon on a triangle that counts means hidden, none means visible;
+                    // a first hit on an ignored triangle or right at the eye is settled from the
+                    // point as above.
+                    const int rows = (n + kPacketWidth - 1) / kPacketWidth;
+                    const std::size_t padded = static_cast<std::size_t>(rows) * kPacketWidth;
+                    dirs.resize(padded);
+                    points.resize(padded);
+                    hits.resize(padded);
+                    found.reset(new bool[padded]);
+                    for (std::size_t k = 0; k < padded; ++k) {
+                        const int sample = std::min(static_cast<int>(k), n - 1);
+                        points[k] = seg.p0 + (seg.p1 - seg.p0) * c.t_of(sample_s(sample));
+                        dirs[k] = points[k] - view.eye();
+                    }
+                    context.accel.intersect_tile(view.eye(), dirs.data(), kPacketWidth, rows, hits.data(), found.get(),
+                                                 1.0f - settings.self_epsilon);
+                    for (int k = 0; k < n; ++k) {
+                        const Hit& hit = hits[static_cast<std::size_t>(k)];
+                        if (!found[k])
+                            sample_states[static_cast<std::size_t>(k)] = 0;
+                        else if (hit.t >= settings.self_epsilon && !std::binary_search(ignored.begin(), ignored.end(), hit.prim))
+                            sample_states[static_cast<std::size_t>(k)] = 1;
+                        else
+                            sample_states[static_cast<std::size_t>(k)] =
+                                count_occluders(context.accel, points[static_cast<std::size_t>(k)], view.eye(), ignored, settings);
+                    }
+                } else {
+                    for (int k = 0; k < n; ++k) sample_states[static_cast<std::size_t>(k)] = state_at(sample_s(k));
+                }
                 cuts.assign(1, c.s_lo);
                 states.clear();
                 int previous = 0;
                 float previous_s = 0;
                 for (int k = 0; k < n; ++k) {
-                    const float s = c.s_lo + span * (static_cast<float>(k) + 0.5f) / static_cast<float>(n);
-                    const int state = state_at(s);
+                    const float s = sample_s(k);
+                    const int state = sample_states[static_cast<std::size_t>(k)];
                     if (k > 0 && state != previous) {
                         float lo = previous_s, hi = s;
                         while ((hi - lo) * image_length > settings.precision) {
