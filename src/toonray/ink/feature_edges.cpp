@@ -319,12 +319,17 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
         std::vector<BBox> boxes(n);
         for (std::size_t t = 0; t < n; ++t)
             for (const Vec3f& p : corners(scene, t)) boxes[t].extend(p);
+        // Each corner's canonical position (equal for equal coordinates, across objects).
+        std::vector<std::array<std::uint32_t, 3>> tri_position(n);
+        for (std::size_t t = 0; t < n; ++t)
+            for (int k = 0; k < 3; ++k) tri_position[t][k] = mesh.vertex_position[mesh.tri_vertices[t][k]];
         auto overlap = [](const BBox& a, const BBox& b) {
             return !(a.lo.x > b.hi.x || a.hi.x < b.lo.x || a.lo.y > b.hi.y || a.hi.y < b.lo.y || a.lo.z > b.hi.z ||
                      a.hi.z < b.lo.z);
         };
         // One BVH query per leaf, with the leaf's box: its triangles are near each other, so
-        // they share most candidates. Each pair is tested once, from its lower triangle.
+        // they share most candidates. Each pair is tested once, from its lower triangle, and
+        // the segments are sorted by pair at the end.
         std::vector<std::uint32_t> leaves;
         for (std::size_t i = 0; i < bvh.nodes.size(); ++i)
             if (bvh.nodes[i].is_leaf()) leaves.push_back(static_cast<std::uint32_t>(i));
@@ -347,7 +352,6 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
                         stack.push_back(node.first + 1);
                     }
                 }
-                std::sort(near.begin(), near.end());
                 for (std::uint32_t i = leaf.first; i < leaf.first + leaf.count; ++i) {
                     const std::uint32_t t = bvh.prim_indices[i];
                     if (!usable(t)) continue;
@@ -356,10 +360,10 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
                     for (std::uint32_t u : near) {
                         if (u <= t || !overlap(boxes[u], box) || !usable(u)) continue;
                         // Triangles sharing a corner position (in any object) touch there: no line.
+                        const auto& pa = tri_position[t];
+                        const auto& pb = tri_position[u];
                         bool shared = false;
-                        for (std::uint32_t va : mesh.tri_vertices[t])
-                            for (std::uint32_t vb : mesh.tri_vertices[u])
-                                shared = shared || mesh.vertex_position[va] == mesh.vertex_position[vb];
+                        for (std::uint32_t a_corner : pa) shared = shared || a_corner == pb[0] || a_corner == pb[1] || a_corner == pb[2];
                         if (shared) continue;
                         const auto b = corners(scene, u);
                         TriangleCrossing c;
