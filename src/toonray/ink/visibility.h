@@ -19,9 +19,10 @@ struct VisibilitySettings {
     /// A ray from a point toward the eye ignores hits closer to the point than this fraction
     /// of the distance to the eye, so that the surface a line lies on does not hide it.
     float self_epsilon = 1e-4f;
-    /// Occluders counted at most: 1 tells only visible (0) from hidden (1), and then segments
-    /// known to be hidden (FeatureSegment::certainly_hidden) are not traced at all; more costs
-    /// a ray query per extra surface on hidden points.
+    /// Occluders counted at most: 1 tells only visible (0) from hidden (1); then segments
+    /// known to be hidden (FeatureSegment::certainly_hidden) are not traced at all, and each
+    /// segment's samples are traced as one packet from the eye. More costs a ray query per
+    /// extra surface on hidden points.
     int max_invisibility = 255;
     /// Segments are clipped to the image grown by this many pixels on each side.
     float margin = 4.0f;
