@@ -122,7 +122,9 @@ void check_against_brute_force(int max_invisibility) {
         // change within 1 px, most of them flickers narrower than the 1 px sampling step.
         EXPECT_LT(near_change, checked / 5);
         EXPECT_GT(hidden, 50);
-        if (max_invisibility > 1) EXPECT_GT(deep, 10);
+        if (max_invisibility > 1) {
+            EXPECT_GT(deep, 10);
+        }
         EXPECT_GT(checked - hidden, 50);
     }
 }
@@ -171,11 +173,15 @@ TEST(Visibility, LinesOnTheFarSideOfClosedSolidsAreHiddenWithoutRays) {
     // Traced, every piece of those segments is hidden.
     const auto traced = ink::split_by_visibility(f.segments, f.context(), {}, 1);
     for (const auto& p : traced)
-        if (f.segments[p.segment].certainly_hidden) EXPECT_GT(p.invisibility, 0) << p.segment;
+        if (f.segments[p.segment].certainly_hidden) {
+            EXPECT_GT(p.invisibility, 0) << p.segment;
+        }
     ink::VisibilitySettings binary;
     binary.max_invisibility = 1;
     for (const auto& p : ink::split_by_visibility(f.segments, f.context(), binary, 1))
-        if (f.segments[p.segment].certainly_hidden) EXPECT_EQ(p.invisibility, 1);
+        if (f.segments[p.segment].certainly_hidden) {
+            EXPECT_EQ(p.invisibility, 1);
+        }
     const Frame g(std::move(open_box), CameraSpec{Vec3f(0.3f, 3.0f, 0.2f), Vec3f(0.3f, 2.0f, 0.2f), Vec3f(0, 0, -1)}, 320,
                   240);
     for (const auto& seg : g.segments) EXPECT_FALSE(seg.certainly_hidden);
