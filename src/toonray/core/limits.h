@@ -2,9 +2,10 @@
 /// Limits on the work and memory an input may ask for (docs/robustness.md).
 ///
 /// toonray reads files downloaded from anywhere. Every reader checks these limits and, instead
-/// of running out of memory or time, throws Error naming the limit and the command-line option
-/// that raises it. The limits are process-wide: the command line sets them once, before any
-/// work starts (set_limits); library callers may pass their own where a function takes them.
+/// of running out of memory or time, throws LimitError (core/error.h) saying which limit and by
+/// how much; the front end says how to raise it. The limits are process-wide: the command line
+/// sets them once, before any work starts (set_limits); library callers may pass their own where
+/// a function takes them.
 
 #include <cstdint>
 #include <string>
@@ -63,18 +64,19 @@ void set_limits(const Limits& limits);
 /// A loaded scene with its BVH: attribute arrays, triangle arrays, and the BVH build.
 [[nodiscard]] std::uint64_t scene_bytes(std::uint64_t vertices, std::uint64_t triangles);
 
-/// Throws Error("WHAT needs about X of memory, more than the limit of Y (--max-memory ...)")
-/// when `bytes` exceeds limits().max_memory. `advice` is appended when not empty.
-void check_memory(std::uint64_t bytes, std::string_view what, std::string_view advice = {});
+/// Throws LimitError(Limit::Memory, "WHAT needs about X of memory, more than the limit of Y")
+/// when `bytes` exceeds limits().max_memory. The third argument is not used: how to need less
+/// memory (fewer frames at once) is the front end's to say, as is how to raise the limit.
+void check_memory(std::uint64_t bytes, std::string_view what, std::string_view = {});
 
 /// "1.5 GiB", "512 MiB", "1234 bytes".
 [[nodiscard]] std::string format_bytes(std::uint64_t bytes);
 
-/// Parses a count for a limit option: "50000000", "50M", "2G" (k, M, G = 10^3, 10^6, 10^9).
-/// Throws Error naming `option` when malformed or zero.
-[[nodiscard]] std::uint64_t parse_count(std::string_view text, std::string_view option);
+/// Parses a count for a limit: "50000000", "50M", "2G" (k, M, G = 10^3, 10^6, 10^9). Throws
+/// Error quoting `text` when malformed or zero.
+[[nodiscard]] std::uint64_t parse_count(std::string_view text);
 /// Parses a size in bytes: "4096", "64K", "512M", "8G", "1T" (powers of 1024; a trailing "B"
-/// or "iB" is accepted). Throws Error naming `option` when malformed or zero.
-[[nodiscard]] std::uint64_t parse_bytes(std::string_view text, std::string_view option);
+/// or "iB" is accepted). Throws Error quoting `text` when malformed or zero.
+[[nodiscard]] std::uint64_t parse_bytes(std::string_view text);
 
 }  // namespace toonray
