@@ -2,6 +2,7 @@
 #include <string>
 
 #include "commands.h"
+#include "hints.h"
 #include "toonray/anim/batch.h"
 #include "toonray/anim/progress.h"
 
@@ -40,7 +41,7 @@ struct BatchArgs {
     }
 };
 
-int run_batch(const BatchArgs& args) {
+int run_batch(const BatchArgs& args, const CLI::App& command) {
     BatchOptions options;
     options.name = args.name;
     options.first = args.first;
@@ -54,7 +55,7 @@ int run_batch(const BatchArgs& args) {
     options.resume = args.resume;
     options.fail_fast = args.fail_fast;
     if (!args.shard.empty()) {
-        options.shard = parse_shard(args.shard);
+        options.shard = with_flag("--shard", [&] { return parse_shard(args.shard); });
     } else if (auto slurm = shard_from_environment()) {
         options.shard = *slurm;
     }
@@ -63,6 +64,7 @@ int run_batch(const BatchArgs& args) {
     ProgressReporter progress(static_cast<int>(frames.size()), stderr, args.quiet);
     BatchReport report = toonray::run_batch(options, &progress);
     progress.finish(report);
+    print_frame_limit_hints(report, command);
     if (report.cancelled) return 130;
     return report.failed > 0 ? 1 : 0;
 }
@@ -76,7 +78,7 @@ Subcommand add_batch_command(CLI::App& app, LimitArgs& limit_args) {
     args->add_to(*batch);
     args->render.add_to(*batch);
     limit_args.add_to(*batch);
-    return {batch, [args] { return run_batch(*args); }};
+    return {batch, [args, batch] { return run_batch(*args, *batch); }};
 }
 
 }  // namespace toonray::cli

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "commands.h"
+#include "hints.h"
 #include "toonray/anim/camera_path.h"
 #include "toonray/anim/demo.h"
 #include "toonray/anim/progress.h"
@@ -37,7 +38,7 @@ struct DemoArgs {
     bool full = false;
 };
 
-int run_demo(const DemoArgs& args) {
+int run_demo(const DemoArgs& args, const CLI::App& command) {
     const PianoArgs& piano = args.piano;
     Score score = load_score_or_demo(piano.score);
     CameraPath path = piano.camera_path.empty() ? load_demo_camera_path() : load_camera_path(piano.camera_path);
@@ -57,8 +58,10 @@ int run_demo(const DemoArgs& args) {
     const int frames = checked_frame_count(seconds, piano.fps);
     (void)audio_options(score, piano, options.seconds);
     DemoProgress progress(frames, piano.quiet);
-    DemoReport report = toonray::run_demo(score, path, options, &progress);
+    DemoReport report =
+        with_soundfont_hint(piano.soundfont, [&] { return toonray::run_demo(score, path, options, &progress); });
     progress.finish(report.movie.batch);
+    print_frame_limit_hints(report.movie.batch, command);
     if (report.movie.batch.cancelled) return 130;
     if (!report.completed) return 1;
     print_warnings(report.audio.warnings);
@@ -85,7 +88,7 @@ Subcommand add_demo_command(CLI::App& app, LimitArgs& limit_args) {
     demo_args.add_common(*demo);
     args->render.add_to(*demo);
     limit_args.add_to(*demo);
-    return {demo, [args] { return run_demo(*args); }};
+    return {demo, [args, demo] { return run_demo(*args, *demo); }};
 }
 
 }  // namespace toonray::cli

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "commands.h"
+#include "hints.h"
 #include "toonray/anim/camera_path.h"
 #include "toonray/anim/piano_movie.h"
 #include "toonray/anim/progress.h"
@@ -19,7 +20,8 @@ struct PianoCommandArgs {
     std::string output;
 };
 
-PianoMovieReport run_piano_movie(const Score& score, const PianoArgs& args, PianoMovieOptions options) {
+PianoMovieReport run_piano_movie(const Score& score, const PianoArgs& args, PianoMovieOptions options,
+                                 const CLI::App& command) {
     CameraPath path = args.camera_path.empty() ? load_demo_camera_path() : load_camera_path(args.camera_path);
     options.start = args.start;
     options.fps = args.fps;
@@ -31,12 +33,13 @@ PianoMovieReport run_piano_movie(const Score& score, const PianoArgs& args, Pian
     ProgressReporter progress(frame_count(seconds, options.fps), stderr, args.quiet);
     PianoMovieReport report = render_piano_movie(score, path, options, &progress);
     progress.finish(report.batch);
+    print_frame_limit_hints(report.batch, command);
     if (report.dropped_holes)
         fmt::print(stderr, "toonray: warning: {} roll holes did not fit the hole pool\n", report.dropped_holes);
     return report;
 }
 
-int run_piano(const PianoCommandArgs& args) {
+int run_piano(const PianoCommandArgs& args, const CLI::App& command) {
     const PianoArgs& piano = args.piano;
     if (args.output.empty() == piano.export_obj.empty())
         throw Error("piano: give exactly one of --output DIR (render PNG frames) or --export-obj DIR");
@@ -49,11 +52,12 @@ int run_piano(const PianoCommandArgs& args) {
     options.render = args.render.resolve();
     std::optional<AudioOptions> audio_opts;  // checked before the frames are rendered
     if (!piano.audio.empty()) audio_opts = audio_options(score, piano, options.seconds);
-    PianoMovieReport report = run_piano_movie(score, piano, options);
+    PianoMovieReport report = run_piano_movie(score, piano, options, command);
     if (report.batch.cancelled) return 130;
     if (report.batch.failed > 0) return 1;
     if (audio_opts) {
-        AudioResult audio = render_audio(score, piano.audio, *audio_opts);
+        AudioResult audio =
+            with_soundfont_hint(piano.soundfont, [&] { return render_audio(score, piano.audio, *audio_opts); });
         print_warnings(audio.warnings);
     }
     return 0;
@@ -79,7 +83,7 @@ Subcommand add_piano_command(CLI::App& app, LimitArgs& limit_args) {
     piano_args.add_common(*piano);
     args->render.add_to(*piano);
     limit_args.add_to(*piano);
-    return {piano, [args] { return run_piano(*args); }};
+    return {piano, [args, piano] { return run_piano(*args, *piano); }};
 }
 
 }  // namespace toonray::cli

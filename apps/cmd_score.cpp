@@ -32,8 +32,7 @@ Subcommand add_score_command(CLI::App& app, LimitArgs& limit_args) {
         ->check(CLI::ExistingFile);
     convert->add_option("output", args->output, "Score to write")->required();
     limit_args.add_to(*convert);
-    // `convert` is the only score subcommand, and one is required.
-    return {score, [args] { return run_convert(*args); }};
+    return {convert, [args] { return run_convert(*args); }};
 }
 
 }  // namespace toonray::cli

@@ -7,10 +7,25 @@
 #include <fmt/format.h>
 
 #include "commands.h"
+#include "hints.h"
 #include "toonray/core/error.h"
 
+namespace {
+
+using namespace toonray::cli;
+
+/// Runs `command`; a limit it exceeds is reported with the option that raises it.
+int run(const Subcommand& command) {
+    try {
+        return command.run();
+    } catch (const toonray::LimitError& e) {
+        throw toonray::Error(with_limit_hint(e.what(), e.limit(), *command.app));
+    }
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
-    using namespace toonray::cli;
     CLI::App app{"toonray: a toon ray tracer. OBJ/MTL scenes in, cel-shaded and outlined PNG out."};
     app.require_subcommand(1);
     app.set_version_flag("--version", "toonray 0.1.0");
@@ -31,7 +46,7 @@ int main(int argc, char** argv) {
     try {
         limit_args.apply();
         for (const Subcommand& command : commands)
-            if (*command.app) return command.run();
+            if (*command.app) return run(command);
     } catch (const std::exception& e) {
         fmt::print(stderr, "toonray: error: {}\n", e.what());
         return 1;

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <fmt/format.h>
 
+#include "hints.h"
 #include "toonray/anim/piano_movie.h"
 #include "toonray/core/limits.h"
 #include "toonray/core/parse.h"
@@ -91,20 +92,21 @@ FrameOptions RenderArgs::resolve() const {
     ImageSize s = parse_image_size(size, "--size");
     o.settings.width = s.width;
     o.settings.height = s.height;
-    for (const std::string& l : lights) o.settings.shading.lights.push_back(parse_light(l));
+    for (const std::string& l : lights)
+        o.settings.shading.lights.push_back(with_flag("--light", [&] { return parse_light(l); }));
     if (!lights_file.empty()) {
         auto from_file = load_lights(lights_file);
         o.settings.shading.lights.insert(o.settings.shading.lights.end(), from_file.begin(), from_file.end());
     }
-    if (!ramp.empty()) o.settings.shading.ramp = parse_ramp(ramp);
+    if (!ramp.empty()) o.settings.shading.ramp = with_flag("--ramp", [&] { return parse_ramp(ramp); });
     o.settings.shading.shadows = shadows;
     o.settings.shading.specular = specular;
     o.settings.shading.rim = rim;
     o.settings.shading.textures = !no_textures;
-    if (!camera.empty()) o.camera = parse_camera_spec(camera);
+    if (!camera.empty()) o.camera = with_flag("--camera", [&] { return parse_camera_spec(camera); });
     o.settings.background = parse_colour(background, "--background");
     o.settings.edges = edges == "classic" ? EdgeMode::Classic : (edges == "ink" ? EdgeMode::Ink : EdgeMode::Robust);
-    o.settings.lines.types = parse_line_types(lines);
+    o.settings.lines.types = with_flag("--lines", [&] { return parse_line_types(lines); });
     o.settings.lines.crease_angle = crease_angle;
     o.settings.lines.depth_threshold = depth_step;
     o.settings.lines.width = line_width;
@@ -142,11 +144,12 @@ void LimitArgs::add_to(CLI::App& app) {
 
 void LimitArgs::apply() const {
     Limits l = limits();
-    if (!triangles.empty()) l.max_triangles = parse_count(triangles, "--max-triangles");
-    if (!vertices.empty()) l.max_vertices = parse_count(vertices, "--max-vertices");
-    if (!pixels.empty()) l.max_image_pixels = parse_count(pixels, "--max-image-pixels");
-    if (!memory.empty()) l.max_memory = parse_bytes(memory, "--max-memory");
-    if (!input_size.empty()) l.max_input_bytes = parse_bytes(input_size, "--max-input-size");
+    if (!triangles.empty()) l.max_triangles = with_flag("--max-triangles", [&] { return parse_count(triangles); });
+    if (!vertices.empty()) l.max_vertices = with_flag("--max-vertices", [&] { return parse_count(vertices); });
+    if (!pixels.empty()) l.max_image_pixels = with_flag("--max-image-pixels", [&] { return parse_count(pixels); });
+    if (!memory.empty()) l.max_memory = with_flag("--max-memory", [&] { return parse_bytes(memory); });
+    if (!input_size.empty())
+        l.max_input_bytes = with_flag("--max-input-size", [&] { return parse_bytes(input_size); });
     set_limits(l);
 }
 
@@ -203,8 +206,13 @@ AudioOptions audio_options(const Score& score, const PianoArgs& args, std::optio
     // lasts for days must fail here, not in an allocation.
     const double length = seconds ? *seconds : std::max(score.end_time, score.duration()) - args.start + 5.0;
     const double bytes = std::max(0.0, length) * audio.sample_rate * 2 * 2 * 2;
-    check_memory(bytes < 1.8e19 ? static_cast<std::uint64_t>(bytes) : UINT64_MAX,
-                 fmt::format("the soundtrack ({:.0f} s)", length));
+    try {
+        check_memory(bytes < 1.8e19 ? static_cast<std::uint64_t>(bytes) : UINT64_MAX,
+                     fmt::format("the soundtrack ({:.0f} s)", length));
+    } catch (const LimitError& e) {
+        // Fewer frames at once (--jobs) leave the soundtrack as large: only the limit helps.
+        throw Error(fmt::format("{} ({})", e.what(), raise_hint(e.limit())));
+    }
     return audio;
 }
 

@@ -67,13 +67,13 @@ std::vector<BadInput> catalogue() {
          "distance sets the field of view, 1 gives 90 degrees)"},
         // --- limits ---
         {"TooManyTriangles", kRender + "degenerate.obj" + kTo + " --max-triangles 3",
-         "{data}/degenerate.obj:9: more than 3 triangles (the limit)"},
+         "{data}/degenerate.obj:9: more than 3 triangles (the limit); --max-triangles raises it"},
         {"TooManyVertices", kRender + "degenerate.obj" + kTo + " --max-vertices 4",
-         "{data}/degenerate.obj:6: more than 4 vertices ('v') (the limit)"},
+         "{data}/degenerate.obj:6: more than 4 vertices ('v') (the limit); --max-vertices raises it"},
         {"InputTooLarge", kRender + "degenerate.obj" + kTo + " --max-input-size 100",
          "{data}/degenerate.obj: 204 bytes, more than the input size limit of 100 bytes (--max-input-size raises it)"},
         {"ImageTooLarge", kRender + "degenerate.obj -o {out}/frame.png --size 20000x20000",
-         "image size 20000x20000: 400000000 pixels, more than the limit of 67108864"},
+         "image size 20000x20000: 400000000 pixels, more than the limit of 67108864 (--max-image-pixels raises it)"},
         {"FrameBuffersOverMemory", kRender + "degenerate.obj -o {out}/frame.png --size 4096x4096 --max-memory 64M",
          "a 4096x4096 frame needs about 3.0 GiB of memory, more than the limit of 64 MiB (--max-memory raises it)"},
         {"BadLimitValue", kRender + "degenerate.obj" + kTo + " --max-triangles lots",
@@ -122,7 +122,7 @@ std::vector<BadInput> catalogue() {
          "frame range 0 2000000000: 2000000001 frames is more than the limit of 10000000"},
         {"TooManyJobsForMemory", "batch keys 1 4 --input {data} --output {out} --size 1024x1024 --jobs 4 --max-memory 600M",
          "4 frames at once (a 1024x1024 frame each) needs about 773 MiB of memory, more than the limit of 600 MiB "
-         "(--max-memory raises it); render fewer frames at once"},
+         "(--max-memory raises it, or render fewer frames at once with --jobs)"},
     };
 }
 

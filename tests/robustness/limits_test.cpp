@@ -78,21 +78,21 @@ Scene parse_with(std::string_view text, const ObjOptions& o) {
 }  // namespace
 
 TEST(LimitValues, CountsAndSizesParseWithSuffixes) {
-    EXPECT_EQ(parse_count("50000000", "--max-triangles"), 50'000'000u);
-    EXPECT_EQ(parse_count("50M", "--max-triangles"), 50'000'000u);
-    EXPECT_EQ(parse_count("2.5k", "--max-triangles"), 2500u);
-    EXPECT_EQ(parse_count("1G", "--max-triangles"), 1'000'000'000u);
-    EXPECT_EQ(parse_bytes("512M", "--max-memory"), 512 * kMiB);
-    EXPECT_EQ(parse_bytes("8GiB", "--max-memory"), 8 * kGiB);
-    EXPECT_EQ(parse_bytes("64KB", "--max-memory"), 64 * kKiB);
-    EXPECT_EQ(parse_bytes("100", "--max-memory"), 100u);
-    EXPECT_EQ(parse_bytes("1e30", "--max-memory"), UINT64_MAX);
+    EXPECT_EQ(parse_count("50000000"), 50'000'000u);
+    EXPECT_EQ(parse_count("50M"), 50'000'000u);
+    EXPECT_EQ(parse_count("2.5k"), 2500u);
+    EXPECT_EQ(parse_count("1G"), 1'000'000'000u);
+    EXPECT_EQ(parse_bytes("512M"), 512 * kMiB);
+    EXPECT_EQ(parse_bytes("8GiB"), 8 * kGiB);
+    EXPECT_EQ(parse_bytes("64KB"), 64 * kKiB);
+    EXPECT_EQ(parse_bytes("100"), 100u);
+    EXPECT_EQ(parse_bytes("1e30"), UINT64_MAX);
     for (const char* bad : {"", "0", "-5", "nan", "inf", "5X", "5MM", "M", "0.1", "1 M"}) {
-        EXPECT_THROW((void)parse_count(bad, "--max-triangles"), Error) << bad;
-        EXPECT_THROW((void)parse_bytes(bad, "--max-memory"), Error) << bad;
+        EXPECT_THROW((void)parse_count(bad), Error) << bad;
+        EXPECT_THROW((void)parse_bytes(bad), Error) << bad;
     }
-    EXPECT_EQ(error_of([] { (void)parse_bytes("lots", "--max-memory"); }),
-              "--max-memory: expected a positive size such as 512M or 8G, got 'lots'");
+    EXPECT_EQ(error_of([] { (void)parse_bytes("lots"); }),
+              "expected a positive size such as 512M or 8G, got 'lots'");
 }
 
 TEST(LimitValues, DefaultsAreDocumented) {
@@ -121,6 +121,14 @@ TEST(LimitValues, MemoryEstimatesSaturateInsteadOfOverflowing) {
     EXPECT_GT(frame_bytes(hd), 1280u * 720u * 196u);
 }
 
+TEST(LimitValues, MemoryOverTheLimitSaysWhatAndHowMuch) {
+    ScopedLimits l([](Limits& x) { x.max_memory = 64 * kMiB; });
+    check_memory(64 * kMiB, "the scene");
+    EXPECT_EQ(error_of([] { check_memory(3 * kGiB, "the scene"); }),
+              "the scene needs about 3.0 GiB of memory, more than the limit of 64 MiB");
+    EXPECT_EQ(limit_of([] { check_memory(64 * kMiB + 1, "the scene"); }), Limit::Memory);
+}
+
 // --- read_file ---------------------------------------------------------------------------
 
 TEST(ReadFile, RefusesFilesOverTheLimitBeforeReading) {
@@ -129,7 +137,8 @@ TEST(ReadFile, RefusesFilesOverTheLimitBeforeReading) {
     const auto p = (dir / "big.obj").string();
     EXPECT_EQ(read_file(dir / "big.obj", 1000).size(), 1000u);
     EXPECT_EQ(error_of([&] { read_file(dir / "big.obj", 999); }),
-              p + ": 1000 bytes, more than the input size limit of 999 bytes (--max-input-size raises it)");
+              p + ": 1000 bytes, more than the input size limit of 999 bytes");
+    EXPECT_EQ(limit_of([&] { read_file(dir / "big.obj", 999); }), Limit::InputBytes);
 }
 
 TEST(ReadFile, RefusesDirectoriesDevicesAndFifosWithoutBlocking) {
@@ -147,7 +156,7 @@ TEST(ReadFile, RefusesDirectoriesDevicesAndFifosWithoutBlocking) {
 TEST(ReadFile, ReadsProcFilesThatReportSizeZero) {
     std::string status = read_file("/proc/self/status");
     EXPECT_NE(status.find("Name:"), std::string::npos);
-    EXPECT_THROW(read_file("/proc/self/status", 16), Error);
+    EXPECT_EQ(limit_of([] { read_file("/proc/self/status", 16); }), Limit::InputBytes);
 }
 
 // --- OBJ ---------------------------------------------------------------------------------
@@ -295,7 +304,8 @@ TEST(PngLimits, HeaderAnnouncingAHugeImageIsRefusedBeforeAllocating) {
     be32(29, ~crc);
     const std::span bytes(reinterpret_cast<const std::uint8_t*>(png.data()), png.size());
     EXPECT_EQ(error_of([&] { decode_png(bytes, "huge.png"); }),
-              "huge.png: a 100000x100000 PNG has more pixels than the limit of 67108864 (--max-image-pixels raises it)");
+              "huge.png: a 100000x100000 PNG has more pixels than the limit of 67108864");
+    EXPECT_EQ(limit_of([&] { decode_png(bytes, "huge.png"); }), Limit::ImagePixels);
 }
 
 TEST(FrameLimits, PlanChecksPixelsAndMemoryAndFitsJobsToMemory) {
@@ -314,7 +324,8 @@ TEST(FrameLimits, PlanChecksPixelsAndMemoryAndFitsJobsToMemory) {
         const std::uint64_t frame = frame_bytes(o);
         ScopedLimits l([&](Limits& x) { x.max_memory = 2 * frame + frame / 2; });
         EXPECT_EQ(plan_frame_jobs(o, 0, 100).jobs, std::min(2, hardware_threads()));
-        EXPECT_NE(error_of([&] { plan_frame_jobs(o, 4, 100); }).find("render fewer frames at once"), std::string::npos);
+        EXPECT_EQ(error_of([&] { plan_frame_jobs(o, 4, 100); }).rfind("4 frames at once (a 1920x1080 frame each) needs about ", 0), 0u);
+        EXPECT_EQ(limit_of([&] { plan_frame_jobs(o, 4, 100); }), Limit::Memory);
     }
     s.width = 10000;
     s.height = 10000;

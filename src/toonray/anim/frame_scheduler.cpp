@@ -128,8 +128,7 @@ FramePlan plan_frame_jobs(const FrameOptions& options, int requested, std::size_
     const int most = static_cast<int>(std::max<std::size_t>(1, std::min<std::size_t>(frames, 1 << 16)));
     plan.jobs = std::max(1, std::min(wanted, most));
     if (requested > 0) {
-        check_memory(plan.jobs * plan.frame_bytes, fmt::format("{} frames at once ({} each)", plan.jobs, size),
-                     "render fewer frames at once");
+        check_memory(plan.jobs * plan.frame_bytes, fmt::format("{} frames at once ({} each)", plan.jobs, size));
     } else {
         // One per core, as many as fit.
         const std::uint64_t fit = std::max<std::uint64_t>(1, lim.max_memory / std::max<std::uint64_t>(plan.frame_bytes, 1));

@@ -168,8 +168,7 @@ PianoMovieReport render_piano_movie(const Score& score, const CameraPath& camera
         while (plan.jobs > 1 && plan.jobs * (plan.frame_bytes + scene) > limits().max_memory) --plan.jobs;
     check_memory(plan.jobs * (plan.frame_bytes + scene),
                  fmt::format("{} frame{} at once of the piano ({} triangles)", plan.jobs, plan.jobs == 1 ? "" : "s",
-                             piano.triangle_count()),
-                 "render fewer frames at once");
+                             piano.triangle_count()));
     std::vector<int> numbers(static_cast<std::size_t>(frames));
     for (int i = 0; i < frames; ++i) numbers[static_cast<std::size_t>(i)] = i + 1;
     ScheduleOptions schedule;

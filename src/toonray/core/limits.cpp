@@ -20,12 +20,11 @@ Limits& process_limits() {
 }
 
 /// A non-negative number with an optional suffix from `units` (each a power of `base`).
-std::uint64_t parse_scaled(std::string_view text, std::string_view option, double base, bool bytes) {
+std::uint64_t parse_scaled(std::string_view text, double base, bool bytes) {
     const std::string_view original = text;
     auto bad = [&]() -> std::uint64_t {
-        throw Error(fmt::format("{}: expected a positive {} such as {}, got '{}'", option,
-                                bytes ? "size" : "number", bytes ? "512M or 8G" : "50000000 or 50M",
-                                original));
+        throw Error(fmt::format("expected a positive {} such as {}, got '{}'", bytes ? "size" : "number",
+                                bytes ? "512M or 8G" : "50000000 or 50M", original));
     };
     double value = 0;
     auto [p, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
@@ -69,13 +68,11 @@ const Limits& limits() { return process_limits(); }
 
 void set_limits(const Limits& limits) { process_limits() = limits; }
 
-void check_memory(std::uint64_t bytes, std::string_view what, std::string_view advice) {
+void check_memory(std::uint64_t bytes, std::string_view what) {
     const std::uint64_t limit = limits().max_memory;
     if (bytes <= limit) return;
-    throw Error(fmt::format("{} needs about {} of memory, more than the limit of {} (--max-memory "
-                            "raises it){}{}",
-                            what, format_bytes(bytes), format_bytes(limit), advice.empty() ? "" : "; ",
-                            advice));
+    throw LimitError(Limit::Memory, fmt::format("{} needs about {} of memory, more than the limit of {}", what,
+                                                format_bytes(bytes), format_bytes(limit)));
 }
 
 std::string format_bytes(std::uint64_t bytes) {
@@ -90,12 +87,8 @@ std::string format_bytes(std::uint64_t bytes) {
     return v < 10 ? fmt::format("{:.1f} {}", v, units[u]) : fmt::format("{:.0f} {}", v, units[u]);
 }
 
-std::uint64_t parse_count(std::string_view text, std::string_view option) {
-    return parse_scaled(text, option, 1000.0, false);
-}
+std::uint64_t parse_count(std::string_view text) { return parse_scaled(text, 1000.0, false); }
 
-std::uint64_t parse_bytes(std::string_view text, std::string_view option) {
-    return parse_scaled(text, option, 1024.0, true);
-}
+std::uint64_t parse_bytes(std::string_view text) { return parse_scaled(text, 1024.0, true); }
 
 }  // namespace toonray

@@ -2,9 +2,10 @@
 /// Limits on the work and memory an input may ask for (docs/robustness.md).
 ///
 /// toonray reads files downloaded from anywhere. Every reader checks these limits and, instead
-/// of running out of memory or time, throws Error naming the limit and the command-line option
-/// that raises it. The limits are process-wide: the command line sets them once, before any
-/// work starts (set_limits); library callers may pass their own where a function takes them.
+/// of running out of memory or time, throws LimitError (core/error.h) saying which limit and by
+/// how much; the front end says how to raise it. The limits are process-wide: the command line
+/// sets them once, before any work starts (set_limits); library callers may pass their own where
+/// a function takes them.
 
 #include <cstdint>
 #include <string>
@@ -58,18 +59,19 @@ void set_limits(const Limits& limits);
 // scene_bytes), deliberately generously: the buffers a frame keeps plus the temporaries of
 // building it, so that a frame within the estimate does not run out of memory.
 
-/// Throws Error("WHAT needs about X of memory, more than the limit of Y (--max-memory ...)")
-/// when `bytes` exceeds limits().max_memory. `advice` is appended when not empty.
-void check_memory(std::uint64_t bytes, std::string_view what, std::string_view advice = {});
+/// Throws LimitError(Limit::Memory, "WHAT needs about X of memory, more than the limit of Y")
+/// when `bytes` exceeds limits().max_memory. How to need less memory (fewer frames at once) or
+/// raise the limit is the front end's to say.
+void check_memory(std::uint64_t bytes, std::string_view what);
 
 /// "1.5 GiB", "512 MiB", "1234 bytes".
 [[nodiscard]] std::string format_bytes(std::uint64_t bytes);
 
-/// Parses a count for a limit option: "50000000", "50M", "2G" (k, M, G = 10^3, 10^6, 10^9).
-/// Throws Error naming `option` when malformed or zero.
-[[nodiscard]] std::uint64_t parse_count(std::string_view text, std::string_view option);
+/// Parses a count for a limit: "50000000", "50M", "2G" (k, M, G = 10^3, 10^6, 10^9). Throws
+/// Error quoting `text` when malformed or zero.
+[[nodiscard]] std::uint64_t parse_count(std::string_view text);
 /// Parses a size in bytes: "4096", "64K", "512M", "8G", "1T" (powers of 1024; a trailing "B"
-/// or "iB" is accepted). Throws Error naming `option` when malformed or zero.
-[[nodiscard]] std::uint64_t parse_bytes(std::string_view text, std::string_view option);
+/// or "iB" is accepted). Throws Error quoting `text` when malformed or zero.
+[[nodiscard]] std::uint64_t parse_bytes(std::string_view text);
 
 }  // namespace toonray

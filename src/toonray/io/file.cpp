@@ -32,10 +32,10 @@ std::string read_file(const std::filesystem::path& path, std::uint64_t max_bytes
                                 path.string()));
     const auto size = static_cast<std::uint64_t>(st.st_size);
     auto too_large = [&](std::uint64_t bytes) {
-        return Error(fmt::format("{}: {}, more than the input size limit of {} (--max-input-size "
-                                 "raises it)",
-                                 path.string(), bytes == 0 ? "larger" : fmt::format("{} bytes", bytes),
-                                 format_bytes(max_bytes)));
+        return LimitError(Limit::InputBytes,
+                          fmt::format("{}: {}, more than the input size limit of {}", path.string(),
+                                      bytes == 0 ? "larger" : fmt::format("{} bytes", bytes),
+                                      format_bytes(max_bytes)));
     };
     if (size > max_bytes) throw too_large(size);
     auto read_some = [&](char* buffer, std::size_t count) -> std::size_t {

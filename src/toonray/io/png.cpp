@@ -157,9 +157,8 @@ DecodedPng decode_png(std::span<const std::uint8_t> bytes, std::string_view name
     // The header may announce any size up to 2^31 - 1 squared: check before allocating.
     const std::uint64_t pixels = std::uint64_t{img.width} * img.height;
     if (img.width > 0x7FFFFFFFu || img.height > 0x7FFFFFFFu || pixels > limits().max_image_pixels)
-        throw Error(fmt::format("{}: a {}x{} PNG has more pixels than the limit of {} "
-                                "(--max-image-pixels raises it)",
-                                name, img.width, img.height, limits().max_image_pixels));
+        throw LimitError(Limit::ImagePixels, fmt::format("{}: a {}x{} PNG has more pixels than the limit of {}",
+                                                         name, img.width, img.height, limits().max_image_pixels));
     img.format = PNG_FORMAT_RGB;
     DecodedPng result;
     result.width = static_cast<int>(img.width);

@@ -77,8 +77,10 @@ void check_soundfont_file(const std::filesystem::path& path) {
     std::error_code ec;
     auto status = std::filesystem::status(path, ec);
     if (!std::filesystem::exists(status))
-        throw Error(fmt::format("{}: SoundFont not found (pass another with --soundfont, or install "
-                                "the Debian package fluid-soundfont-gm)", path.string()));
+        throw Error(fmt::format("{}: SoundFont not found{}", path.string(),
+                                path == default_soundfont()
+                                    ? " (the default SoundFont, installed by the Debian package fluid-soundfont-gm)"
+                                    : ""));
     if (!std::filesystem::is_regular_file(status))
         throw Error(fmt::format("{}: SoundFont is not a regular file", path.string()));
     std::FILE* f = std::fopen(path.c_str(), "rb");
