@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "toonray/core/parse.h"
+#include "toonray/core/portable_math.h"
 #include "toonray/io/file.h"
 #include "toonray/io/png.h"
 
@@ -186,7 +187,7 @@ namespace {
         if (s.specular && material.ns > 0.0f && (material.ks.x > 0 || material.ks.y > 0 || material.ks.z > 0)) {
             Vec3f half = normalize(to_light - dir);
             float n_dot_h = std::max(0.0f, dot(n, half));
-            if (std::pow(n_dot_h, material.ns) > 0.5f) highlight = 1.0f;  // one hard-edged band
+            if (portable::pow(n_dot_h, material.ns) > 0.5f) highlight = 1.0f;  // one hard-edged band
         }
     }
     // With one unit light this is max(0, l.n): the same band as the seed's int(l.n * 16).
