@@ -4,8 +4,12 @@
 /// x86's results exactly: NaN rules of min/max and comparisons, cvtt's out-of-range value,
 /// blends by the sign bit. SIMDE_FAST_* must therefore stay undefined. Code written against
 /// these intrinsics thus computes the same bits on every CPU.
+///
+/// TOONRAY_SIMD_SIMDE selects SIMDe's portable implementation on x86 too (SIMDE_NO_NATIVE): only
+/// for measuring what the aarch64 path costs (docs/accel.md), in translation units that include
+/// no x86 intrinsics header of their own.
 
-#if defined(__x86_64__) || defined(__i386__)
+#if (defined(__x86_64__) || defined(__i386__)) && !defined(TOONRAY_SIMD_SIMDE)
 #include <smmintrin.h>
 #include <nmmintrin.h>
 #else
@@ -19,6 +23,9 @@
 #define SIMDE_NO_FAST_ROUND_MODE
 #define SIMDE_NO_FAST_ROUND_TIES
 #define SIMDE_NO_FAST_CONVERSION_RANGE
+#if defined(TOONRAY_SIMD_SIMDE)
+#define SIMDE_NO_NATIVE
+#endif
 #define SIMDE_ENABLE_NATIVE_ALIASES
 #include <simde/x86/sse4.2.h>
 #endif
