@@ -40,6 +40,7 @@ aarch64_packages=(
   g++-aarch64-linux-gnu qemu-user
   libfmt-dev:arm64 libtbb-dev:arm64 libdeflate-dev:arm64 libpng-dev:arm64
   libfluidsynth-dev:arm64 libgtest-dev:arm64 libgmock-dev:arm64
+  libtinyobjloader-dev:arm64  # the OBJ loader tests compare with it
 )
 
 case "$profile" in

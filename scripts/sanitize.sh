@@ -17,8 +17,11 @@ cd "$(dirname "$0")/.."
 build=${TOONRAY_ASAN_BUILD_DIR:-build-asan}
 sanitizers="-fsanitize=address,undefined,float-cast-overflow -fno-sanitize-recover=all"
 
+launcher=()
+if command -v ccache >/dev/null; then launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache); fi
+
 echo "sanitize: configuring $build"
-cmake -S . -B "$build" -G Ninja \
+cmake -S . -B "$build" -G Ninja "${launcher[@]}" -DTOONRAY_WARNINGS_AS_ERRORS=ON \
   -DCMAKE_CXX_COMPILER="${CXX:-g++}" \
   -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g" \

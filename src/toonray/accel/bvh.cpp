@@ -1,6 +1,5 @@
 #include "toonray/accel/bvh.h"
 
-#include <smmintrin.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_group.h>
@@ -10,6 +9,8 @@
 #include <atomic>
 #include <limits>
 #include <memory>
+
+#include "toonray/core/simd_sse.h"
 
 namespace toonray {
 namespace {

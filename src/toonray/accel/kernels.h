@@ -1,7 +1,8 @@
 #pragma once
 /// The traversal kernels per instruction set (internal to the accel module): kernels_sse.cpp
-/// (the portable build, SSE4.2) and kernels_avx2.cpp (AVX2, compiled with a target pragma and
-/// chosen at run time when the CPU has it). Both compute bit-identical results.
+/// (the portable build: SSE4.2, or SIMDe off x86), kernels_avx2.cpp and kernels_avx512.cpp (x86
+/// only, with their instruction sets from CMake, chosen at run time when the CPU has them). All
+/// compute bit-identical results.
 
 #include <cstdint>
 

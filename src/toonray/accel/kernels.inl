@@ -1,6 +1,6 @@
 // The traversal kernels (internal to the accel module), written once against the vf8/vm8/vi8
-// types of simd8.inl and compiled three times: kernels_sse.cpp (the portable x86-64-v2 build,
-// 8-wide as pairs of SSE registers), kernels_avx2.cpp and kernels_avx512.cpp (target pragmas,
+// types of simd8.inl and compiled three times: kernels_sse.cpp (the portable build, 8-wide as
+// pairs of SSE registers), kernels_avx2.cpp and kernels_avx512.cpp (ISA options from CMake,
 // chosen at run time when the CPU has them). Included inside an anonymous namespace in
 // `toonray::accel::<isa>`, after simd8.inl, with all headers already included.
 //
@@ -269,6 +269,10 @@ struct RayBoxes {
     // made conservative in the constants: c's rounding error is at most |c| 2^-24, so near
     // planes use c - |c| 2^-21 and far planes c + |c| 2^-21; the far distance is then widened
     // by kBoxSlack as in the plain test. (Infinite or NaN terms give NaN, which never culls.)
+    // This visits other boxes than the SSE kernels' two-rounding test, but both only widen the
+    // exact slab interval (by far less than kBoxSlack), so neither culls a box that holds the
+    // closest hit, and the hit (lowest t, then index, over the FMA-free triangle tests) is the
+    // same: every ISA gives the same pixels (tile_test.cpp, scripts/compare-frames.sh).
     vf8 in8[3], cn8[3], cf8[3];
 #else
     vf8 o8[3], i8[3];

@@ -1,14 +1,18 @@
-// The traversal kernels with AVX2, compiled with a target pragma so that the portable build
-// (-march=x86-64-v2) has them too; TriangleAccel picks them at run time when the CPU supports
-// AVX2. FMA only in the box tests (see kernels.inl); the triangle tests never fuse.
+// The traversal kernels with AVX2, chosen at run time by TriangleAccel when the CPU has AVX2,
+// FMA, BMI1 and BMI2. CMake compiles this file, and only this file, with -mavx2 -mfma -mbmi
+// -mbmi2 -mlzcnt -mpopcnt (see the top-level CMakeLists.txt), so the portable build
+// (-march=x86-64-v2) has these kernels too. FMA only in the box tests (see kernels.inl).
 //
-// Everything is included before the pragma, so inline functions from headers keep the default
-// target (they could otherwise be merged, AVX2 code and all, into other translation units).
-// Every float operation of the triangle tests must round exactly as written, in every build:
-// no fused multiply-adds, which -march=native (TOONRAY_NATIVE) would otherwise let GCC form.
-#pragma GCC optimize("fp-contract=off")
-#include <immintrin.h>
-
+// Why compiling the whole file with these options cannot put AVX instructions into code that
+// other translation units run on CPUs without them: the kernels are in an anonymous namespace
+// (internal linkage), so no other object file can link to them, and the only function this
+// file exports, kernels_avx2(), returns the address of a constant-initialised table (no
+// vector code) and is called only after the CPU check. What remains are inline functions from
+// the headers (std::, Vec3f, watertight.h), which the compiler may emit here as weak symbols
+// that the linker could pick for every translation unit. The CTest test accel_isa_symbols
+// (cmake/check_isa_symbols.cmake) checks with nm that this object defines no weak or global
+// symbol but kernels_avx2() and the table's guard variable; a header change that breaks this
+// fails that test instead of crashing on an older CPU.
 #include <algorithm>
 #include <cstring>
 #include <limits>
@@ -16,12 +20,12 @@
 #include "toonray/accel/kernels.h"
 #include "toonray/accel/watertight.h"
 
-#if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
+#if defined(__x86_64__) || defined(__i386__)
+#include <immintrin.h>
+
 #define TOONRAY_ACCEL_HAVE_AVX2 1
-#pragma GCC push_options
-#pragma GCC target("avx2,bmi,bmi2,lzcnt,popcnt,fma")
 #define TOONRAY_ACCEL_AVX2 1
-#define TOONRAY_ACCEL_FMA 1  // box tests only; fp-contract=off keeps it out of everything else
+#define TOONRAY_ACCEL_FMA 1  // box tests only (see kernels.inl)
 
 namespace toonray::accel {
 namespace avx2 {
@@ -31,8 +35,6 @@ namespace {  // internal linkage: the instruction sets' copies must never be mer
 }  // namespace
 }  // namespace avx2
 }  // namespace toonray::accel
-
-#pragma GCC pop_options
 #endif
 
 namespace toonray::accel {

@@ -1,14 +1,19 @@
 // The traversal kernels compiled for AVX-512 (F, VL, BW, DQ): the same 8-wide code as
 // kernels_avx2.cpp, which the compiler can then write with mask registers and three-input
-// logic. Chosen at run time when the CPU has it. FMA only in the box tests (see kernels.inl).
+// logic. Chosen at run time when the CPU has it. CMake compiles this file, and only this file,
+// with the AVX2 options plus -mavx512f -mavx512vl -mavx512bw -mavx512dq (top-level
+// CMakeLists.txt). FMA only in the box tests (see kernels.inl).
 //
-// Everything is included before the pragma, so inline functions from headers keep the default
-// target (they could otherwise be merged, AVX-512 code and all, into other translation units).
-// Every float operation of the triangle tests must round exactly as written, in every build:
-// no fused multiply-adds, which -march=native (TOONRAY_NATIVE) would otherwise let GCC form.
-#pragma GCC optimize("fp-contract=off")
-#include <immintrin.h>
-
+// Why compiling the whole file with these options cannot put AVX instructions into code that
+// other translation units run on CPUs without them: the kernels are in an anonymous namespace
+// (internal linkage), so no other object file can link to them, and the only function this
+// file exports, kernels_avx512(), returns the address of a constant-initialised table (no
+// vector code) and is called only after the CPU check. What remains are inline functions from
+// the headers (std::, Vec3f, watertight.h), which the compiler may emit here as weak symbols
+// that the linker could pick for every translation unit. The CTest test accel_isa_symbols
+// (cmake/check_isa_symbols.cmake) checks with nm that this object defines no weak or global
+// symbol but kernels_avx512() and the table's guard variable; a header change that breaks this
+// fails that test instead of crashing on an older CPU.
 #include <algorithm>
 #include <cstring>
 #include <limits>
@@ -16,12 +21,12 @@
 #include "toonray/accel/kernels.h"
 #include "toonray/accel/watertight.h"
 
-#if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
+#if defined(__x86_64__) || defined(__i386__)
+#include <immintrin.h>
+
 #define TOONRAY_ACCEL_HAVE_AVX512 1
-#pragma GCC push_options
-#pragma GCC target("avx2,bmi,bmi2,lzcnt,popcnt,avx512f,avx512vl,avx512bw,avx512dq,fma")
 #define TOONRAY_ACCEL_AVX2 1
-#define TOONRAY_ACCEL_FMA 1  // box tests only; fp-contract=off keeps it out of everything else
+#define TOONRAY_ACCEL_FMA 1  // box tests only (see kernels.inl)
 
 namespace toonray::accel {
 namespace avx512 {
@@ -31,8 +36,6 @@ namespace {  // internal linkage: the instruction sets' copies must never be mer
 }  // namespace
 }  // namespace avx512
 }  // namespace toonray::accel
-
-#pragma GCC pop_options
 #endif
 
 namespace toonray::accel {

@@ -1,16 +1,13 @@
-// The traversal kernels for the portable build (x86-64-v2: SSE4.2), 8-wide vectors as pairs of
-// SSE registers.
-// Every float operation of the triangle tests must round exactly as written, in every build:
-// no fused multiply-adds, which -march=native (TOONRAY_NATIVE) would otherwise let GCC form.
-#pragma GCC optimize("fp-contract=off")
-#include <smmintrin.h>
-
+// The traversal kernels for the portable build, 8-wide vectors as pairs of SSE registers: SSE4.2
+// on x86-64 (x86-64-v2), and the same intrinsics through SIMDe on other CPUs (aarch64), where
+// they keep x86's exact results (core/simd_sse.h).
 #include <algorithm>
 #include <cstring>
 #include <limits>
 
 #include "toonray/accel/kernels.h"
 #include "toonray/accel/watertight.h"
+#include "toonray/core/simd_sse.h"
 
 namespace toonray::accel {
 namespace sse {

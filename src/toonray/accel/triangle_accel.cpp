@@ -1,6 +1,5 @@
 // Every float operation of the triangle tests must round exactly as written, in every build:
-// no fused multiply-adds, which -march=native (TOONRAY_NATIVE) would otherwise let GCC form.
-#pragma GCC optimize("fp-contract=off")
+// no fused multiply-adds (the project compiles with -ffp-contract=off).
 #include "toonray/accel/triangle_accel.h"
 
 #include <atomic>

@@ -9,6 +9,7 @@
 
 #include "toonray/core/error.h"
 #include "toonray/core/limits.h"
+#include "toonray/core/portable_math.h"
 #include "toonray/io/file.h"
 
 namespace toonray {
@@ -80,7 +81,7 @@ CameraSpec camera_spec(const CameraPose& pose) {
     const Frame f = make_frame(eye, to_d(pose.target), to_d(pose.up));
     if (!(f.view_length > 0)) throw Error("camera: eye and target are the same point");
     if (!(f.up_sine > kMinUpSine)) throw Error("camera: up is parallel to the view direction");
-    const double distance = 1.0 / std::tan(0.5 * pose.fov * kDegrees);
+    const double distance = 1.0 / portable::tan(0.5 * pose.fov * kDegrees);
     const Vec3d gaze = {eye.x + f.dir.x * distance, eye.y + f.dir.y * distance,
                         eye.z + f.dir.z * distance};
     return {pose.eye, to_f(gaze), to_f(f.up)};

@@ -7,6 +7,7 @@
 #include <numbers>
 #include <tuple>
 
+#include "toonray/core/portable_math.h"
 #include "toonray/ink/chunks.h"
 
 namespace toonray::ink {
@@ -196,7 +197,7 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
     }
     std::sort(sides.begin(), sides.end(),
               [](const Side& a, const Side& b) { return std::tie(a.lo, a.hi, a.tri) < std::tie(b.lo, b.hi, b.tri); });
-    const float cos_crease = std::cos(settings.crease_angle * std::numbers::pi_v<float> / 180.0f);
+    const float cos_crease = portable::cos(settings.crease_angle * std::numbers::pi_v<float> / 180.0f);
     // Shading is smooth across a side shared by two triangles when both have a normal at every
     // corner and the same normals at the side's two ends.
     auto corner_normal = [&](std::uint32_t t, std::uint32_t welded) {

@@ -5,18 +5,20 @@
 #include <numbers>
 #include <tuple>
 
+#include "toonray/core/portable_math.h"
+
 namespace toonray::ink {
 
 namespace {
 
-float distance(const Point2& a, const Point2& b) { return std::hypot(a.x - b.x, a.y - b.y); }
+float distance(const Point2& a, const Point2& b) { return portable::hypot(a.x - b.x, a.y - b.y); }
 
 float distance_to_segment(const Point2& p, const Point2& a, const Point2& b) {
     const float dx = b.x - a.x, dy = b.y - a.y;
     const float len2 = dx * dx + dy * dy;
     float t = len2 > 0.0f ? ((p.x - a.x) * dx + (p.y - a.y) * dy) / len2 : 0.0f;
     t = std::clamp(t, 0.0f, 1.0f);
-    return std::hypot(p.x - (a.x + dx * t), p.y - (a.y + dy * t));
+    return portable::hypot(p.x - (a.x + dx * t), p.y - (a.y + dy * t));
 }
 
 void douglas_peucker(std::span<const Point2> points, std::size_t first, std::size_t last, float tolerance,
@@ -117,7 +119,7 @@ std::vector<Stroke> chain_pieces(std::span<const EdgePiece> pieces, const ChainS
         auto hi = std::upper_bound(ends.begin(), ends.end(), key, [](const EndpointKey& k, const End& e) { return k < e.key; });
         return std::span<const End>(&*lo, static_cast<std::size_t>(hi - lo));
     };
-    const float cos_max_turn = std::cos(settings.max_turn * std::numbers::pi_v<float> / 180.0f);
+    const float cos_max_turn = portable::cos(settings.max_turn * std::numbers::pi_v<float> / 180.0f);
 
     std::vector<bool> used(links.size(), false);
     std::vector<Stroke> strokes;
@@ -139,7 +141,7 @@ std::vector<Stroke> chain_pieces(std::span<const EdgePiece> pieces, const ChainS
                 int candidates = 0;
                 float best_cos = -2.0f;
                 const float hx = tip.x - previous.x, hy = tip.y - previous.y;
-                const float hlen = std::hypot(hx, hy);
+                const float hlen = portable::hypot(hx, hy);
                 std::uint32_t last_link = kNoIndex;
                 for (const End& e : ends_at(key)) {
                     const Link& l = links[e.link];
@@ -148,7 +150,7 @@ std::vector<Stroke> chain_pieces(std::span<const EdgePiece> pieces, const ChainS
                     ++candidates;
                     const Point2 next = e.side == 0 ? l.s1 : l.s0;
                     const float nx = next.x - tip.x, ny = next.y - tip.y;
-                    const float nlen = std::hypot(nx, ny);
+                    const float nlen = portable::hypot(nx, ny);
                     const float c = hlen > 0 && nlen > 0 ? (hx * nx + hy * ny) / (hlen * nlen) : 1.0f;
                     if (c > best_cos) {
                         best_cos = c;

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <memory>
 
+#include "toonray/core/portable_math.h"
 #include "toonray/ink/chunks.h"
 
 namespace toonray::ink {
@@ -132,7 +133,7 @@ std::vector<EdgePiece> split_by_visibility(std::span<const FeatureSegment> segme
                 };
                 // Samples at the middles of n equal steps of at most `step` pixels; a change
                 // between two samples is found by bisection.
-                const float image_length = std::hypot(c.b.x - c.a.x, c.b.y - c.a.y);
+                const float image_length = portable::hypot(c.b.x - c.a.x, c.b.y - c.a.y);
                 const float span = c.s_hi - c.s_lo;
                 const int n = std::max(1, static_cast<int>(std::ceil(image_length * span / settings.step)));
                 auto sample_s = [&](int k) { return c.s_lo + span * (static_cast<float>(k) + 0.5f) / static_cast<float>(n); };

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "toonray/core/error.h"
+#include "toonray/core/portable_math.h"
 
 namespace toonray {
 namespace {
@@ -55,7 +56,7 @@ Frame Frame::along(const Vec3f& origin, const Vec3f& axis) {
 }
 
 Vec3f rotate_about(const Vec3f& v, const Vec3f& axis, float angle) {
-    float c = std::cos(angle), s = std::sin(angle);
+    float c = portable::cos(angle), s = portable::sin(angle);
     return v * c + cross(axis, v) * s + axis * (dot(axis, v) * (1.0f - c));
 }
 
@@ -89,7 +90,7 @@ void append_arc(std::vector<ProfilePoint>& out, float cu, float cv, float radius
     for (int i = 0; i <= segments; ++i) {
         float a = a0 + (a1 - a0) * static_cast<float>(i) / static_cast<float>(segments);
         bool end = i == 0 || i == segments;
-        out.push_back({cu + radius * std::cos(a), cv + radius * std::sin(a), !end || smooth_ends});
+        out.push_back({cu + radius * portable::cos(a), cv + radius * portable::sin(a), !end || smooth_ends});
     }
 }
 
@@ -325,8 +326,8 @@ void MeshBuilder::lathe(std::span<const ProfilePoint> profile, int segments, boo
     std::vector<float> cs(segments), sn(segments);
     for (int k = 0; k < segments; ++k) {
         float a = 2.0f * kPi * static_cast<float>(k) / static_cast<float>(segments);
-        cs[k] = std::cos(a);
-        sn[k] = std::sin(a);
+        cs[k] = portable::cos(a);
+        sn[k] = portable::sin(a);
     }
     auto local = [&](float r, float h, int k) { return Vec3f(r * cs[k], h, -r * sn[k]); };
     auto ldir = [&](Vec2f m, int k) { return Vec3f(m.x * cs[k], m.y, -m.x * sn[k]); };

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <fmt/format.h>
 
+#include "toonray/core/portable_math.h"
+
 namespace toonray {
 namespace {
 
@@ -107,7 +109,7 @@ std::array<float, 2> PianoPlayback::pedal_angles(double t) const {
     const double activity = smoothstep((t - t0) / ease) * (1.0 - smoothstep((t - end_) / ease));
     if (activity <= 0.0) return {0.0f, 0.0f};
     const double phase = 2.0 * 3.14159265358979 * (t - t0) / settings_.pedal_cycle;
-    const double left = 0.5 - 0.5 * std::cos(phase), right = 1.0 - left;
+    const double left = 0.5 - 0.5 * portable::cos(phase), right = 1.0 - left;
     const double s = settings_.pedal_stroke * activity;
     return {static_cast<float>(s * left), static_cast<float>(s * right)};
 }

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "toonray/core/error.h"
+#include "toonray/core/portable_math.h"
 #include "toonray/piano/mesh_builder.h"
 
 namespace toonray {
@@ -153,7 +154,7 @@ std::vector<ProfilePoint> leg_profile() {
     const int vase_steps = 28;
     for (int i = 0; i <= vase_steps; ++i) {
         float s = static_cast<float>(i) / vase_steps;
-        float bump = std::pow(std::max(0.0f, std::sin(kPi * std::pow(s, 0.62f))), 1.4f);
+        float bump = portable::pow(std::max(0.0f, portable::sin(kPi * portable::pow(s, 0.62f))), 1.4f);
         float r = 0.0175f + 0.002f * (1.0f - s) + 0.0215f * bump;
         p.push_back({r, 0.150f + 0.250f * s, i > 0 && i < vase_steps});
     }
@@ -752,7 +753,7 @@ CameraSpec look_at(const Vec3f& eye, const Vec3f& target, float horizontal_fov_d
     if (length(right) < 1e-6f) right = Vec3f(1.0f, 0.0f, 0.0f);
     right = normalize(right);
     Vec3f up = normalize(cross(right, forward));
-    float distance = 1.0f / std::tan(0.5f * horizontal_fov_degrees * kPi / 180.0f);
+    float distance = 1.0f / portable::tan(0.5f * horizontal_fov_degrees * kPi / 180.0f);
     return {eye, eye + forward * distance, up};
 }
 

@@ -6,6 +6,8 @@
 #include <utility>
 #include <vector>
 
+#include "toonray/core/portable_math.h"
+
 namespace toonray {
 namespace {
 
@@ -14,7 +16,7 @@ struct Rotation {
     Vec3f r0, r1, r2;
 
     Rotation(const Vec3f& a, float angle) {
-        const float c = std::cos(angle), s = std::sin(angle), t = 1.0f - c;
+        const float c = portable::cos(angle), s = portable::sin(angle), t = 1.0f - c;
         r0 = {t * a.x * a.x + c, t * a.x * a.y - s * a.z, t * a.x * a.z + s * a.y};
         r1 = {t * a.x * a.y + s * a.z, t * a.y * a.y + c, t * a.y * a.z - s * a.x};
         r2 = {t * a.x * a.z - s * a.y, t * a.y * a.z + s * a.x, t * a.z * a.z + c};

@@ -1,12 +1,10 @@
-// Lets GCC if-convert float comparisons (the clamps and selects in to_byte, round_half_away and
-// the maps) so the per-pixel loops vectorise; with trapping math on it keeps them as branches.
-// It changes no result, only which floating-point exception flags may be raised, and nothing in
-// toonray reads those. Before the includes, so classic.h's inline helpers get it too (GCC will
-// not inline a function compiled with other floating-point options into these loops).
-#pragma GCC optimize("no-trapping-math")
+// Compiled with -fno-trapping-math (top-level CMakeLists.txt), so that GCC if-converts the float
+// comparisons (the clamps and selects in to_byte, round_half_away and the maps) and the
+// per-pixel loops vectorise. It changes no result, only which floating-point exception flags
+// may be raised, and nothing in toonray reads those.
 #include "toonray/render/classic.h"
 
-#include <emmintrin.h>
+#include "toonray/core/simd_sse.h"
 
 #include <algorithm>
 #include <cmath>

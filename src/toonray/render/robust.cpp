@@ -9,6 +9,7 @@
 
 #include "toonray/core/error.h"
 #include "toonray/core/parallel.h"
+#include "toonray/core/portable_math.h"
 #include "toonray/render/classic.h"
 
 namespace toonray {
@@ -467,7 +468,7 @@ void find_line_seeds(const FineBuffers& fine, const RobustLineSettings& s, Image
     const int w = fine.depth.width(), h = fine.depth.height();
     size_for_overwrite(seeds, w, h);
     if (w == 0 || h == 0) return;
-    const SeedTests tests{s.types, std::cos(s.crease_angle * 3.14159265f / 180.0f), s.depth_threshold,
+    const SeedTests tests{s.types, portable::cos(s.crease_angle * 3.14159265f / 180.0f), s.depth_threshold,
                           s.silhouette_ratio};
     parallel_for(h, kRowGrain, threads, [&](int y0, int y1) {
         SeedRowScratch r(w);

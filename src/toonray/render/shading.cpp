@@ -7,6 +7,7 @@
 
 #include "toonray/core/error.h"
 #include "toonray/core/parse.h"
+#include "toonray/core/portable_math.h"
 
 namespace toonray {
 namespace {
@@ -120,7 +121,7 @@ namespace {
         if (s.specular && material.ns > 0.0f && (material.ks.x > 0 || material.ks.y > 0 || material.ks.z > 0)) {
             Vec3f half = normalize(to_light - dir);
             float n_dot_h = std::max(0.0f, dot(n, half));
-            if (std::pow(n_dot_h, material.ns) > 0.5f) highlight = 1.0f;  // one hard-edged band
+            if (portable::pow(n_dot_h, material.ns) > 0.5f) highlight = 1.0f;  // one hard-edged band
         }
     }
     // With one unit light this is max(0, l.n): the same band as the seed's int(l.n * 16).

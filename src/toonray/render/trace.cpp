@@ -1,10 +1,8 @@
 // Sample directions must round exactly as written (the tests compare them bit for bit with
-// normalize(view.pixel_point(...) - view.eye)): no fused multiply-adds, which -march=native
-// (TOONRAY_NATIVE) would otherwise let GCC form.
-#pragma GCC optimize("fp-contract=off")
+// normalize(view.pixel_point(...) - view.eye)): the project compiles with -ffp-contract=off.
 #include "toonray/render/trace.h"
 
-#include <smmintrin.h>
+#include "toonray/core/simd_sse.h"
 
 #include <algorithm>
 #include <array>

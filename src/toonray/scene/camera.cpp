@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "toonray/core/error.h"
+#include "toonray/core/portable_math.h"
 
 namespace toonray {
 
@@ -78,7 +79,7 @@ CameraSpec auto_camera(std::span<const Vec3f> points, int width, int height) {
     Vec3f center = box.center();
     // Look at the centre from the front-right, slightly above, 60 degrees horizontal field of
     // view (|viewDir| = 1 / tan(30 deg)).
-    const float view_len = 1.0f / std::tan(30.0f * 3.14159265f / 180.0f);
+    const float view_len = 1.0f / portable::tan(30.0f * 3.14159265f / 180.0f);
     const float tan_x = 1.0f / view_len;
     const float tan_y = tan_x * static_cast<float>(height) / static_cast<float>(width);
     Vec3f dir = normalize(Vec3f(0.55f, 0.45f, 1.0f));  // from the centre towards the eye
