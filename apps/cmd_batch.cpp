@@ -19,22 +19,30 @@ struct BatchArgs {
     RenderArgs render;
 
     void add_to(CLI::App& app) {
-        app.add_option("name", name, "Animation name: frame N is read from NAME_NNNNNN.obj, "
-                                     "NAME_NNNN.obj, NAMEN.obj or NAME_N.obj, the first that exists")
+        app.add_option("name", name,
+                       "Animation name: frame N is read from NAME_NNNNNN.obj, "
+                       "NAME_NNNN.obj, NAMEN.obj or NAME_N.obj, the first that exists")
             ->required();
-        app.add_option("first", first, "First frame number")->required()->check(CLI::NonNegativeNumber);
-        app.add_option("last", last, "Last frame number (inclusive)")->required()->check(CLI::NonNegativeNumber);
-        app.add_option("-i,--input", input, "Directory of the frame OBJ files")->capture_default_str();
+        app.add_option("first", first, "First frame number")
+            ->required()
+            ->check(CLI::NonNegativeNumber);
+        app.add_option("last", last, "Last frame number (inclusive)")
+            ->required()
+            ->check(CLI::NonNegativeNumber);
+        app.add_option("-i,--input", input, "Directory of the frame OBJ files")
+            ->capture_default_str();
         app.add_option("-o,--output", output, "Directory for the PNG frames (created if missing)")
             ->capture_default_str();
         app.add_option("--pattern", pattern, "Input file pattern, e.g. 'keys_%06d.obj'");
-        app.add_option("--output-pattern", output_pattern, "Output file pattern (default: NAME_%06d.png)");
+        app.add_option("--output-pattern", output_pattern,
+                       "Output file pattern (default: NAME_%06d.png)");
         app.add_option("--jobs", jobs, "Frames rendered at once (0 = one per core)")
             ->check(CLI::Range(0, 256))
             ->capture_default_str();
-        app.add_option("--shard", shard,
-                       "Render shard K of N (K/N): frames at positions K-1, K-1+N, ... of the range. "
-                       "Default: from SLURM_ARRAY_TASK_ID/COUNT/MIN when set, else all frames");
+        app.add_option(
+            "--shard", shard,
+            "Render shard K of N (K/N): frames at positions K-1, K-1+N, ... of the range. "
+            "Default: from SLURM_ARRAY_TASK_ID/COUNT/MIN when set, else all frames");
         app.add_flag("--resume", resume, "Skip frames whose PNG already exists and is valid");
         app.add_flag("--fail-fast", fail_fast, "Stop at the first frame that fails");
         app.add_flag("-q,--quiet", quiet, "No progress output (failures are still reported)");
@@ -74,7 +82,8 @@ int run_batch(const BatchArgs& args, const CLI::App& command) {
 Subcommand add_batch_command(CLI::App& app, LimitArgs& limit_args) {
     auto args = std::make_shared<BatchArgs>();
     CLI::App* batch = app.add_subcommand(
-        "batch", "Render numbered frames NAME FIRST LAST to a PNG sequence (all render options apply)");
+        "batch",
+        "Render numbered frames NAME FIRST LAST to a PNG sequence (all render options apply)");
     args->add_to(*batch);
     args->render.add_to(*batch);
     limit_args.add_to(*batch);

@@ -22,8 +22,9 @@ int run_encode(const EncodeArgs& args) {
     options.audio = args.audio;
     if (args.start_number >= 0) options.start_number = args.start_number;
     EncodeResult result = encode_video(options);
-    fmt::print(stderr, "toonray: wrote {}: {} frames ({}), {:.2f} s{}\n", args.output, result.frames.count,
-               result.frames.pattern(), result.duration, args.audio.empty() ? "" : ", with audio");
+    fmt::print(stderr, "toonray: wrote {}: {} frames ({}), {:.2f} s{}\n", args.output,
+               result.frames.count, result.frames.pattern(), result.duration,
+               args.audio.empty() ? "" : ", with audio");
     return 0;
 }
 
@@ -32,7 +33,8 @@ int run_encode(const EncodeArgs& args) {
 Subcommand add_encode_command(CLI::App& app) {
     auto args = std::make_shared<EncodeArgs>();
     CLI::App* encode = app.add_subcommand(
-        "encode", "Compile a PNG sequence into an H.264 MP4 (yuv420p) with ffmpeg, optionally with audio");
+        "encode",
+        "Compile a PNG sequence into an H.264 MP4 (yuv420p) with ffmpeg, optionally with audio");
     encode->add_option("frames", args->frames_dir, "Directory holding one numbered PNG sequence")
         ->required()
         ->check(CLI::ExistingDirectory);
@@ -40,8 +42,11 @@ Subcommand add_encode_command(CLI::App& app) {
     encode->add_option("--fps", args->fps, "Frames per second")
         ->check(CLI::Range(0.001, 1000.0))
         ->capture_default_str();
-    encode->add_option("--audio", args->audio, "Soundtrack (WAV or anything ffmpeg reads), aligned with frame 0");
-    encode->add_option("--start-number", args->start_number, "First frame number (default: the lowest present)")
+    encode->add_option("--audio", args->audio,
+                       "Soundtrack (WAV or anything ffmpeg reads), aligned with frame 0");
+    encode
+        ->add_option("--start-number", args->start_number,
+                     "First frame number (default: the lowest present)")
         ->check(CLI::NonNegativeNumber);
     return {encode, [args] { return run_encode(*args); }};
 }

@@ -20,29 +20,34 @@ struct PianoCommandArgs {
     std::string output;
 };
 
-PianoMovieReport run_piano_movie(const Score& score, const PianoArgs& args, PianoMovieOptions options,
-                                 const CLI::App& command) {
-    CameraPath path = args.camera_path.empty() ? load_demo_camera_path() : load_camera_path(args.camera_path);
+PianoMovieReport run_piano_movie(const Score& score, const PianoArgs& args,
+                                 PianoMovieOptions options, const CLI::App& command) {
+    CameraPath path =
+        args.camera_path.empty() ? load_demo_camera_path() : load_camera_path(args.camera_path);
     options.start = args.start;
     options.fps = args.fps;
     options.jobs = args.jobs;
     options.resume = args.resume;
     options.cancel = install_stop_handlers();
-    double seconds = options.seconds ? *options.seconds
-                                     : std::max(0.0, (score.notes.empty() ? 0.0 : score.duration()) - options.start);
+    double seconds =
+        options.seconds
+            ? *options.seconds
+            : std::max(0.0, (score.notes.empty() ? 0.0 : score.duration()) - options.start);
     ProgressReporter progress(frame_count(seconds, options.fps), stderr, args.quiet);
     PianoMovieReport report = render_piano_movie(score, path, options, &progress);
     progress.finish(report.batch);
     print_frame_limit_hints(report.batch, command);
     if (report.dropped_holes)
-        fmt::print(stderr, "toonray: warning: {} roll holes did not fit the hole pool\n", report.dropped_holes);
+        fmt::print(stderr, "toonray: warning: {} roll holes did not fit the hole pool\n",
+                   report.dropped_holes);
     return report;
 }
 
 int run_piano(const PianoCommandArgs& args, const CLI::App& command) {
     const PianoArgs& piano = args.piano;
     if (args.output.empty() == piano.export_obj.empty())
-        throw Error("piano: give exactly one of --output DIR (render PNG frames) or --export-obj DIR");
+        throw Error(
+            "piano: give exactly one of --output DIR (render PNG frames) or --export-obj DIR");
     Score score = load_score_or_demo(piano.score);
     PianoMovieOptions options;
     options.name = piano.name;
@@ -56,8 +61,8 @@ int run_piano(const PianoCommandArgs& args, const CLI::App& command) {
     if (report.batch.cancelled) return 130;
     if (report.batch.failed > 0) return 1;
     if (audio_opts) {
-        AudioResult audio =
-            with_soundfont_hint(piano.soundfont, [&] { return render_audio(score, piano.audio, *audio_opts); });
+        AudioResult audio = with_soundfont_hint(
+            piano.soundfont, [&] { return render_audio(score, piano.audio, *audio_opts); });
         print_warnings(audio.warnings);
     }
     return 0;
@@ -69,17 +74,22 @@ Subcommand add_piano_command(CLI::App& app, LimitArgs& limit_args) {
     auto args = std::make_shared<PianoCommandArgs>();
     PianoArgs& piano_args = args->piano;
     CLI::App* piano = app.add_subcommand(
-        "piano", "Render the procedural player piano playing a score, or export its frames as OBJ files");
+        "piano",
+        "Render the procedural player piano playing a score, or export its frames as OBJ files");
     piano->add_option("--score", piano_args.score,
                       "Score: a MIDI file or a note script (default: the built-in Entertainer)");
     piano->add_option("-o,--output", args->output, "Directory for the PNG frames");
-    piano->add_option("--export-obj", piano_args.export_obj,
-                      "Instead of rendering, write one OBJ + MTL per frame with its camera block to this "
-                      "directory (render them with `toonray batch NAME 1 N`)");
-    piano->add_option("--seconds", piano_args.seconds, "Length in seconds (default: to the end of the music)")
+    piano->add_option(
+        "--export-obj", piano_args.export_obj,
+        "Instead of rendering, write one OBJ + MTL per frame with its camera block to this "
+        "directory (render them with `toonray batch NAME 1 N`)");
+    piano
+        ->add_option("--seconds", piano_args.seconds,
+                     "Length in seconds (default: to the end of the music)")
         ->check(CLI::PositiveNumber);
     piano->add_option("--name", piano_args.name, "Frame file name prefix")->capture_default_str();
-    piano->add_option("--audio", piano_args.audio, "Also write the soundtrack of the same stretch to this WAV");
+    piano->add_option("--audio", piano_args.audio,
+                      "Also write the soundtrack of the same stretch to this WAV");
     piano_args.add_common(*piano);
     args->render.add_to(*piano);
     limit_args.add_to(*piano);

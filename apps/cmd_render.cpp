@@ -50,10 +50,12 @@ Subcommand add_render_command(CLI::App& app, LimitArgs& limit_args) {
         ->check(CLI::ExistingFile);
     render->add_option("-o,--output", args->output, "Output PNG file")->required();
     args->render.add_to(*render);
-    render->add_option("--svg", args->svg,
-                       "With --edges ink: also write the visible lines as SVG paths in pixel units, "
-                       "grouped by type (silhouette, border, crease, material, intersection)");
-    render->add_flag("--svg-hidden", args->svg_hidden, "With --svg: also write the hidden lines, in a layer of their own");
+    render->add_option(
+        "--svg", args->svg,
+        "With --edges ink: also write the visible lines as SVG paths in pixel units, "
+        "grouped by type (silhouette, border, crease, material, intersection)");
+    render->add_flag("--svg-hidden", args->svg_hidden,
+                     "With --svg: also write the hidden lines, in a layer of their own");
     limit_args.add_to(*render);
     return {render, [args] { return run_render(*args); }};
 }

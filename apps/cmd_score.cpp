@@ -25,8 +25,9 @@ Subcommand add_score_command(CLI::App& app, LimitArgs& limit_args) {
     CLI::App* score = app.add_subcommand("score", "Work with scores (note scripts and MIDI files)");
     score->require_subcommand(1);
     CLI::App* convert = score->add_subcommand(
-        "convert", "Convert between a MIDI file and a note script, losslessly where the script can say it "
-                   "(the output's extension chooses: .mid/.midi or .notes)");
+        "convert",
+        "Convert between a MIDI file and a note script, losslessly where the script can say it "
+        "(the output's extension chooses: .mid/.midi or .notes)");
     convert->add_option("input", args->input, "Score to read (MIDI or note script)")
         ->required()
         ->check(CLI::ExistingFile);

@@ -67,7 +67,8 @@ std::string with_limit_hint(const std::string& message, Limit limit, const CLI::
     const std::string hints = limit_hints(message, limit, command);
     if (hints.empty()) return message;
     // "(the limit)" becomes "(the limit); --max-triangles raises it", not two parentheses in a row.
-    return message.ends_with(')') ? fmt::format("{}; {}", message, hints) : fmt::format("{} ({})", message, hints);
+    return message.ends_with(')') ? fmt::format("{}; {}", message, hints)
+                                  : fmt::format("{} ({})", message, hints);
 }
 
 void print_frame_limit_hints(const BatchReport& report, const CLI::App& command) {
@@ -82,8 +83,8 @@ void print_frame_limit_hints(const BatchReport& report, const CLI::App& command)
     }
     for (const auto& [limit, frames_and_hint] : hinted) {
         const auto& [frames, hint] = frames_and_hint;
-        fmt::print(stderr, "toonray: {} frame{} exceeded the {} limit: {}\n", frames, frames == 1 ? "" : "s",
-                   limit_name(limit), hint);
+        fmt::print(stderr, "toonray: {} frame{} exceeded the {} limit: {}\n", frames,
+                   frames == 1 ? "" : "s", limit_name(limit), hint);
     }
 }
 

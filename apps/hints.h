@@ -52,7 +52,8 @@ std::string soundfont_hint(const std::string& message, const std::filesystem::pa
 /// Runs `synthesise`, which plays a score on `soundfont` (empty: the default); when it fails
 /// because that file does not exist, the error says that --soundfont chooses another.
 template <class Synthesise>
-auto with_soundfont_hint(const std::filesystem::path& soundfont, Synthesise&& synthesise) -> decltype(synthesise()) {
+auto with_soundfont_hint(const std::filesystem::path& soundfont, Synthesise&& synthesise)
+    -> decltype(synthesise()) {
     try {
         return synthesise();
     } catch (const Error& e) {

@@ -32,9 +32,12 @@ int main(int argc, char** argv) {
 
     LimitArgs limit_args;
     const Subcommand commands[] = {
-        add_render_command(app, limit_args), add_batch_command(app, limit_args),
-        add_encode_command(app),             add_score_command(app, limit_args),
-        add_piano_command(app, limit_args),  add_demo_command(app, limit_args),
+        add_render_command(app, limit_args),
+        add_batch_command(app, limit_args),
+        add_encode_command(app),
+        add_score_command(app, limit_args),
+        add_piano_command(app, limit_args),
+        add_demo_command(app, limit_args),
     };
 
     try {

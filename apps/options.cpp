@@ -16,19 +16,25 @@ namespace toonray::cli {
 
 void RenderArgs::add_to(CLI::App& app) {
     app.add_option("--size", size, "Image size WIDTHxHEIGHT")->capture_default_str();
-    app.add_option("--light", lights,
-                   "A light, repeatable: x,y,z or point:x,y,z (a point light), dir:x,y,z (a directional "
-                   "light shining along the vector), each with an optional @intensity (default: one "
-                   "point light at the eye moved by half the scene radius along the camera's up and right)");
-    app.add_option("--lights", lights_file,
-                   "File of lights, one per line: point x y z [intensity] | directional x y z [intensity]")
+    app.add_option(
+        "--light", lights,
+        "A light, repeatable: x,y,z or point:x,y,z (a point light), dir:x,y,z (a directional "
+        "light shining along the vector), each with an optional @intensity (default: one "
+        "point light at the eye moved by half the scene radius along the camera's up and right)");
+    app.add_option(
+           "--lights", lights_file,
+           "File of lights, one per line: point x y z [intensity] | directional x y z [intensity]")
         ->check(CLI::ExistingFile);
-    app.add_option("--ramp", ramp,
-                   "Toon bands LEVELS@THRESHOLDS, e.g. 0.5,0.75,1.0@0.25,0.5 (the seed's ramp, the default): "
-                   "diffuse light below the first threshold gives the first level, and so on");
-    app.add_flag("--shadows", shadows, "Toon shadows: lights blocked by geometry do not light a point");
-    app.add_flag("--specular", specular, "A hard-edged highlight band from the material's Ks and Ns");
-    app.add_option("--rim", rim, "Rim band width in [0,1) (0 = off): brightens surfaces seen edge-on")
+    app.add_option(
+        "--ramp", ramp,
+        "Toon bands LEVELS@THRESHOLDS, e.g. 0.5,0.75,1.0@0.25,0.5 (the seed's ramp, the default): "
+        "diffuse light below the first threshold gives the first level, and so on");
+    app.add_flag("--shadows", shadows,
+                 "Toon shadows: lights blocked by geometry do not light a point");
+    app.add_flag("--specular", specular,
+                 "A hard-edged highlight band from the material's Ks and Ns");
+    app.add_option("--rim", rim,
+                   "Rim band width in [0,1) (0 = off): brightens surfaces seen edge-on")
         ->check(CLI::Range(0.0f, 0.99f))
         ->capture_default_str();
     app.add_flag("--no-textures", no_textures, "Ignore map_Kd textures");
@@ -37,21 +43,25 @@ void RenderArgs::add_to(CLI::App& app) {
                    "file's camera block (default: the block, else a camera framing the scene)");
     app.add_option("--background", background, "Background colour r,g,b in [0,1] or #rrggbb")
         ->capture_default_str();
-    app.add_option("--edges", edges,
-                   "Line mode: robust (supersampled, plane-aware, resolution-independent lines), "
-                   "classic (the seed's Sobel pipeline, exactly) or ink (lines found on the geometry, "
-                   "with ray-traced visibility, drawn as exact strokes; render --svg writes them)")
+    app.add_option(
+           "--edges", edges,
+           "Line mode: robust (supersampled, plane-aware, resolution-independent lines), "
+           "classic (the seed's Sobel pipeline, exactly) or ink (lines found on the geometry, "
+           "with ray-traced visibility, drawn as exact strokes; render --svg writes them)")
         ->check(CLI::IsMember({"robust", "classic", "ink"}))
         ->capture_default_str();
-    app.add_option("--lines", lines,
-                   "Robust: line types to draw, from silhouette,crease,depth,object,material (or all, none)")
+    app.add_option(
+           "--lines", lines,
+           "Robust: line types to draw, from silhouette,crease,depth,object,material (or all, none)")
         ->capture_default_str();
-    app.add_option("--crease-angle", crease_angle,
-                   "Robust: angle in degrees between neighbouring surfaces above which a crease is drawn")
+    app.add_option(
+           "--crease-angle", crease_angle,
+           "Robust: angle in degrees between neighbouring surfaces above which a crease is drawn")
         ->check(CLI::Range(0.0f, 180.0f))
         ->capture_default_str();
-    app.add_option("--depth-step", depth_step,
-                   "Robust: relative jump in depth (second difference of 1/z over 1/z) that makes a depth line")
+    app.add_option(
+           "--depth-step", depth_step,
+           "Robust: relative jump in depth (second difference of 1/z over 1/z) that makes a depth line")
         ->check(CLI::PositiveNumber)
         ->capture_default_str();
     app.add_option("--line-width", line_width,
@@ -60,22 +70,26 @@ void RenderArgs::add_to(CLI::App& app) {
         ->capture_default_str();
     app.add_option("--line-color", line_colour, "Robust: line colour r,g,b in [0,1] or #rrggbb")
         ->capture_default_str();
-    app.add_option("--samples", samples,
-                   "Robust: samples per pixel on a regular grid (1, 4, 9 or 16); lines and colours are "
-                   "filtered down from it")
+    app.add_option(
+           "--samples", samples,
+           "Robust: samples per pixel on a regular grid (1, 4, 9 or 16); lines and colours are "
+           "filtered down from it")
         ->check(CLI::IsMember({1, 4, 9, 16}))
         ->capture_default_str();
-    app.add_option("--depth-threshold", depth_threshold,
-                   "Classic mode: Sobel magnitude on the 8-bit depth map above which a pixel is a line")
+    app.add_option(
+           "--depth-threshold", depth_threshold,
+           "Classic mode: Sobel magnitude on the 8-bit depth map above which a pixel is a line")
         ->capture_default_str();
-    app.add_option("--normal-threshold", normal_threshold,
-                   "Classic mode: Sobel magnitude on the 8-bit normal map above which a pixel is a line")
+    app.add_option(
+           "--normal-threshold", normal_threshold,
+           "Classic mode: Sobel magnitude on the 8-bit normal map above which a pixel is a line")
         ->capture_default_str();
-    app.add_option("--aov", aov_dir,
-                   "Also write feature images to this directory, named after the output: "
-                   "NAME_depth, _normal, _edges, _cel .png, and per mode: classic _edges_depth, "
-                   "_edges_normal; robust _lines_silhouette, _lines_crease, _lines_depth, _lines_object, "
-                   "_lines_material, _object_id, _material_id; ink _object_id, _material_id");
+    app.add_option(
+        "--aov", aov_dir,
+        "Also write feature images to this directory, named after the output: "
+        "NAME_depth, _normal, _edges, _cel .png, and per mode: classic _edges_depth, "
+        "_edges_normal; robust _lines_silhouette, _lines_crease, _lines_depth, _lines_object, "
+        "_lines_material, _object_id, _material_id; ink _object_id, _material_id");
     app.add_option("--threads", threads, "Threads to use (0 = all)")
         ->check(CLI::Range(0, 1024))
         ->capture_default_str();
@@ -96,16 +110,20 @@ FrameOptions RenderArgs::resolve() const {
         o.settings.shading.lights.push_back(with_flag("--light", [&] { return parse_light(l); }));
     if (!lights_file.empty()) {
         auto from_file = load_lights(lights_file);
-        o.settings.shading.lights.insert(o.settings.shading.lights.end(), from_file.begin(), from_file.end());
+        o.settings.shading.lights.insert(o.settings.shading.lights.end(), from_file.begin(),
+                                         from_file.end());
     }
-    if (!ramp.empty()) o.settings.shading.ramp = with_flag("--ramp", [&] { return parse_ramp(ramp); });
+    if (!ramp.empty())
+        o.settings.shading.ramp = with_flag("--ramp", [&] { return parse_ramp(ramp); });
     o.settings.shading.shadows = shadows;
     o.settings.shading.specular = specular;
     o.settings.shading.rim = rim;
     o.settings.shading.textures = !no_textures;
-    if (!camera.empty()) o.camera = with_flag("--camera", [&] { return parse_camera_spec(camera); });
+    if (!camera.empty())
+        o.camera = with_flag("--camera", [&] { return parse_camera_spec(camera); });
     o.settings.background = parse_colour(background, "--background");
-    o.settings.edges = edges == "classic" ? EdgeMode::Classic : (edges == "ink" ? EdgeMode::Ink : EdgeMode::Robust);
+    o.settings.edges = edges == "classic" ? EdgeMode::Classic
+                                          : (edges == "ink" ? EdgeMode::Ink : EdgeMode::Robust);
     o.settings.lines.types = with_flag("--lines", [&] { return parse_line_types(lines); });
     o.settings.lines.crease_angle = crease_angle;
     o.settings.lines.depth_threshold = depth_step;
@@ -124,17 +142,21 @@ FrameOptions RenderArgs::resolve() const {
 void LimitArgs::add_to(CLI::App& app) {
     const Limits d;
     app.add_option("--max-triangles", triangles,
-                   fmt::format("Largest scene, in triangles (default {}; k, M, G suffixes)", d.max_triangles))
+                   fmt::format("Largest scene, in triangles (default {}; k, M, G suffixes)",
+                               d.max_triangles))
         ->group("Limits");
-    app.add_option("--max-vertices", vertices,
-                   fmt::format("Most OBJ v, vn and vt statements, each (default {})", d.max_vertices))
+    app.add_option(
+           "--max-vertices", vertices,
+           fmt::format("Most OBJ v, vn and vt statements, each (default {})", d.max_vertices))
         ->group("Limits");
     app.add_option("--max-image-pixels", pixels,
-                   fmt::format("Largest image, width x height (default {} = 8192x8192)", d.max_image_pixels))
+                   fmt::format("Largest image, width x height (default {} = 8192x8192)",
+                               d.max_image_pixels))
         ->group("Limits");
-    app.add_option("--max-memory", memory,
-                   "Memory the estimate of a run may reach (frame buffers and scenes of all frames in "
-                   "flight), e.g. 4G (default: 3/4 of physical memory)")
+    app.add_option(
+           "--max-memory", memory,
+           "Memory the estimate of a run may reach (frame buffers and scenes of all frames in "
+           "flight), e.g. 4G (default: 3/4 of physical memory)")
         ->group("Limits");
     app.add_option("--max-input-size", input_size,
                    fmt::format("Largest input file: OBJ, MTL, score, camera path (default {})",
@@ -144,10 +166,14 @@ void LimitArgs::add_to(CLI::App& app) {
 
 void LimitArgs::apply() const {
     Limits l = limits();
-    if (!triangles.empty()) l.max_triangles = with_flag("--max-triangles", [&] { return parse_count(triangles); });
-    if (!vertices.empty()) l.max_vertices = with_flag("--max-vertices", [&] { return parse_count(vertices); });
-    if (!pixels.empty()) l.max_image_pixels = with_flag("--max-image-pixels", [&] { return parse_count(pixels); });
-    if (!memory.empty()) l.max_memory = with_flag("--max-memory", [&] { return parse_bytes(memory); });
+    if (!triangles.empty())
+        l.max_triangles = with_flag("--max-triangles", [&] { return parse_count(triangles); });
+    if (!vertices.empty())
+        l.max_vertices = with_flag("--max-vertices", [&] { return parse_count(vertices); });
+    if (!pixels.empty())
+        l.max_image_pixels = with_flag("--max-image-pixels", [&] { return parse_count(pixels); });
+    if (!memory.empty())
+        l.max_memory = with_flag("--max-memory", [&] { return parse_bytes(memory); });
     if (!input_size.empty())
         l.max_input_bytes = with_flag("--max-input-size", [&] { return parse_bytes(input_size); });
     set_limits(l);
@@ -156,7 +182,9 @@ void LimitArgs::apply() const {
 void PianoArgs::add_common(CLI::App& app) {
     app.add_option("--camera-path", camera_path,
                    "Camera path file (docs/camera-path.md; default: the built-in path)");
-    app.add_option("--fps", fps, "Frames per second")->check(CLI::Range(0.001, 1000.0))->capture_default_str();
+    app.add_option("--fps", fps, "Frames per second")
+        ->check(CLI::Range(0.001, 1000.0))
+        ->capture_default_str();
     app.add_option("--start", start, "Score time of the first frame, seconds")
         ->check(CLI::NonNegativeNumber)
         ->capture_default_str();
@@ -197,14 +225,16 @@ Score load_score_or_demo(const std::string& path) {
     return score;
 }
 
-AudioOptions audio_options(const Score& score, const PianoArgs& args, std::optional<double> seconds) {
+AudioOptions audio_options(const Score& score, const PianoArgs& args,
+                           std::optional<double> seconds) {
     AudioOptions audio;
     audio.soundfont = args.soundfont;
     audio.start = args.start;
     audio.length = seconds;
     // The soundtrack is synthesised in memory (16-bit stereo, then its WAV copy): a score that
     // lasts for days must fail here, not in an allocation.
-    const double length = seconds ? *seconds : std::max(score.end_time, score.duration()) - args.start + 5.0;
+    const double length =
+        seconds ? *seconds : std::max(score.end_time, score.duration()) - args.start + 5.0;
     const double bytes = std::max(0.0, length) * audio.sample_rate * 2 * 2 * 2;
     try {
         check_memory(bytes < 1.8e19 ? static_cast<std::uint64_t>(bytes) : UINT64_MAX,

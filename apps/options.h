@@ -74,6 +74,7 @@ Score load_score_or_demo(const std::string& path);
 
 /// Audio options for the soundtrack of `seconds` of `score` (to its end when empty); throws if the
 /// soundtrack would not fit the memory limit.
-AudioOptions audio_options(const Score& score, const PianoArgs& args, std::optional<double> seconds);
+AudioOptions audio_options(const Score& score, const PianoArgs& args,
+                           std::optional<double> seconds);
 
 }  // namespace toonray::cli

@@ -184,8 +184,8 @@ public:
         auto t0 = Clock::now();
         scene_ = rtcNewScene(device_);
         RTCGeometry g = rtcNewGeometry(device_, RTC_GEOMETRY_TYPE_TRIANGLE);
-        rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, verts_.data(), 0,
-                                   3 * sizeof(float), m.positions.size());
+        rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, verts_.data(),
+                                   0, 3 * sizeof(float), m.positions.size());
         rtcSetSharedGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, m.tris.data(), 0,
                                    3 * sizeof(std::uint32_t), m.tris.size());
         rtcCommitGeometry(g);
@@ -193,7 +193,8 @@ public:
         rtcReleaseGeometry(g);
         rtcCommitScene(scene_);
         double s = seconds_since(t0);
-        if (rtcGetDeviceError(device_) != RTC_ERROR_NONE) throw std::runtime_error("embree build failed");
+        if (rtcGetDeviceError(device_) != RTC_ERROR_NONE)
+            throw std::runtime_error("embree build failed");
         return s;
     }
     RTCScene scene() const { return scene_; }
@@ -234,7 +235,8 @@ std::vector<Ray> shadow_rays(const Mesh& m, const ViewPlane& view, const Hits& p
     return rays;
 }
 
-[[gnu::noinline]] size_t trace_shadows_closest(const TriangleAccel& accel, const std::vector<Ray>& rays) {
+[[gnu::noinline]] size_t trace_shadows_closest(const TriangleAccel& accel,
+                                               const std::vector<Ray>& rays) {
     size_t blocked = 0;
     for (const Ray& r : rays) {
         Hit hit;
@@ -243,7 +245,8 @@ std::vector<Ray> shadow_rays(const Mesh& m, const ViewPlane& view, const Hits& p
     return blocked;
 }
 
-[[gnu::noinline]] size_t trace_shadows_any(const TriangleAccel& accel, const std::vector<Ray>& rays) {
+[[gnu::noinline]] size_t trace_shadows_any(const TriangleAccel& accel,
+                                           const std::vector<Ray>& rays) {
     size_t blocked = 0;
     for (const Ray& r : rays) blocked += accel.occluded(r);
     return blocked;
@@ -256,7 +259,8 @@ void trace_ours_single(const TriangleAccel& accel, const ViewPlane& view, int w,
     });
 }
 
-void trace_legacy(const legacy::TriangleAccel& accel, const ViewPlane& view, int w, int h, Hits& out) {
+void trace_legacy(const legacy::TriangleAccel& accel, const ViewPlane& view, int w, int h,
+                  Hits& out) {
     for_each_tile_ray(view, w, h, [&](int x, int y, const Vec3f& dir) {
         size_t i = static_cast<size_t>(y) * w + x;
         out.found[i] = accel.intersect(Ray{view.eye, dir}, out.hit[i]);
@@ -320,8 +324,9 @@ void trace_embree8(RTCScene scene, const ViewPlane& view, int w, int h, Hits& ou
                         px[k] = x;
                         py[k] = y;
                         valid[k] = x < w && y < h ? -1 : 0;
-                        Vec3f dir = valid[k] ? normalize(view.pixel_point(x + 0.5f, y + 0.5f) - view.eye)
-                                             : Vec3f(0, 0, 1);
+                        Vec3f dir = valid[k]
+                                        ? normalize(view.pixel_point(x + 0.5f, y + 0.5f) - view.eye)
+                                        : Vec3f(0, 0, 1);
                         rh.ray.org_x[k] = view.eye.x;
                         rh.ray.org_y[k] = view.eye.y;
                         rh.ray.org_z[k] = view.eye.z;
@@ -352,13 +357,16 @@ void trace_embree8(RTCScene scene, const ViewPlane& view, int w, int h, Hits& ou
 size_t exact_diff(const Hits& a, const Hits& b, const char* what) {
     size_t bad = 0;
     for (size_t i = 0; i < a.hit.size(); ++i) {
-        bool same = a.found[i] == b.found[i] &&
-                    (!a.found[i] || (bits(a.hit[i].t) == bits(b.hit[i].t) && a.hit[i].prim == b.hit[i].prim &&
-                                     bits(a.hit[i].u) == bits(b.hit[i].u) && bits(a.hit[i].v) == bits(b.hit[i].v)));
+        bool same =
+            a.found[i] == b.found[i] &&
+            (!a.found[i] ||
+             (bits(a.hit[i].t) == bits(b.hit[i].t) && a.hit[i].prim == b.hit[i].prim &&
+              bits(a.hit[i].u) == bits(b.hit[i].u) && bits(a.hit[i].v) == bits(b.hit[i].v)));
         if (!same) {
             if (bad < 5)
-                std::printf("    %s differs at ray %zu: found %d/%d t %.9g/%.9g prim %u/%u\n", what, i, a.found[i],
-                            b.found[i], a.hit[i].t, b.hit[i].t, a.hit[i].prim, b.hit[i].prim);
+                std::printf("    %s differs at ray %zu: found %d/%d t %.9g/%.9g prim %u/%u\n", what,
+                            i, a.found[i], b.found[i], a.hit[i].t, b.hit[i].t, a.hit[i].prim,
+                            b.hit[i].prim);
             ++bad;
         }
     }
@@ -434,8 +442,7 @@ int main(int argc, char** argv) {
             opt.height = 180;
             opt.build = false;
             opt.scenes = {"teapot", "spot70k", "piano"};
-        }
-        else if (a == "--size") {
+        } else if (a == "--size") {
             std::string v = next();
             opt.width = std::stoi(v.substr(0, v.find('x')));
             opt.height = std::stoi(v.substr(v.find('x') + 1));
@@ -463,20 +470,23 @@ int main(int argc, char** argv) {
     std::vector<std::string> rows;
     for (const std::string& name : opt.scenes) {
         Mesh m;
-        if (name == "teapot") m = load_mesh("teapot", TOONRAY_SOURCE_DIR "/tests/data/teapot.obj", w, h);
-        else if (name == "spot") m = load_mesh("spot", TOONRAY_SOURCE_DIR "/tests/data/spot.obj", w, h);
+        if (name == "teapot")
+            m = load_mesh("teapot", TOONRAY_SOURCE_DIR "/tests/data/teapot.obj", w, h);
+        else if (name == "spot")
+            m = load_mesh("spot", TOONRAY_SOURCE_DIR "/tests/data/spot.obj", w, h);
         else if (name == "spot70k") m = spot70k(w, h);
         else if (name == "piano") {
             if (!std::filesystem::exists(opt.piano)) {
-                std::printf("## piano: %s not found, skipped (make it with: toonray piano --export-obj "
-                            "/tmp/p --start 6 --seconds 0.04)\n",
-                            opt.piano.c_str());
+                std::printf(
+                    "## piano: %s not found, skipped (make it with: toonray piano --export-obj "
+                    "/tmp/p --start 6 --seconds 0.04)\n",
+                    opt.piano.c_str());
                 continue;
             }
             m = load_mesh("piano", opt.piano, w, h);
-        }
-        else if (name == "sphere1m") m = sphere1m(w, h);
-        else if (std::filesystem::exists(name)) m = load_mesh(std::filesystem::path(name).stem(), name, w, h);
+        } else if (name == "sphere1m") m = sphere1m(w, h);
+        else if (std::filesystem::exists(name))
+            m = load_mesh(std::filesystem::path(name).stem(), name, w, h);
         else {
             std::fprintf(stderr, "unknown scene %s\n", name.c_str());
             return 2;
@@ -487,7 +497,8 @@ int main(int argc, char** argv) {
         TriangleAccel ours;
         ours.build(m.positions, m.tris, opt.config);
         const double bvh_mb = ours.memory_bytes() / 1e6;
-        std::printf("  ours: %zu binary nodes, %.1f MB, kernels %s\n", ours.bvh().nodes.size(), bvh_mb, accel_isa());
+        std::printf("  ours: %zu binary nodes, %.1f MB, kernels %s\n", ours.bvh().nodes.size(),
+                    bvh_mb, accel_isa());
         Embree& emb = embree_1t;
         emb.build(m);
 
@@ -507,7 +518,8 @@ int main(int argc, char** argv) {
             size_t bad = 0;
             for_each_tile_ray(view, w, h, [&](int x, int y, const Vec3f& dir) {
                 const Vec3f& d = tile.dir[static_cast<size_t>(y) * w + x];
-                bad += bits(d.x) != bits(dir.x) || bits(d.y) != bits(dir.y) || bits(d.z) != bits(dir.z);
+                bad += bits(d.x) != bits(dir.x) || bits(d.y) != bits(dir.y) ||
+                       bits(d.z) != bits(dir.z);
             });
             std::printf("  trace_primary directions: %zu differ from the scalar ones\n", bad);
             failed |= bad != 0;
@@ -528,11 +540,14 @@ int main(int argc, char** argv) {
             std::printf("  bit-exact tile vs single: %zu diffs\n", d);
             failed |= d != 0;
         }
-        for (const auto& [what, e] : {std::pair<const char*, const Hits*>{"rtcIntersect1", &e1}, {"rtcIntersect8", &e8}}) {
+        for (const auto& [what, e] :
+             {std::pair<const char*, const Hits*>{"rtcIntersect1", &e1}, {"rtcIntersect8", &e8}}) {
             Agreement a = embree_agree(single, *e);
-            std::printf("  vs embree %s: same triangle and distance %.4f%%, tie (other triangle, same "
-                        "distance) %.4f%%, hit/miss %.4f%%, other %.4f%%\n",
-                        what, 100.0 * a.same / n, 100.0 * a.tie / n, 100.0 * a.hit_miss / n, 100.0 * a.other / n);
+            std::printf(
+                "  vs embree %s: same triangle and distance %.4f%%, tie (other triangle, same "
+                "distance) %.4f%%, hit/miss %.4f%%, other %.4f%%\n",
+                what, 100.0 * a.same / n, 100.0 * a.tie / n, 100.0 * a.hit_miss / n,
+                100.0 * a.other / n);
             if (a.same + a.tie < n * 0.9999) failed = true;
         }
 
@@ -545,8 +560,8 @@ int main(int argc, char** argv) {
             blocked += any;
             shadow_diffs += closest != any;
         }
-        std::printf("  shadow rays: %zu, %zu blocked; occluded differs from intersect on %zu\n", shadows.size(),
-                    blocked, shadow_diffs);
+        std::printf("  shadow rays: %zu, %zu blocked; occluded differs from intersect on %zu\n",
+                    shadows.size(), blocked, shadow_diffs);
         failed |= shadow_diffs != 0;
 
         // Timing: the variants alternate run by run.
@@ -578,14 +593,18 @@ int main(int argc, char** argv) {
             trace_embree8(emb.scene(), view, w, h, e8);
             t8.push_back(seconds_since(t0));
         }
-        auto mrays = [&](const std::vector<double>& t) { return t.empty() ? 0.0 : n / median(t) * 1e-6; };
-        std::printf("  Mrays/s: ours single %.2f, ours tile %.2f, embree1 %.2f, embree8 %.2f (before the rewrite: "
-                    "%.2f)\n",
-                    mrays(ts), mrays(tt), mrays(t1), mrays(t8), mrays(tl));
+        auto mrays = [&](const std::vector<double>& t) {
+            return t.empty() ? 0.0 : n / median(t) * 1e-6;
+        };
+        std::printf(
+            "  Mrays/s: ours single %.2f, ours tile %.2f, embree1 %.2f, embree8 %.2f (before the rewrite: "
+            "%.2f)\n",
+            mrays(ts), mrays(tt), mrays(t1), mrays(t8), mrays(tl));
         if (!tsc.empty() && !shadows.empty())
-            std::printf("  shadow Mrays/s: closest hit (intersect) %.2f, any hit (occluded) %.2f: %.2fx\n",
-                        shadows.size() / median(tsc) * 1e-6, shadows.size() / median(tsa) * 1e-6,
-                        median(tsc) / median(tsa));
+            std::printf(
+                "  shadow Mrays/s: closest hit (intersect) %.2f, any hit (occluded) %.2f: %.2fx\n",
+                shadows.size() / median(tsc) * 1e-6, shadows.size() / median(tsa) * 1e-6,
+                median(tsc) / median(tsa));
 
         double bo1 = 0, be1 = 0, boa = 0, bea = 0;
         if (opt.build) {
@@ -612,23 +631,26 @@ int main(int argc, char** argv) {
             be1 = median(e1t) * 1e3;
             boa = median(oa) * 1e3;
             bea = median(ea) * 1e3;
-            std::printf("  build ms: ours 1t %.1f, embree 1t %.1f, ours all %.1f, embree all %.1f\n", bo1, be1,
-                        boa, bea);
+            std::printf(
+                "  build ms: ours 1t %.1f, embree 1t %.1f, ours all %.1f, embree all %.1f\n", bo1,
+                be1, boa, bea);
         }
         char row[512];
         auto ratio = [](double a, double b) { return b > 0 ? a / b : 0.0; };
-        std::snprintf(row, sizeof row,
-                      "| %s | %zu | %.1f | %.1f | %.1f (%.2fx) | %.1f | %.1f (%.2fx) | %.1f | %.1f / %.1f | %.1f / %.1f |",
-                      m.name.c_str(), m.tris.size(), mrays(tl), mrays(t1), mrays(ts), ratio(mrays(ts), mrays(t1)),
-                      mrays(t8), mrays(tt), ratio(mrays(tt), mrays(t8)), m.tris.size() ? bvh_mb : 0.0, bo1, be1, boa,
-                      bea);
+        std::snprintf(
+            row, sizeof row,
+            "| %s | %zu | %.1f | %.1f | %.1f (%.2fx) | %.1f | %.1f (%.2fx) | %.1f | %.1f / %.1f | %.1f / %.1f |",
+            m.name.c_str(), m.tris.size(), mrays(tl), mrays(t1), mrays(ts),
+            ratio(mrays(ts), mrays(t1)), mrays(t8), mrays(tt), ratio(mrays(tt), mrays(t8)),
+            m.tris.size() ? bvh_mb : 0.0, bo1, be1, boa, bea);
         rows.push_back(row);
         std::fflush(stdout);
     }
-    std::printf("\nMrays/s (one thread, median) and build ms (ours / Embree):\n\n"
-                "| scene | triangles | before | Embree rtcIntersect1 | ours single | Embree rtcIntersect8 | "
-                "ours tile | ours MB | build 1 thread | build all threads |\n"
-                "|---|---|---|---|---|---|---|---|---|---|\n");
+    std::printf(
+        "\nMrays/s (one thread, median) and build ms (ours / Embree):\n\n"
+        "| scene | triangles | before | Embree rtcIntersect1 | ours single | Embree rtcIntersect8 | "
+        "ours tile | ours MB | build 1 thread | build all threads |\n"
+        "|---|---|---|---|---|---|---|---|---|---|\n");
     for (const auto& r : rows) std::printf("%s\n", r.c_str());
     std::printf("%s\n", failed ? "CHECKS FAILED" : "all checks passed");
     return failed ? 1 : 0;

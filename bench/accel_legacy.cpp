@@ -224,7 +224,8 @@ inline bool watertight_test(const ShearedRay& r, const Vec3f& v0, const Vec3f& v
         e1 = static_cast<float>(static_cast<double>(ax) * cy - static_cast<double>(ay) * cx);
         e2 = static_cast<float>(static_cast<double>(bx) * ay - static_cast<double>(by) * ax);
     }
-    if ((e0 < 0.0f || e1 < 0.0f || e2 < 0.0f) && (e0 > 0.0f || e1 > 0.0f || e2 > 0.0f)) return false;
+    if ((e0 < 0.0f || e1 < 0.0f || e2 < 0.0f) && (e0 > 0.0f || e1 > 0.0f || e2 > 0.0f))
+        return false;
     const float det = e0 + e1 + e2;
     if (det == 0.0f) return false;
     const float az = r.sz * a[r.kz], bz = r.sz * b[r.kz], cz = r.sz * c[r.kz];
@@ -232,7 +233,8 @@ inline bool watertight_test(const ShearedRay& r, const Vec3f& v0, const Vec3f& v
     // Reject most misses before the division, on scaled values with some slack (rounding of
     // tmax * det must not reject a hit at exactly tmax); the exact test is on t below.
     const float bound = tmax * det * (1.0f + 1.0f / (1 << 20));
-    if (det > 0.0f ? (scaled_t <= 0.0f || scaled_t > bound) : (scaled_t >= 0.0f || scaled_t < bound))
+    if (det > 0.0f ? (scaled_t <= 0.0f || scaled_t > bound)
+                   : (scaled_t >= 0.0f || scaled_t < bound))
         return false;
     const float inv = 1.0f / det;
     t = scaled_t * inv;
@@ -250,7 +252,8 @@ inline float box_entry(const BBox& b, const Vec3f& org, const Vec3f& inv_dir, fl
     float ty0 = (b.lo.y - org.y) * inv_dir.y, ty1 = (b.hi.y - org.y) * inv_dir.y;
     float tz0 = (b.lo.z - org.z) * inv_dir.z, tz1 = (b.hi.z - org.z) * inv_dir.z;
     float tnear = std::max({std::min(tx0, tx1), std::min(ty0, ty1), std::min(tz0, tz1), 0.0f});
-    float tfar = std::min({std::max(tx0, tx1), std::max(ty0, ty1), std::max(tz0, tz1), tmax}) * kWiden;
+    float tfar =
+        std::min({std::max(tx0, tx1), std::max(ty0, ty1), std::max(tz0, tz1), tmax}) * kWiden;
     return tnear <= tfar ? tnear : std::numeric_limits<float>::infinity();
 }
 
@@ -266,14 +269,19 @@ struct FixedStack {
 struct HeapStack {
     std::vector<std::uint32_t> items;
     void push(std::uint32_t v) { items.push_back(v); }
-    std::uint32_t pop() { std::uint32_t v = items.back(); items.pop_back(); return v; }
+    std::uint32_t pop() {
+        std::uint32_t v = items.back();
+        items.pop_back();
+        return v;
+    }
     bool empty() const { return items.empty(); }
 };
 
 }  // namespace
 
 void TriangleAccel::build(std::span<const Vec3f> positions,
-                          std::span<const std::array<std::uint32_t, 3>> tris, const Bvh::Config& config) {
+                          std::span<const std::array<std::uint32_t, 3>> tris,
+                          const Bvh::Config& config) {
     std::vector<BBox> boxes(tris.size());
     std::vector<Vec3f> centers(tris.size());
     for (std::size_t i = 0; i < tris.size(); ++i) {
@@ -312,7 +320,8 @@ bool TriangleAccel::traverse(const Ray& ray, Hit& hit, Stack& stack) const {
     float tmax = ray.tmax;
     std::uint32_t best = 0xffffffffu, best_prim = 0xffffffffu;
     const BvhNode* nodes = bvh_.nodes.data();
-    if (box_entry(nodes[0].bounds, ray.origin, inv_dir, tmax) == std::numeric_limits<float>::infinity())
+    if (box_entry(nodes[0].bounds, ray.origin, inv_dir, tmax) ==
+        std::numeric_limits<float>::infinity())
         return false;
     stack.push(0);
     while (!stack.empty()) {

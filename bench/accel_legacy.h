@@ -30,13 +30,14 @@ struct BvhNode {
 struct Bvh {
     /// Build settings; defaults suit triangle meshes.
     struct Config {
-        int max_leaf_size = 8;      ///< leaves never hold more (the seed used 10)
-        int bin_count = 16;         ///< SAH bins per axis
-        float traversal_cost = 1.0f;  ///< cost of visiting a node, relative to...
+        int max_leaf_size = 8;           ///< leaves never hold more (the seed used 10)
+        int bin_count = 16;              ///< SAH bins per axis
+        float traversal_cost = 1.0f;     ///< cost of visiting a node, relative to...
         float intersection_cost = 1.0f;  ///< ...testing one primitive
     };
 
-    std::vector<BvhNode> nodes;  ///< nodes[0] is the root; children follow parents; empty if no primitives
+    std::vector<BvhNode>
+        nodes;  ///< nodes[0] is the root; children follow parents; empty if no primitives
     std::vector<std::uint32_t> prim_indices;  ///< primitive ids in leaf order
 
     /// Builds with binned SAH. Deterministic: the same input gives the same tree.
@@ -61,7 +62,8 @@ public:
     void build(std::span<const Vec3f> positions, std::span<const std::array<std::uint32_t, 3>> tris,
                const Bvh::Config& config = {});
     /// Updates for moved vertices with the same triangles (topology kept).
-    void refit(std::span<const Vec3f> positions, std::span<const std::array<std::uint32_t, 3>> tris);
+    void refit(std::span<const Vec3f> positions,
+               std::span<const std::array<std::uint32_t, 3>> tris);
 
     /// Closest hit with 0 < t < ray.tmax. Returns true and fills `hit` when there is one.
     /// Among hits at the same distance the lowest triangle index wins, whatever the tree.

@@ -147,9 +147,9 @@ void for_each_pixel(int w, int h, int threads, const Body& body) {
 // G-buffer writes) on stored rays and hits, so shading is timed apart from traversal. They are
 // handed over in the renderer's 16 x 16 tiles, as trace_primary does; the G-buffer must come out
 // bit-equal to Renderer's, which is checked before anything is timed.
-void shade(const Scene& scene, const TriangleAccel& accel, const ViewPlane& view, const Vec3f& light,
-           const RenderSettings& settings, const std::vector<Vec3f>& ray_dirs, const std::vector<Hit>& hits,
-           GBuffer& g, int threads) {
+void shade(const Scene& scene, const TriangleAccel& accel, const ViewPlane& view,
+           const Vec3f& light, const RenderSettings& settings, const std::vector<Vec3f>& ray_dirs,
+           const std::vector<Hit>& hits, GBuffer& g, int threads) {
     const int w = settings.width, h = settings.height;
     const std::vector<Light> lights{Light{Light::Kind::Point, light, 1.0f}};  // as Renderer::render
     const ShadingContext ctx{scene, accel, settings.shading, lights, nullptr};
@@ -340,8 +340,7 @@ HitCheck check_embree(const Scene& scene, const TriangleAccel& accel, const Embr
                 ++c.agree;
             } else if (ho && he && o.prim == e.prim) {
                 ExactHit ex;
-                if (close(o.t, e.t))
-                    ++c.agree;
+                if (close(o.t, e.t)) ++c.agree;
                 else if (ex = exact_hit(scene, ray, o.prim);
                          std::abs(o.t - ex.t) <= ex.t * (1e-4 + 4 * FLT_EPSILON / std::abs(ex.cos)))
                     ++c.grazing;
@@ -500,7 +499,8 @@ SceneResult bench_scene(const fs::path& path, const Options& opt) {
     // 3. The shading stage on stored hits against the renderer, for both thread counts.
     RenderSettings settings = fro.settings;
     std::vector<Hit> hits(static_cast<std::size_t>(w) * h);
-    std::vector<Vec3f> dirs(hits.size());  // kept for the shading stage, as trace_primary hands them on
+    std::vector<Vec3f> dirs(
+        hits.size());  // kept for the shading stage, as trace_primary hands them on
     auto trace = [&](int threads) {
         for_each_pixel(w, h, threads, [&](int x, int y) {
             Hit hit;
@@ -603,7 +603,8 @@ SceneResult bench_scene(const fs::path& path, const Options& opt) {
     };
     auto blur = [&](int t) {
         merge_edges(a.edges_depth, a.edges_normal, a.edges);
-        compose_lines(g.colour, a.edges, composed, t, &a.cel);  // with the cel AOV, as the renderer does
+        compose_lines(g.colour, a.edges, composed, t,
+                      &a.cel);  // with the cel AOV, as the renderer does
     };
     auto edges = [&](int t) {
         maps(t);

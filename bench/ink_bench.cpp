@@ -35,7 +35,9 @@ using Clock = std::chrono::steady_clock;
 
 double median(std::vector<double> v) {
     std::sort(v.begin(), v.end());
-    return v.empty() ? 0.0 : (v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]));
+    return v.empty()
+               ? 0.0
+               : (v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]));
 }
 
 int count_specks(const ImageGray8& lines) {
@@ -78,8 +80,9 @@ struct Options {
 };
 
 int run(const Options& options) {
-    fmt::print("| scene | triangles | classic frame | robust frame | ink frame | ink frame, 1 sample | "
-               "ink 1 sample / classic | ink: edges | visibility | chaining | drawing | specks robust / ink |\n");
+    fmt::print(
+        "| scene | triangles | classic frame | robust frame | ink frame | ink frame, 1 sample | "
+        "ink 1 sample / classic | ink: edges | visibility | chaining | drawing | specks robust / ink |\n");
     fmt::print("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
     int failures = 0;
     for (const fs::path& path : options.scenes) {
@@ -97,7 +100,8 @@ int run(const Options& options) {
         // Whole frames on one thread: trace, shade, lines, compose.
         // Whole frames on one thread: trace, shade, lines, compose. Then once more with the
         // feature images, which the speck counts and --out read.
-        auto time_frame = [&](EdgeMode mode, Renderer& renderer, int samples = RenderSettings{}.samples) {
+        auto time_frame = [&](EdgeMode mode, Renderer& renderer,
+                              int samples = RenderSettings{}.samples) {
             RenderSettings settings = file_options.settings;
             settings.edges = mode;
             settings.samples = samples;
@@ -106,7 +110,8 @@ int run(const Options& options) {
             for (int i = 0; i <= repeats; ++i) {
                 const auto start = Clock::now();
                 renderer.render(scene, accel, camera, settings);
-                if (i > 0 || repeats == 0) t.push_back(std::chrono::duration<double>(Clock::now() - start).count());
+                if (i > 0 || repeats == 0)
+                    t.push_back(std::chrono::duration<double>(Clock::now() - start).count());
             }
             settings.feature_images = true;
             renderer.render(scene, accel, camera, settings);
@@ -128,14 +133,17 @@ int run(const Options& options) {
             visibility.push_back(lines.timings.visibility);
             chaining.push_back(lines.timings.chaining);
             drawing.push_back(lines.timings.drawing);
-            total.push_back(lines.timings.edges + lines.timings.visibility + lines.timings.chaining +
-                            lines.timings.drawing);
+            total.push_back(lines.timings.edges + lines.timings.visibility +
+                            lines.timings.chaining + lines.timings.drawing);
         }
         if (options.quick) {
             ink::InkLines threaded;
-            ink::draw_ink_lines(scene, accel, camera, options.width, options.height, {}, 0, threaded);
-            if (!std::equal(lines.coverage.data(), lines.coverage.data() + lines.coverage.size(), threaded.coverage.data())) {
-                fmt::print(stderr, "{}: ink lines differ between one thread and all threads\n", path.string());
+            ink::draw_ink_lines(scene, accel, camera, options.width, options.height, {}, 0,
+                                threaded);
+            if (!std::equal(lines.coverage.data(), lines.coverage.data() + lines.coverage.size(),
+                            threaded.coverage.data())) {
+                fmt::print(stderr, "{}: ink lines differ between one thread and all threads\n",
+                           path.string());
                 ++failures;
             }
         }
@@ -144,16 +152,18 @@ int run(const Options& options) {
         const int ink_specks = count_specks(ink_gray);
         const int robust_specks = count_specks(robust.aovs().edges);
         auto ms = [](double s) { return fmt::format("{:.1f} ms", s * 1e3); };
-        fmt::print("| {} | {} | {} | {} | {} | {} | {:.2f} | {} | {} | {} | {} | {} / {} |\n", path.filename().string(),
-                   scene.triangle_count(), ms(classic_s), ms(robust_s), ms(ink_s), ms(ink1_s), ink1_s / classic_s,
-                   ms(median(edges)), ms(median(visibility)), ms(median(chaining)), ms(median(drawing)),
-                   robust_specks, ink_specks);
+        fmt::print("| {} | {} | {} | {} | {} | {} | {:.2f} | {} | {} | {} | {} | {} / {} |\n",
+                   path.filename().string(), scene.triangle_count(), ms(classic_s), ms(robust_s),
+                   ms(ink_s), ms(ink1_s), ink1_s / classic_s, ms(median(edges)),
+                   ms(median(visibility)), ms(median(chaining)), ms(median(drawing)), robust_specks,
+                   ink_specks);
         if (options.out) {
             fs::create_directories(*options.out);
             const std::string stem = path.stem().string();
             RenderSettings settings = file_options.settings;
             settings.edges = EdgeMode::Ink;
-            write_png(*options.out / (stem + "_ink.png"), inked.render(scene, accel, camera, settings));
+            write_png(*options.out / (stem + "_ink.png"),
+                      inked.render(scene, accel, camera, settings));
             write_png(*options.out / (stem + "_ink_edges.png"), ink_gray);
             write_png(*options.out / (stem + "_robust_edges.png"), robust.aovs().edges);
             ink::SvgSettings svg;
@@ -161,8 +171,9 @@ int run(const Options& options) {
             svg.height = options.height;
             svg.thickness = ink::stroke_thickness(2.0f, options.height);
             const std::string text = ink::svg_text(lines.strokes, svg);
-            write_file_atomic(*options.out / (stem + "_ink.svg"),
-                              std::span(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()));
+            write_file_atomic(
+                *options.out / (stem + "_ink.svg"),
+                std::span(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()));
         }
     }
     return failures ? 1 : 0;
@@ -193,7 +204,8 @@ int main(int argc, char** argv) {
             else if (!arg.empty() && arg[0] == '-') throw toonray::Error("unknown option " + arg);
             else options.scenes.emplace_back(arg);
         }
-        if (options.scenes.empty()) options.scenes.emplace_back(TOONRAY_BENCH_DATA_DIR "/teapot.obj");
+        if (options.scenes.empty())
+            options.scenes.emplace_back(TOONRAY_BENCH_DATA_DIR "/teapot.obj");
         return run(options);
     } catch (const std::exception& e) {
         std::fprintf(stderr, "toonray_ink_bench: %s\n", e.what());

@@ -18,7 +18,12 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         return 0;
     }
     FUZZ_CHECK(!path.empty());
-    std::vector<double> times = {-1e9, -1.0, 0.0, 0.5, 1e9, std::numeric_limits<double>::infinity(),
+    std::vector<double> times = {-1e9,
+                                 -1.0,
+                                 0.0,
+                                 0.5,
+                                 1e9,
+                                 std::numeric_limits<double>::infinity(),
                                  std::numeric_limits<double>::quiet_NaN()};
     for (const CameraKey& k : path.keys()) {
         times.push_back(k.time);

@@ -25,7 +25,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     for (std::size_t i = 0; i < n; ++i) {
         for (int c = 0; c < 3; ++c) {
             FUZZ_CHECK(scene.tri_positions[i][c] < scene.positions.size());
-            FUZZ_CHECK(scene.tri_normals[i][c] == kNoIndex || scene.tri_normals[i][c] < scene.normals.size());
+            FUZZ_CHECK(scene.tri_normals[i][c] == kNoIndex ||
+                       scene.tri_normals[i][c] < scene.normals.size());
             FUZZ_CHECK(scene.tri_texcoords[i][c] == kNoIndex ||
                        scene.tri_texcoords[i][c] < scene.texcoords.size());
         }
@@ -36,7 +37,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     for (const Vec3f& p : scene.normals) FUZZ_CHECK(is_finite(p));
     for (const Vec2f& t : scene.texcoords) FUZZ_CHECK(std::isfinite(t.x) && std::isfinite(t.y));
     if (scene.camera) {
-        FUZZ_CHECK(is_finite(scene.camera->eye) && is_finite(scene.camera->gaze) && is_finite(scene.camera->up));
+        FUZZ_CHECK(is_finite(scene.camera->eye) && is_finite(scene.camera->gaze) &&
+                   is_finite(scene.camera->up));
         FUZZ_CHECK(!(scene.camera->eye == scene.camera->gaze));
     }
     (void)scene.bounds();

@@ -39,7 +39,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
                     std::string name = p.format(frame);
                     // A pattern names a file in the output directory, never a path out of it.
                     FUZZ_CHECK(name.find('/') == std::string::npos);
-                    FUZZ_CHECK(name.find('\0') == std::string::npos || text.find('\0') != std::string::npos);
+                    FUZZ_CHECK(name.find('\0') == std::string::npos ||
+                               text.find('\0') != std::string::npos);
                 }
                 break;
             }

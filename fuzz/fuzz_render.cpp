@@ -35,7 +35,8 @@ std::uint32_t bits(float f) {
 }
 
 bool same_hit(const Hit& a, const Hit& b) {
-    return a.prim == b.prim && bits(a.t) == bits(b.t) && bits(a.u) == bits(b.u) && bits(a.v) == bits(b.v);
+    return a.prim == b.prim && bits(a.t) == bits(b.t) && bits(a.u) == bits(b.u) &&
+           bits(a.v) == bits(b.v);
 }
 
 // The lowest (t, index) over the triangles whose watertight test passes: what the accelerator
@@ -47,7 +48,8 @@ Hit brute_force(const Scene& scene, const Ray& ray) {
         Ray r = ray;
         r.tmax = std::min(best.t, ray.tmax);
         float t, u, v;
-        if (intersect_triangle(r, scene.positions[tri[0]], scene.positions[tri[1]], scene.positions[tri[2]], t, u, v))
+        if (intersect_triangle(r, scene.positions[tri[0]], scene.positions[tri[1]],
+                               scene.positions[tri[2]], t, u, v))
             best = Hit{t, i, u, v};
     }
     return best;
@@ -73,7 +75,8 @@ struct IsaGuard {
 // Traces the camera's pixel rays (as the renderer makes them) as one tile and one by one with
 // the current kernels; both must agree with each other and with `reference` (brute force on the
 // first instruction set, then that set's hits), which is filled on the first call.
-void check_hits(const Scene& scene, const TriangleAccel& accel, const ViewPlane& view, std::vector<Hit>& reference) {
+void check_hits(const Scene& scene, const TriangleAccel& accel, const ViewPlane& view,
+                std::vector<Hit>& reference) {
     std::vector<Vec3f> dirs(kWidth * kHeight);
     for (int y = 0; y < kHeight; ++y)
         for (int x = 0; x < kWidth; ++x)
@@ -111,7 +114,9 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     settings.width = kWidth;
     settings.height = kHeight;
     settings.threads = 1;
-    CameraSpec camera = scene.camera ? *scene.camera : auto_camera(scene.positions, settings.width, settings.height);
+    CameraSpec camera = scene.camera
+                            ? *scene.camera
+                            : auto_camera(scene.positions, settings.width, settings.height);
     ViewPlane view;
     try {
         view = make_view_plane(camera, settings.width, settings.height);
@@ -140,7 +145,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
             if (reference.width() == 0) {
                 reference = image;
             } else {
-                FUZZ_CHECK(std::memcmp(image.data(), reference.data(), sizeof(Rgb8) * kWidth * kHeight) == 0);
+                FUZZ_CHECK(std::memcmp(image.data(), reference.data(),
+                                       sizeof(Rgb8) * kWidth * kHeight) == 0);
             }
         }
     }

@@ -18,8 +18,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         switch (data[0] % 3) {
             case 0: {
                 ToonRamp ramp = parse_ramp(text);
-                FUZZ_CHECK(!ramp.levels.empty() && ramp.thresholds.size() + 1 == ramp.levels.size());
-                for (float d : {-1.0f, 0.0f, 0.3f, 1.0f, 2.0f}) FUZZ_CHECK(std::isfinite(ramp.level(d)));
+                FUZZ_CHECK(!ramp.levels.empty() &&
+                           ramp.thresholds.size() + 1 == ramp.levels.size());
+                for (float d : {-1.0f, 0.0f, 0.3f, 1.0f, 2.0f})
+                    FUZZ_CHECK(std::isfinite(ramp.level(d)));
                 break;
             }
             case 1: {
@@ -29,7 +31,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
             }
             case 2: {
                 for (const Light& l : parse_lights(text, "fuzz.lights"))
-                    FUZZ_CHECK(is_finite(l.vector) && std::isfinite(l.intensity) && l.intensity >= 0);
+                    FUZZ_CHECK(is_finite(l.vector) && std::isfinite(l.intensity) &&
+                               l.intensity >= 0);
                 break;
             }
         }

@@ -25,6 +25,8 @@ stage_done() {
 
 bash scripts/install-deps.sh all
 stage_done "installing dependencies"
+# The sources are in the repository's .clang-format style (bash scripts/format.sh applies it).
+bash scripts/format.sh --check
 bash scripts/build.sh -DTOONRAY_BUILD_TESTS=ON -DTOONRAY_BUILD_BENCH=ON -DTOONRAY_WARNINGS_AS_ERRORS=ON
 stage_done "the Release build"
 ctest --test-dir "${TOONRAY_BUILD_DIR:-build}" --output-on-failure --parallel "$(nproc)" --timeout 900

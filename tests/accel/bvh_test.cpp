@@ -34,7 +34,8 @@ Hit brute_force(const Soup& s, const Ray& ray) {
 }
 
 // Rays from random points on a sphere around the mesh towards random points inside it.
-void expect_matches_brute_force(const Soup& s, const TriangleAccel& accel, int rays, unsigned seed) {
+void expect_matches_brute_force(const Soup& s, const TriangleAccel& accel, int rays,
+                                unsigned seed) {
     BBox box;
     for (const Vec3f& p : s.positions) box.extend(p);
     float radius = length(box.extent());

@@ -18,15 +18,16 @@ using namespace toonray;
 namespace {
 
 using test_support::from_obj;
-using test_support::isas;
 using test_support::IsaGuard;
+using test_support::isas;
 using test_support::random_soup;
 using test_support::Soup;
 
 bool brute_force_occluded(const Soup& s, const Ray& ray) {
     for (const auto& tri : s.tris) {
         float t, u, v;
-        if (intersect_triangle(ray, s.positions[tri[0]], s.positions[tri[1]], s.positions[tri[2]], t, u, v))
+        if (intersect_triangle(ray, s.positions[tri[0]], s.positions[tri[1]], s.positions[tri[2]],
+                               t, u, v))
             return true;
     }
     return false;
@@ -62,7 +63,8 @@ void expect_agrees(const Soup& s, int rays, unsigned seed, int check) {
         for (int i = 0; i < rays; ++i) {
             // Half from outside, half from inside (as shadow rays start on surfaces).
             const Vec3f from =
-                i % 2 ? inside() : box.center() + normalize(Vec3f(n(rng), n(rng), n(rng))) * radius * 1.5f;
+                i % 2 ? inside()
+                      : box.center() + normalize(Vec3f(n(rng), n(rng), n(rng))) * radius * 1.5f;
             const Vec3f dir = inside() - from;
             Hit closest;
             accel.intersect(Ray{from, dir}, closest);
@@ -125,7 +127,8 @@ TEST(Occlusion, SharedEdgesLetNoRayThrough) {
             // is not either (0 < t < tmax).
             EXPECT_FALSE(accel.occluded(Ray{ray.origin, ray.dir, 0.5f})) << isa << " " << x;
             EXPECT_FALSE(accel.occluded(Ray{ray.origin, ray.dir, 1.0f})) << isa << " " << x;
-            EXPECT_TRUE(accel.occluded(Ray{ray.origin, ray.dir, std::nextafter(1.0f, 2.0f)})) << isa << " " << x;
+            EXPECT_TRUE(accel.occluded(Ray{ray.origin, ray.dir, std::nextafter(1.0f, 2.0f)}))
+                << isa << " " << x;
         }
     }
 }

@@ -22,8 +22,8 @@ using namespace toonray;
 namespace {
 
 using test_support::from_obj;
-using test_support::isas;
 using test_support::IsaGuard;
+using test_support::isas;
 using test_support::random_soup;
 using test_support::Soup;
 
@@ -55,8 +55,8 @@ Hit brute_force(const Soup& s, const Ray& ray) {
         float t, u, v;
         Ray r = ray;
         r.tmax = std::min(best.t, ray.tmax);
-        if (intersect_triangle(r, s.positions[s.tris[i][0]], s.positions[s.tris[i][1]], s.positions[s.tris[i][2]],
-                               t, u, v)) {
+        if (intersect_triangle(r, s.positions[s.tris[i][0]], s.positions[s.tris[i][1]],
+                               s.positions[s.tris[i][2]], t, u, v)) {
             best.t = t;
             best.prim = i;
             best.u = u;
@@ -69,8 +69,8 @@ Hit brute_force(const Soup& s, const Ray& ray) {
 // Traces width x height pinhole rays through view (as trace_primary makes them) in tiles of
 // tw x th, and checks every ray: the tile result equals the single-ray result bit for bit, and
 // every `stride`-th equals brute force.
-void check_view(const Soup& s, const TriangleAccel& accel, const ViewPlane& view, int width, int height, int tw,
-                int th, int stride, int* hits_out = nullptr) {
+void check_view(const Soup& s, const TriangleAccel& accel, const ViewPlane& view, int width,
+                int height, int tw, int th, int stride, int* hits_out = nullptr) {
     int hits = 0;
     for (int y0 = 0; y0 < height; y0 += th)
         for (int x0 = 0; x0 < width; x0 += tw) {
@@ -78,7 +78,8 @@ void check_view(const Soup& s, const TriangleAccel& accel, const ViewPlane& view
             std::vector<Vec3f> dirs(static_cast<std::size_t>(w * h));
             for (int y = 0; y < h; ++y)
                 for (int x = 0; x < w; ++x)
-                    dirs[y * w + x] = normalize(view.pixel_point(x0 + x + 0.5f, y0 + y + 0.5f) - view.eye);
+                    dirs[y * w + x] =
+                        normalize(view.pixel_point(x0 + x + 0.5f, y0 + y + 0.5f) - view.eye);
             std::vector<Hit> tile(dirs.size());
             std::unique_ptr<bool[]> found(new bool[dirs.size()]);
             accel.intersect_tile(view.eye, dirs.data(), w, h, tile.data(), found.get());
@@ -181,9 +182,10 @@ TEST(Tile, DegenerateDirectionsAgreeWithSingleRays) {
     const float nan = std::numeric_limits<float>::quiet_NaN();
     const float inf = std::numeric_limits<float>::infinity();
     std::vector<Vec3f> dirs = {
-        {0, 0, 1},   {0, 0, -1},   {1, 0, 0},     {-1, 0, 0},     {0, 1, 0},    {0, -1, 0},  {0, 0, 0},
-        {nan, 0, 1}, {inf, 0, 0},  {0.0f, -0.0f, -1.0f}, {1e-30f, 0, 1}, {1, 1, 1},   {-1, 1, -1}, {1e-40f, 1, 0},
-        {0.3f, 0.3f, 0.3f}, {-0.0f, 1, 0}};
+        {0, 0, 1},   {0, 0, -1},           {1, 0, 0},          {-1, 0, 0},
+        {0, 1, 0},   {0, -1, 0},           {0, 0, 0},          {nan, 0, 1},
+        {inf, 0, 0}, {0.0f, -0.0f, -1.0f}, {1e-30f, 0, 1},     {1, 1, 1},
+        {-1, 1, -1}, {1e-40f, 1, 0},       {0.3f, 0.3f, 0.3f}, {-0.0f, 1, 0}};
     for (const std::string& isa : isas()) {
         IsaGuard guard(isa);
         for (const Vec3f& origin : {Vec3f(0.0f), Vec3f(0.1f, -0.2f, -3.0f)}) {
@@ -216,7 +218,8 @@ TEST(Tile, TmaxAndEmptyAccelerator) {
     EXPECT_FALSE(found[1]);
     accel.intersect_tile(Vec3f(0.0f), dirs, 2, 1, hits, found, 4.0f);
     EXPECT_FALSE(found[0]);
-    accel.intersect_tile(Vec3f(0.0f), dirs, 2, 1, hits, found, 5.0f);  // hits must be strictly inside tmax
+    accel.intersect_tile(Vec3f(0.0f), dirs, 2, 1, hits, found,
+                         5.0f);  // hits must be strictly inside tmax
     EXPECT_FALSE(found[0]);
     TriangleAccel empty;
     empty.build({}, {});
@@ -229,7 +232,8 @@ TEST(Tile, TmaxAndEmptyAccelerator) {
 TEST(Tile, LargeLeavesAndLargeTiles) {
     // Leaves of more than 15 triangles are ended by a flag rather than a count.
     Soup s = random_soup(400, 8, 0.05f);
-    for (int i = 0; i < 200; ++i) s.tris.push_back(s.tris[static_cast<std::size_t>(i) * 2]);  // exact duplicates
+    for (int i = 0; i < 200; ++i)
+        s.tris.push_back(s.tris[static_cast<std::size_t>(i) * 2]);  // exact duplicates
     Bvh::Config config;
     config.max_leaf_size = 64;
     config.traversal_cost = 100.0f;  // leaves as large as allowed

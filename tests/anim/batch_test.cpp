@@ -35,22 +35,25 @@ using toonray::test_support::TempDir;
 std::string frame_obj(int frame) {
     std::string s = "mtllib frame.mtl\n";
     float a = 0.05f * frame;
-    s += "# Camera start\nv " + std::to_string(3 * std::sin(a)) + " 1.5 " + std::to_string(3 * std::cos(a)) +
-         "\nv " + std::to_string(2 * std::sin(a)) + " 1.2 " + std::to_string(2 * std::cos(a)) +
-         "\nvn 0 1 0\nc -2 -1 -1\n# Camera end\n";
+    s += "# Camera start\nv " + std::to_string(3 * std::sin(a)) + " 1.5 " +
+         std::to_string(3 * std::cos(a)) + "\nv " + std::to_string(2 * std::sin(a)) + " 1.2 " +
+         std::to_string(2 * std::cos(a)) + "\nvn 0 1 0\nc -2 -1 -1\n# Camera end\n";
     s += "o box\nusemtl red\n";
     for (int i = 0; i < 8; ++i)
-        s += "v " + std::to_string((i & 1) ? 0.5f : -0.5f) + " " + std::to_string((i & 2) ? 1.0f : 0.0f) +
-             " " + std::to_string((i & 4) ? 0.5f : -0.5f) + "\n";
-    s += "f -8 -7 -5 -6\nf -4 -3 -1 -2\nf -8 -6 -2 -4\nf -7 -3 -1 -5\nf -8 -4 -3 -7\nf -6 -5 -1 -2\n";
+        s += "v " + std::to_string((i & 1) ? 0.5f : -0.5f) + " " +
+             std::to_string((i & 2) ? 1.0f : 0.0f) + " " + std::to_string((i & 4) ? 0.5f : -0.5f) +
+             "\n";
+    s +=
+        "f -8 -7 -5 -6\nf -4 -3 -1 -2\nf -8 -6 -2 -4\nf -7 -3 -1 -5\nf -8 -4 -3 -7\nf -6 -5 -1 -2\n";
     s += "o strip\nusemtl blue\n";
     int n = 10 + frame % 37;
     for (int i = 0; i <= n; ++i)
-        s += "v " + std::to_string(-1 + 2.0f * i / n) + " 0 1\nv " + std::to_string(-1 + 2.0f * i / n) + " 0.3 1.2\n";
+        s += "v " + std::to_string(-1 + 2.0f * i / n) + " 0 1\nv " +
+             std::to_string(-1 + 2.0f * i / n) + " 0.3 1.2\n";
     for (int i = 0; i < n; ++i) {
         int b = -2 * (n + 1) + 2 * i;
-        s += "f " + std::to_string(b) + " " + std::to_string(b + 2) + " " + std::to_string(b + 3) + " " +
-             std::to_string(b + 1) + "\n";
+        s += "f " + std::to_string(b) + " " + std::to_string(b + 2) + " " + std::to_string(b + 3) +
+             " " + std::to_string(b + 1) + "\n";
     }
     return s;
 }
@@ -94,7 +97,8 @@ TEST(FramePattern, FormatsAndValidates) {
     EXPECT_EQ(FramePattern("keys_%06d.obj").format(42), "keys_000042.obj");
     EXPECT_EQ(FramePattern("k%d.obj").format(7), "k7.obj");
     EXPECT_EQ(FramePattern("100%%_%04d.png").format(3), "100%_0003.png");
-    for (const char* bad : {"keys.obj", "%d_%d.obj", "%s.obj", "%6d.obj", "%010d.obj", "a/%d.obj", "%"})
+    for (const char* bad :
+         {"keys.obj", "%d_%d.obj", "%s.obj", "%6d.obj", "%010d.obj", "a/%d.obj", "%"})
         EXPECT_THROW(FramePattern{bad}, Error) << bad;
 }
 
@@ -199,7 +203,8 @@ TEST(Batch, BadFramesAreReportedAndTheRestRendered) {
     EXPECT_EQ(r.rendered, 3);
     ASSERT_EQ(r.failed, 2);
     EXPECT_EQ(r.failures[0].frame, 2);
-    EXPECT_NE(r.failures[0].message.find("keys_000002.obj:4: face vertex index 9 out of range"), std::string::npos)
+    EXPECT_NE(r.failures[0].message.find("keys_000002.obj:4: face vertex index 9 out of range"),
+              std::string::npos)
         << r.failures[0].message;
     EXPECT_EQ(r.failures[1].frame, 4);
     EXPECT_NE(r.failures[1].message.find("no input file for frame 4"), std::string::npos);

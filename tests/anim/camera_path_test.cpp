@@ -91,9 +91,14 @@ TEST(CameraPath, SpeedIsContinuousAtKeysWithUnevenTimes) {
     int moving_keys = 0;
     for (std::size_t i = 1; i + 1 < path.keys().size(); ++i) {
         const double t = path.keys()[i].time;
-        struct Channel { const char* name; std::function<Vec3f(double)> at; float scale; };
-        for (const Channel& c : {Channel{"eye", eye, top_speed},
-                                 Channel{"target", target, top_speed}, Channel{"fov", fov, 10.0f}}) {
+        struct Channel {
+            const char* name;
+            std::function<Vec3f(double)> at;
+            float scale;
+        };
+        for (const Channel& c :
+             {Channel{"eye", eye, top_speed}, Channel{"target", target, top_speed},
+              Channel{"fov", fov, 10.0f}}) {
             const Vec3f before = one_sided_velocity(c.at, t, -1);
             const Vec3f after = one_sided_velocity(c.at, t, +1);
             const float speed = std::max(length(before), length(after));
@@ -116,7 +121,8 @@ key 1  eye 1 1 3    target 0 1 0
 key 4  eye 1.2 1 3  target 0 1 0
 key 6  eye 1.2 1 3  target 0 1 0
 key 7  eye 3 1 3    target 0 1 0
-)", "hold");
+)",
+                                        "hold");
     float last_x = -1;
     for (int i = 0; i <= 700; ++i) {
         const float x = path.pose(i * 0.01).eye.x;
@@ -156,7 +162,8 @@ TEST(CameraPath, CameraSpecMatchesTheSeedConvention) {
 TEST(CameraPath, UpIsReorthogonalised) {
     CameraPath path = parse_camera_path(
         "key 0 eye 0 2 2 target 0 0 0 up 0 1 0 fov 40\n"
-        "key 1 eye 2 2 0 target 0 0 0 up 0 5 0 fov 40\n", "up");
+        "key 1 eye 2 2 0 target 0 0 0 up 0 5 0 fov 40\n",
+        "up");
     for (double t = 0; t <= 1.0; t += 0.1) {
         const CameraSpec c = path.camera(t);
         EXPECT_NEAR(length(c.up), 1.0f, 1e-5f);
@@ -170,7 +177,8 @@ key 0  eye 0 1 3      target 0 0.5 0
 key 3  eye 2 1.5 2    target 0 0.5 0 fov 50
 key 6  eye 0.5 1.2 2.5 target 0 0.8 0 fov 40
 key 8  eye -1.5 0.8 2.5 target 0 0.6 0
-)", "loop");
+)",
+                                        "loop");
     ASSERT_TRUE(path.loop_period());
     EXPECT_DOUBLE_EQ(*path.loop_period(), 10.0);
     for (double t : {0.0, 1.3, 4.2, 7.7, 9.99}) {
@@ -225,7 +233,8 @@ TEST(CameraPath, ErrorsNameFileAndLine) {
               "test.campath:2: malformed number 'x' after 'key'");
     EXPECT_EQ(error_of(k0 + "key nan eye 0 1 2 target 0 0 0\n"),
               "test.campath:2: malformed number 'nan' after 'key'");
-    EXPECT_EQ(error_of(k0 + "loop 10 20\n"), "test.campath:2: unexpected '20' at the end of the line");
+    EXPECT_EQ(error_of(k0 + "loop 10 20\n"),
+              "test.campath:2: unexpected '20' at the end of the line");
     EXPECT_EQ(error_of("loop 1\n" + k0 + "key 1 eye 0 1 3 target 0 0 0\n"),
               "test.campath:1: loop period 1 s must be longer than the keys' span 1 s: after the "
               "last key the path returns to the first (leave out a closing key equal to the "
@@ -237,18 +246,25 @@ TEST(CameraPath, ErrorsNameFileAndLine) {
 
 TEST(CameraPath, DegenerateCameraBetweenKeysIsReported) {
     // The eye flies through the target.
-    std::string e = error_of("key 0 eye 0 1 2 target 0 1 0\n"
-                             "key 2 eye 0 1 -2 target 0 1 0\n");
+    std::string e = error_of(
+        "key 0 eye 0 1 2 target 0 1 0\n"
+        "key 2 eye 0 1 -2 target 0 1 0\n");
     EXPECT_EQ(e.rfind("test.campath:1: between this key (0 s) and the next (2 s, line 2) the eye "
-                      "reaches the target", 0), 0u) << e;
+                      "reaches the target",
+                      0),
+              0u)
+        << e;
     // Up flips over.
-    e = error_of("key 0 eye 0 0 2 target 0 0 0 up 0 1 0\n"
-                 "key 1 eye 0 0 2 target 0 0 0 up 0 -1 0\n");
+    e = error_of(
+        "key 0 eye 0 0 2 target 0 0 0 up 0 1 0\n"
+        "key 1 eye 0 0 2 target 0 0 0 up 0 -1 0\n");
     EXPECT_NE(e.find("the up vector vanishes"), std::string::npos) << e;
     // Looking straight down on the way between two fine keys.
-    e = error_of("key 0 eye 1 2 0 target 0 0 0\n"
-                 "key 1 eye -1 2 0 target 0 0 0\n");
-    EXPECT_NE(e.find("up turns parallel to the view direction near 0.500 s"), std::string::npos) << e;
+    e = error_of(
+        "key 0 eye 1 2 0 target 0 0 0\n"
+        "key 1 eye -1 2 0 target 0 0 0\n");
+    EXPECT_NE(e.find("up turns parallel to the view direction near 0.500 s"), std::string::npos)
+        << e;
 }
 
 TEST(CameraPath, BuiltInCodeAndSingleKey) {
@@ -326,7 +342,8 @@ TEST(EntertainerPath, LoadsLoopsAndKeepsClearOfThePiano) {
             continue;
         const Vec3f v = p - start.eye;
         widest = std::max(widest, std::abs(dot(v, right) / dot(v, dir)) / half_width);
-        highest = std::max(highest, std::abs(dot(v, start.up) / dot(v, dir)) / (half_width * 9 / 16));
+        highest =
+            std::max(highest, std::abs(dot(v, start.up) / dot(v, dir)) / (half_width * 9 / 16));
     }
     EXPECT_LT(widest, 0.95f) << "the piano is wider than the opening view";
     EXPECT_LT(highest, 0.95f) << "the piano is taller than the opening view";

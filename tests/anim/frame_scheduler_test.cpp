@@ -22,7 +22,9 @@ class FakeFrames : public FrameSource {
 public:
     explicit FakeFrames(fs::path dir) : dir_(std::move(dir)) {}
 
-    [[nodiscard]] fs::path output(int frame) const override { return dir_ / ("f" + std::to_string(frame) + ".png"); }
+    [[nodiscard]] fs::path output(int frame) const override {
+        return dir_ / ("f" + std::to_string(frame) + ".png");
+    }
 
     std::unique_ptr<FrameJob> make_job(int jobs) override {
         jobs_seen = jobs;
@@ -46,14 +48,16 @@ private:
             {
                 std::lock_guard lock(source_.mutex);
                 if (expected_ && *expected_ != frame)
-                    source_.broken_promises.push_back(std::to_string(*expected_) + " then " + std::to_string(frame));
+                    source_.broken_promises.push_back(std::to_string(*expected_) + " then " +
+                                                      std::to_string(frame));
                 source_.produced.insert(frame);
             }
             expected_ = next;
             if (source_.cancel_after_first) *source_.cancel_after_first = true;
             if (source_.warned.count(frame)) warnings.push_back("look at " + std::to_string(frame));
             if (source_.bad.count(frame)) throw Error("frame " + std::to_string(frame) + " is bad");
-            if (source_.limited.count(frame)) throw LimitError(Limit::Triangles, "too many triangles");
+            if (source_.limited.count(frame))
+                throw LimitError(Limit::Triangles, "too many triangles");
             write_png(source_.output(frame), ImageGray8(2, 2));
         }
 
@@ -70,7 +74,9 @@ struct Recorder : BatchObserver {
         done[frame] = status;
         if (!message.empty()) messages[frame] = message;
     }
-    void warning(int frame, const std::string& message) override { warnings.emplace_back(frame, message); }
+    void warning(int frame, const std::string& message) override {
+        warnings.emplace_back(frame, message);
+    }
     std::map<int, FrameStatus> done;
     std::map<int, std::string> messages;
     std::vector<std::pair<int, std::string>> warnings;

@@ -78,7 +78,8 @@ TEST(PianoMovie, ExportedObjFramesRenderIdenticallyWithBatch) {
         ASSERT_FALSE(a.empty());
         EXPECT_EQ(a, bytes(dir.path / "batch" / name)) << name;
     }
-    EXPECT_NE(bytes(dir.path / "memory/keys_000001.png"), bytes(dir.path / "memory/keys_000006.png"));
+    EXPECT_NE(bytes(dir.path / "memory/keys_000001.png"),
+              bytes(dir.path / "memory/keys_000006.png"));
 }
 
 TEST(PianoMovie, JobsGiveIdenticalFrames) {
@@ -120,7 +121,9 @@ TEST(PianoMovie, BadOptionsAreErrors) {
     options.start = -1;
     EXPECT_EQ(error_of(), "start time -1 s: must not be negative");
     options.start = 1e6;  // past the end of the music
-    EXPECT_EQ(error_of(), "nothing to render: the length is zero (an empty score, or a start time past its end)");
+    EXPECT_EQ(
+        error_of(),
+        "nothing to render: the length is zero (an empty score, or a start time past its end)");
     options.start = 0;
     options.name = "a/b";
     EXPECT_EQ(error_of(), "frame name 'a/b': must be a plain file name");
@@ -140,9 +143,11 @@ TEST(PianoMovie, EveryOnsetInTheFirstThirtySecondsShowsItsKeyDown) {
         double t = (frame - 1) / fps;
         ASSERT_GE(t, n.start - 1e-9);
         ASSERT_LT(t, n.start + 1.0 / fps);
-        EXPECT_TRUE(play.is_key_down(n.key, t)) << "note " << n.key << " at " << n.start << " s, frame " << frame;
+        EXPECT_TRUE(play.is_key_down(n.key, t))
+            << "note " << n.key << " at " << n.start << " s, frame " << frame;
         PianoPose pose = play.pose_at(t);
-        EXPECT_GE(pose.key_angle[static_cast<std::size_t>(n.key - 21)], kKeyDownDepth * play.settings().key_dip_angle);
+        EXPECT_GE(pose.key_angle[static_cast<std::size_t>(n.key - 21)],
+                  kKeyDownDepth * play.settings().key_dip_angle);
         ++checked;
     }
     EXPECT_GT(checked, 250);

@@ -24,7 +24,8 @@ void write_frames(const TempDir& dir, int count) {
         char name[64];
         std::snprintf(name, sizeof name, "in/keys_%06d.obj", f);
         float x = 0.02f * f;
-        std::string camera = "v " + std::to_string(x) + " 2 8\nv " + std::to_string(x) + " 1.8 7\nvn 0 1 0\nc -2 -1 -1\n";
+        std::string camera = "v " + std::to_string(x) + " 2 8\nv " + std::to_string(x) +
+                             " 1.8 7\nvn 0 1 0\nc -2 -1 -1\n";
         dir.write(name, teapot + camera);
     }
 }
@@ -46,8 +47,10 @@ TEST(BatchCli, RendersASequenceAndReportsFailuresWithExitCode) {
                                   (dir / "png").string() + " --size 160x90 --quiet");
     EXPECT_EQ(r.exit_code, 1) << r.output;
     EXPECT_NE(r.output.find("frame 3 failed"), std::string::npos) << r.output;
-    EXPECT_NE(r.output.find("keys_000003.obj:4: face vertex index 0"), std::string::npos) << r.output;
-    EXPECT_NE(r.output.find("3 rendered, 0 skipped, 1 failed of 4 frames"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("keys_000003.obj:4: face vertex index 0"), std::string::npos)
+        << r.output;
+    EXPECT_NE(r.output.find("3 rendered, 0 skipped, 1 failed of 4 frames"), std::string::npos)
+        << r.output;
     EXPECT_EQ(count_files(dir / "png", ".png"), 3);
 }
 
@@ -55,19 +58,20 @@ TEST(BatchCli, ShardsTogetherRenderEveryFrameOnce) {
     TempDir dir("cli_shard");
     write_frames(dir, 7);
     for (int k = 1; k <= 3; ++k) {
-        CommandResult r = run_toonray("batch keys 1 7 --input " + (dir / "in").string() + " --output " +
-                                      (dir / "png").string() + " --size 64x36 --quiet --shard " +
-                                      std::to_string(k) + "/3");
+        CommandResult r = run_toonray("batch keys 1 7 --input " + (dir / "in").string() +
+                                      " --output " + (dir / "png").string() +
+                                      " --size 64x36 --quiet --shard " + std::to_string(k) + "/3");
         ASSERT_EQ(r.exit_code, 0) << r.output;
     }
     EXPECT_EQ(count_files(dir / "png", ".png"), 7);
-    CommandResult env = run_toonray("batch keys 1 7 --input " + (dir / "in").string() + " --output " +
-                                    (dir / "png2").string() + " --size 64x36 --quiet");
+    CommandResult env =
+        run_toonray("batch keys 1 7 --input " + (dir / "in").string() + " --output " +
+                    (dir / "png2").string() + " --size 64x36 --quiet");
     ASSERT_EQ(env.exit_code, 0);
     // Slurm variables pick the shard when --shard is absent.
-    std::string cmd = std::string("env SLURM_ARRAY_TASK_ID=2 SLURM_ARRAY_TASK_COUNT=3 ") + TOONRAY_CLI +
-                      " batch keys 1 7 --input " + (dir / "in").string() + " --output " +
-                      (dir / "png3").string() + " --size 64x36 --quiet";
+    std::string cmd = std::string("env SLURM_ARRAY_TASK_ID=2 SLURM_ARRAY_TASK_COUNT=3 ") +
+                      TOONRAY_CLI + " batch keys 1 7 --input " + (dir / "in").string() +
+                      " --output " + (dir / "png3").string() + " --size 64x36 --quiet";
     ASSERT_EQ(std::system(cmd.c_str()), 0);
     EXPECT_EQ(count_files(dir / "png3", ".png"), 2);  // frames 2 and 5
     EXPECT_TRUE(fs::exists(dir / "png3/keys_000005.png"));
@@ -88,8 +92,10 @@ TEST(BatchCli, InterruptStopsCleanlyAndResumeCompletes) {
     const int frames = 150;
     write_frames(dir, frames);
     std::string in = (dir / "in").string(), out = (dir / "png").string();
-    std::vector<std::string> args = {TOONRAY_CLI, "batch", "keys", "1", std::to_string(frames), "--input", in,
-                                     "--output", out, "--size", "640x360", "--quiet", "--jobs", "2"};
+    std::vector<std::string> args = {
+        TOONRAY_CLI, "batch",   "keys",     "1", std::to_string(frames),
+        "--input",   in,        "--output", out, "--size",
+        "640x360",   "--quiet", "--jobs",   "2"};
     std::vector<char*> argv;
     for (auto& a : args) argv.push_back(a.data());
     argv.push_back(nullptr);
@@ -107,9 +113,10 @@ TEST(BatchCli, InterruptStopsCleanlyAndResumeCompletes) {
     EXPECT_GE(done, 5);
     EXPECT_LT(done, frames) << "the run should have been stopped early";
     EXPECT_EQ(count_files(out, ".tmp"), 0) << "no partial files";
-    for (auto& e : fs::directory_iterator(out)) EXPECT_TRUE(toonray::is_valid_png(e.path())) << e.path();
-    CommandResult r = run_toonray("batch keys 1 " + std::to_string(frames) + " --input " + in + " --output " +
-                                  out + " --size 640x360 --quiet --resume");
+    for (auto& e : fs::directory_iterator(out))
+        EXPECT_TRUE(toonray::is_valid_png(e.path())) << e.path();
+    CommandResult r = run_toonray("batch keys 1 " + std::to_string(frames) + " --input " + in +
+                                  " --output " + out + " --size 640x360 --quiet --resume");
     ASSERT_EQ(r.exit_code, 0) << r.output;
     EXPECT_EQ(count_files(out, ".png"), frames);
 }

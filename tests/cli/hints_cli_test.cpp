@@ -20,14 +20,16 @@ std::string error_line(const std::string& output) {
     const std::size_t at = output.find(prefix);
     if (at == std::string::npos) return "(no error line)";
     const std::size_t end = output.find('\n', at);
-    return output.substr(at + prefix.size(), end == std::string::npos ? std::string::npos : end - at - prefix.size());
+    return output.substr(at + prefix.size(),
+                         end == std::string::npos ? std::string::npos : end - at - prefix.size());
 }
 
 }  // namespace
 
 TEST(HintsCli, BadOptionValuesNameTheirFlag) {
     TempDir dir("cli_hint_flags");
-    const std::string render = "render " + kData + "/teapot.obj -o " + (dir / "o.png").string() + " --size 32x24";
+    const std::string render =
+        "render " + kData + "/teapot.obj -o " + (dir / "o.png").string() + " --size 32x24";
     const std::pair<std::string, std::string> cases[] = {
         {render + " --ramp 0.2@x", "--ramp"},
         {render + " --ramp 0.5,1@0.6,0.2", "--ramp"},
@@ -43,7 +45,8 @@ TEST(HintsCli, BadOptionValuesNameTheirFlag) {
         EXPECT_EQ(r.exit_code, 1) << args << "\n" << r.output;
         const std::string error = error_line(r.output);
         EXPECT_EQ(error.rfind(flag, 0), 0u) << args << "\n" << r.output;
-        EXPECT_EQ(error.find(flag, flag.size()), std::string::npos) << "flag named twice: " << error;
+        EXPECT_EQ(error.find(flag, flag.size()), std::string::npos)
+            << "flag named twice: " << error;
     }
     EXPECT_FALSE(fs::exists(dir / "o.png"));
     EXPECT_EQ(error_line(run_toonray(render + " --max-memory lots").output),
@@ -60,13 +63,17 @@ TEST(HintsCli, LimitsNameOnlyTheOptionsOfTheCommand) {
     EXPECT_EQ(r.exit_code, 1);
     std::string error = error_line(r.output);
     EXPECT_EQ(error.rfind("a 640x480 frame needs about ", 0), 0u) << error;
-    EXPECT_TRUE(error.ends_with(" of memory, more than the limit of 1.0 MiB (--max-memory raises it)")) << error;
+    EXPECT_TRUE(
+        error.ends_with(" of memory, more than the limit of 1.0 MiB (--max-memory raises it)"))
+        << error;
     // `piano` has: its frames in flight can be fewer.
-    r = run_toonray("piano -o " + (dir / "p").string() + " --seconds 1 --size 1024x1024 --jobs 8 --max-memory 1G");
+    r = run_toonray("piano -o " + (dir / "p").string() +
+                    " --seconds 1 --size 1024x1024 --jobs 8 --max-memory 1G");
     EXPECT_EQ(r.exit_code, 1);
     error = error_line(r.output);
     EXPECT_EQ(error.rfind("8 frames at once", 0), 0u) << error;
-    EXPECT_NE(error.find("(--max-memory raises it, or render fewer frames at once with --jobs)"), std::string::npos)
+    EXPECT_NE(error.find("(--max-memory raises it, or render fewer frames at once with --jobs)"),
+              std::string::npos)
         << error;
     EXPECT_FALSE(fs::exists(dir / "o.png"));
 }
@@ -78,10 +85,12 @@ TEST(HintsCli, FramesOverALimitSayHowToRaiseIt) {
     fs::create_directories(dir / "in");
     dir.write("in/keys_000001.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
     dir.write("in/keys_000002.obj", teapot);
-    CommandResult r = run_toonray("batch keys 1 2 --input " + (dir / "in").string() + " --output " +
-                                  (dir / "png").string() + " --size 32x24 --quiet --max-triangles 100");
+    CommandResult r =
+        run_toonray("batch keys 1 2 --input " + (dir / "in").string() + " --output " +
+                    (dir / "png").string() + " --size 32x24 --quiet --max-triangles 100");
     EXPECT_EQ(r.exit_code, 1) << r.output;
-    EXPECT_NE(r.output.find("frame 2 failed: " + (dir / "in" / "keys_000002.obj").string()), std::string::npos)
+    EXPECT_NE(r.output.find("frame 2 failed: " + (dir / "in" / "keys_000002.obj").string()),
+              std::string::npos)
         << r.output;
     EXPECT_NE(r.output.find("--max-triangles raises it"), std::string::npos) << r.output;
     EXPECT_TRUE(fs::exists(dir / "png" / "keys_000001.png"));
@@ -90,9 +99,11 @@ TEST(HintsCli, FramesOverALimitSayHowToRaiseIt) {
 TEST(HintsCli, MissingSoundFontSaysHowToChooseAnother) {
     TempDir dir("cli_hint_soundfont");
     const std::string soundfont = (dir / "gone.sf2").string();
-    CommandResult r = run_toonray("piano -o " + (dir / "frames").string() + " --seconds 0.1 --size 32x24 --quiet --audio " +
+    CommandResult r = run_toonray("piano -o " + (dir / "frames").string() +
+                                  " --seconds 0.1 --size 32x24 --quiet --audio " +
                                   (dir / "a.wav").string() + " --soundfont " + soundfont);
     EXPECT_EQ(r.exit_code, 1) << r.output;
-    EXPECT_EQ(error_line(r.output), soundfont + ": SoundFont not found; --soundfont chooses another");
+    EXPECT_EQ(error_line(r.output),
+              soundfont + ": SoundFont not found; --soundfont chooses another");
     EXPECT_FALSE(fs::exists(dir / "a.wav"));
 }

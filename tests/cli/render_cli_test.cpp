@@ -18,7 +18,8 @@ TEST(RenderCli, HelpDocumentsEveryOptionAndItsDefault) {
                             "--depth-threshold", "--normal-threshold", "--aov", "--threads",
                             "--bvh-leaf-size", "--png-level"})
         EXPECT_NE(r.output.find(opt), std::string::npos) << opt;
-    for (const char* opt : {"--lines", "--crease-angle", "--depth-step", "--line-width", "--line-color", "--samples"})
+    for (const char* opt :
+         {"--lines", "--crease-angle", "--depth-step", "--line-width", "--line-color", "--samples"})
         EXPECT_NE(r.output.find(opt), std::string::npos) << opt;
     for (const char* def : {"1280x720", "robust", "classic", "=8", "=4"})
         EXPECT_NE(r.output.find(def), std::string::npos) << def << "\n" << r.output;
@@ -35,9 +36,10 @@ TEST(RenderCli, RendersTheTeapotAtTheDefaultSize) {
 
 TEST(RenderCli, SizeLightThresholdsAndAovs) {
     TempDir dir("cli_opts");
-    CommandResult r = run_toonray("render " + kData + "/teapot.obj -o " + (dir / "f.png").string() +
-                                  " --size 320x200 --light 4,6,10 --aov " + (dir / "aov").string() +
-                                  " --depth-threshold 8 --normal-threshold 4 --edges classic --threads 2");
+    CommandResult r =
+        run_toonray("render " + kData + "/teapot.obj -o " + (dir / "f.png").string() +
+                    " --size 320x200 --light 4,6,10 --aov " + (dir / "aov").string() +
+                    " --depth-threshold 8 --normal-threshold 4 --edges classic --threads 2");
     ASSERT_EQ(r.exit_code, 0) << r.output;
     EXPECT_EQ(read_png(dir / "f.png").width, 320);
     for (const char* name : {"depth", "normal", "edges_depth", "edges_normal", "edges", "cel"})
@@ -47,16 +49,18 @@ TEST(RenderCli, SizeLightThresholdsAndAovs) {
 TEST(RenderCli, BadSceneIsAnErrorWithFileAndLineAndNoOutput) {
     TempDir dir("cli_bad");
     dir.write("bad.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n");
-    CommandResult r = run_toonray("render " + (dir / "bad.obj").string() + " -o " + (dir / "out.png").string());
+    CommandResult r =
+        run_toonray("render " + (dir / "bad.obj").string() + " -o " + (dir / "out.png").string());
     EXPECT_EQ(r.exit_code, 1);
-    EXPECT_NE(r.output.find("bad.obj:4: face vertex index 4 out of range"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("bad.obj:4: face vertex index 4 out of range"), std::string::npos)
+        << r.output;
     EXPECT_FALSE(fs::exists(dir / "out.png"));
 }
 
 TEST(RenderCli, BadCameraIsAnErrorAndNoOutput) {
     TempDir dir("cli_cam");
-    CommandResult r = run_toonray("render " + kData + "/teapot.obj -o " + (dir / "out.png").string() +
-                                  " --camera 0,0,5,0,0,5,0,1,0");
+    CommandResult r = run_toonray("render " + kData + "/teapot.obj -o " +
+                                  (dir / "out.png").string() + " --camera 0,0,5,0,0,5,0,1,0");
     EXPECT_EQ(r.exit_code, 1);
     EXPECT_NE(r.output.find("eye and gaze point are the same"), std::string::npos) << r.output;
     EXPECT_FALSE(fs::exists(dir / "out.png"));
@@ -65,7 +69,8 @@ TEST(RenderCli, BadCameraIsAnErrorAndNoOutput) {
 TEST(RenderCli, BadOptionValuesAreRejected) {
     TempDir dir("cli_opt");
     std::string base = "render " + kData + "/teapot.obj -o " + (dir / "o.png").string();
-    for (const char* bad : {" --size 0x10", " --light 1,2", " --edges fancy", " --threads -1", " --background 2,0,0"}) {
+    for (const char* bad : {" --size 0x10", " --light 1,2", " --edges fancy", " --threads -1",
+                            " --background 2,0,0"}) {
         CommandResult r = run_toonray(base + bad);
         EXPECT_NE(r.exit_code, 0) << bad;
         EXPECT_FALSE(fs::exists(dir / "o.png")) << bad;
@@ -76,7 +81,8 @@ TEST(RenderCli, BadOptionValuesAreRejected) {
 TEST(RenderCli, MissingMaterialLibraryWarnsAndRenders) {
     TempDir dir("cli_warn");
     dir.write("s.obj", "mtllib gone.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl red\nf 1 2 3\n");
-    CommandResult r = run_toonray("render " + (dir / "s.obj").string() + " -o " + (dir / "o.png").string() + " --size 64x64");
+    CommandResult r = run_toonray("render " + (dir / "s.obj").string() + " -o " +
+                                  (dir / "o.png").string() + " --size 64x64");
     EXPECT_EQ(r.exit_code, 0) << r.output;
     EXPECT_NE(r.output.find("warning"), std::string::npos) << r.output;
     EXPECT_NE(r.output.find("gone.mtl"), std::string::npos) << r.output;
@@ -84,7 +90,8 @@ TEST(RenderCli, MissingMaterialLibraryWarnsAndRenders) {
 }
 
 TEST(RenderCli, UnwritableOutputIsAnError) {
-    CommandResult r = run_toonray("render " + kData + "/teapot.obj -o /nonexistent-dir/o.png --size 32x32");
+    CommandResult r =
+        run_toonray("render " + kData + "/teapot.obj -o /nonexistent-dir/o.png --size 32x32");
     EXPECT_EQ(r.exit_code, 1);
     EXPECT_NE(r.output.find("/nonexistent-dir/o.png"), std::string::npos) << r.output;
 }
@@ -92,10 +99,11 @@ TEST(RenderCli, UnwritableOutputIsAnError) {
 TEST(RenderCli, ToonShadingOptions) {
     TempDir dir("cli_shading");
     std::string base = "render " + kData + "/teapot.obj --size 160x90 -o ";
-    CommandResult r = run_toonray(base + (dir / "a.png").string() +
-                                  " --ramp 0.3,0.6,0.9,1@0.2,0.4,0.7 --light dir:-1,-1,-1 --light 3,4,5@0.5"
-                                  " --shadows --specular --rim 0.3 --samples 9 --line-width 3 --line-color '#402010'"
-                                  " --lines silhouette,crease --crease-angle 60");
+    CommandResult r = run_toonray(
+        base + (dir / "a.png").string() +
+        " --ramp 0.3,0.6,0.9,1@0.2,0.4,0.7 --light dir:-1,-1,-1 --light 3,4,5@0.5"
+        " --shadows --specular --rim 0.3 --samples 9 --line-width 3 --line-color '#402010'"
+        " --lines silhouette,crease --crease-angle 60");
     ASSERT_EQ(r.exit_code, 0) << r.output;
     EXPECT_TRUE(fs::exists(dir / "a.png"));
     dir.write("lights.txt", "point 1 2 3\nsun 1 2 3\n");
@@ -113,30 +121,36 @@ TEST(RenderCli, TexturedObjRendersItsTextureAndAMissingOneWarns) {
     TempDir dir("cli_texture");
     toonray::ImageRgb8 tex(8, 8, toonray::Rgb8{0, 200, 0});
     toonray::write_png(dir / "green.png", tex);
-    dir.write("t.mtl", "newmtl tex\nKd 1 1 1\nmap_Kd green.png\nnewmtl gone\nKd 0.5 0.5 0.5\nmap_Kd nothere.png\n");
-    dir.write("t.obj", "mtllib t.mtl\nv -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
-                       "usemtl tex\nf 1/1 2/2 3/3\nusemtl gone\nf 1/1 3/3 4/4\n");
-    CommandResult r = run_toonray("render " + (dir / "t.obj").string() + " -o " + (dir / "t.png").string() +
-                                  " --size 64x64 --camera 0,0,3,0,0,2,0,1,0 --light 0,0,10 --lines none");
+    dir.write(
+        "t.mtl",
+        "newmtl tex\nKd 1 1 1\nmap_Kd green.png\nnewmtl gone\nKd 0.5 0.5 0.5\nmap_Kd nothere.png\n");
+    dir.write(
+        "t.obj",
+        "mtllib t.mtl\nv -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n"
+        "usemtl tex\nf 1/1 2/2 3/3\nusemtl gone\nf 1/1 3/3 4/4\n");
+    CommandResult r =
+        run_toonray("render " + (dir / "t.obj").string() + " -o " + (dir / "t.png").string() +
+                    " --size 64x64 --camera 0,0,3,0,0,2,0,1,0 --light 0,0,10 --lines none");
     ASSERT_EQ(r.exit_code, 0) << r.output;
     EXPECT_NE(r.output.find("nothere.png"), std::string::npos) << r.output;
     auto png = toonray::read_png(dir / "t.png");
-    EXPECT_EQ(png.rgb(40, 40), (toonray::Rgb8{0, 200, 0}));     // the textured triangle (lower right)
+    EXPECT_EQ(png.rgb(40, 40), (toonray::Rgb8{0, 200, 0}));  // the textured triangle (lower right)
     EXPECT_EQ(png.rgb(22, 22), (toonray::Rgb8{128, 128, 128}));  // the other keeps its Kd
 }
 
 TEST(RenderCli, InkLinesWithSvg) {
     TempDir dir("cli_ink");
     CommandResult r = run_toonray("render " + kData + "/teapot.obj -o " + (dir / "t.png").string() +
-                                  " --size 320x180 --edges ink --svg " + (dir / "t.svg").string() + " --svg-hidden --aov " +
-                                  (dir / "aov").string());
+                                  " --size 320x180 --edges ink --svg " + (dir / "t.svg").string() +
+                                  " --svg-hidden --aov " + (dir / "aov").string());
     ASSERT_EQ(r.exit_code, 0) << r.output;
     EXPECT_EQ(read_png(dir / "t.png").width, 320);
     EXPECT_TRUE(fs::exists(dir / "t.svg"));
     EXPECT_TRUE(fs::exists(dir / "aov" / "t_edges.png"));
     EXPECT_FALSE(fs::exists(dir / "aov" / "t_lines_depth.png"));
     // An SVG needs the ink lines; the message names the flags.
-    r = run_toonray("render " + kData + "/teapot.obj -o " + (dir / "u.png").string() + " --svg " + (dir / "u.svg").string());
+    r = run_toonray("render " + kData + "/teapot.obj -o " + (dir / "u.png").string() + " --svg " +
+                    (dir / "u.svg").string());
     EXPECT_EQ(r.exit_code, 1);
     EXPECT_NE(r.output.find("--svg needs --edges ink"), std::string::npos) << r.output;
     EXPECT_FALSE(fs::exists(dir / "u.png"));

@@ -13,7 +13,8 @@ TEST(ParseImageSize, AcceptsWidthByHeight) {
 }
 
 TEST(ParseImageSize, RejectsMalformedAndOutOfRange) {
-    for (const char* bad : {"1920", "1920x", "x1080", "0x10", "10x0", "-5x5", "100000x10", "12x12x", "a x b"})
+    for (const char* bad :
+         {"1920", "1920x", "x1080", "0x10", "10x0", "-5x5", "100000x10", "12x12x", "a x b"})
         EXPECT_THROW(parse_image_size(bad, "--size"), Error) << bad;
 }
 

@@ -53,7 +53,8 @@ TEST(PortableMath, ExactValues) {
     EXPECT_EQ(portable::cos(0.0f), 1.0f);
     EXPECT_EQ(portable::sin(static_cast<float>(M_PI / 6)), 0.5f);
     EXPECT_EQ(portable::tan(static_cast<float>(M_PI / 4)), 1.0f);
-    EXPECT_EQ(portable::cos(static_cast<float>(M_PI / 3)), 0x1.fffffep-2f);  // the float below pi/3 is above it
+    EXPECT_EQ(portable::cos(static_cast<float>(M_PI / 3)),
+              0x1.fffffep-2f);  // the float below pi/3 is above it
     EXPECT_EQ(portable::pow(2.0f, 10.0f), 1024.0f);
     EXPECT_EQ(portable::pow(4.0f, 0.5f), 2.0f);
     EXPECT_EQ(portable::pow(10.0f, 3.0f), 1000.0f);
@@ -90,9 +91,12 @@ TEST(PortableMath, DoubleWithinTwoUlpOfLibm) {
     EXPECT_LE(worst_cos, 2);
     EXPECT_LE(worst_tan, 3);
     std::int64_t worst_exp = 0, worst_log = 0;
-    sweep(-740.0, 709.0, 200001, [&](double x) { worst_exp = std::max(worst_exp, ulps(portable::exp(x), std::exp(x))); });
-    sweep(1e-300, 1e300, 10001, [&](double x) { worst_log = std::max(worst_log, ulps(portable::log(x), std::log(x))); });
-    sweep(0.01, 100.0, 200001, [&](double x) { worst_log = std::max(worst_log, ulps(portable::log(x), std::log(x))); });
+    sweep(-740.0, 709.0, 200001,
+          [&](double x) { worst_exp = std::max(worst_exp, ulps(portable::exp(x), std::exp(x))); });
+    sweep(1e-300, 1e300, 10001,
+          [&](double x) { worst_log = std::max(worst_log, ulps(portable::log(x), std::log(x))); });
+    sweep(0.01, 100.0, 200001,
+          [&](double x) { worst_log = std::max(worst_log, ulps(portable::log(x), std::log(x))); });
     EXPECT_LE(worst_exp, 2);
     EXPECT_LE(worst_log, 2);
     EXPECT_EQ(ulps(portable::log(4.9e-324), std::log(4.9e-324)), 0);  // subnormal input
@@ -119,11 +123,13 @@ TEST(PortableMath, FloatCorrectlyRounded) {
     sweep(1e-3, 1.0, 100001, [&](double xd) {
         const float x = static_cast<float>(xd);
         for (float y : {0.62f, 1.4f, 2.0f, 10.0f, 32.0f, 100.0f, 1000.0f})
-            check(portable::pow(x, y), std::pow(static_cast<long double>(x), static_cast<long double>(y)),
+            check(portable::pow(x, y),
+                  std::pow(static_cast<long double>(x), static_cast<long double>(y)),
                   std::pow(x, y));
     });
     EXPECT_LE(worst_libm, 1);
-    EXPECT_LT(misrounded, total / 100000) << misrounded << " of " << total << " not correctly rounded";
+    EXPECT_LT(misrounded, total / 100000)
+        << misrounded << " of " << total << " not correctly rounded";
 }
 
 TEST(PortableMath, Deterministic) {

@@ -29,7 +29,8 @@ Scene twisted_teapot(const Scene& teapot, int frame) {
     const float angle = 0.05f * static_cast<float>(frame);
     for (Vec3f& p : scene.positions) {
         const float a = angle * p.y;
-        p = Vec3f(p.x * std::cos(a) - p.z * std::sin(a), p.y, p.x * std::sin(a) + p.z * std::cos(a));
+        p = Vec3f(p.x * std::cos(a) - p.z * std::sin(a), p.y,
+                  p.x * std::sin(a) + p.z * std::cos(a));
     }
     return scene;
 }

@@ -9,7 +9,8 @@
 using namespace toonray;
 
 TEST(LightsFile, ParsesPointAndDirectionalLightsWithComments) {
-    auto lights = parse_lights("# key and fill\npoint 1 2 3\ndirectional 0 -1 0 0.25  # fill\n", "l.txt");
+    auto lights =
+        parse_lights("# key and fill\npoint 1 2 3\ndirectional 0 -1 0 0.25  # fill\n", "l.txt");
     ASSERT_EQ(lights.size(), 2u);
     EXPECT_EQ(lights[0].kind, Light::Kind::Point);
     EXPECT_EQ(lights[0].vector, Vec3f(1, 2, 3));
@@ -19,7 +20,8 @@ TEST(LightsFile, ParsesPointAndDirectionalLightsWithComments) {
         parse_lights("point 1 2 3\nspot 1 2 3\n", "l.txt");
         FAIL();
     } catch (const Error& e) {
-        EXPECT_NE(std::string(e.what()).find("l.txt:2: unknown light 'spot'"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("l.txt:2: unknown light 'spot'"), std::string::npos)
+            << e.what();
     }
     EXPECT_THROW(parse_lights("point 1 2\n", "l.txt"), Error);
     EXPECT_THROW(parse_lights("directional 0 0 0\n", "l.txt"), Error);
@@ -39,7 +41,9 @@ TEST(LightsFile, LoadsAFileAndNamesItInErrors) {
         load_lights(dir.path / "bad.lights");
         FAIL();
     } catch (const Error& e) {
-        EXPECT_NE(std::string(e.what()).find("bad.lights:2: malformed number 'x'"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("bad.lights:2: malformed number 'x'"),
+                  std::string::npos)
+            << e.what();
     }
     EXPECT_THROW(load_lights(dir.path / "missing.lights"), Error);
 }

@@ -48,7 +48,8 @@ TEST(DrawStrokes, SameForAnyStrokeOrderAndThreadCount) {
     std::mt19937 rng(5);
     std::uniform_real_distribution<float> u(-10.0f, 210.0f);
     std::vector<Stroke> strokes;
-    for (int i = 0; i < 60; ++i) strokes.push_back(stroke({{u(rng), u(rng)}, {u(rng), u(rng)}, {u(rng), u(rng)}}));
+    for (int i = 0; i < 60; ++i)
+        strokes.push_back(stroke({{u(rng), u(rng)}, {u(rng), u(rng)}, {u(rng), u(rng)}}));
     ImageF a(200, 150, 0.0f), b(200, 150, 0.0f);
     ink::draw_strokes(strokes, 2.5f, a, 1);
     std::reverse(strokes.begin(), strokes.end());

@@ -16,7 +16,8 @@ using test_support::add_quad;
 using test_support::add_sphere;
 using test_support::build_accel;
 
-std::vector<FeatureSegment> edges_of(const Scene& s, const Vec3f& eye, const ink::FeatureEdgeSettings& settings = {},
+std::vector<FeatureSegment> edges_of(const Scene& s, const Vec3f& eye,
+                                     const ink::FeatureEdgeSettings& settings = {},
                                      int threads = 1) {
     const TriangleAccel accel = build_accel(s);
     return ink::find_feature_edges(s, ink::weld_vertices(s), accel.bvh(), eye, settings, threads);
@@ -77,8 +78,10 @@ TEST(FeatureEdges, CreaseAngleIsAThreshold) {
 TEST(FeatureEdges, MaterialBoundaryBetweenFlatFaces) {
     Scene s;
     s.materials.emplace_back("red");
-    const std::uint32_t a = test_support::add_vertex(s, Vec3f(0, 0, 0)), b = test_support::add_vertex(s, Vec3f(1, 0, 0)),
-                        c = test_support::add_vertex(s, Vec3f(1, 1, 0)), d = test_support::add_vertex(s, Vec3f(0, 1, 0));
+    const std::uint32_t a = test_support::add_vertex(s, Vec3f(0, 0, 0)),
+                        b = test_support::add_vertex(s, Vec3f(1, 0, 0)),
+                        c = test_support::add_vertex(s, Vec3f(1, 1, 0)),
+                        d = test_support::add_vertex(s, Vec3f(0, 1, 0));
     s.add_triangle({a, b, c}, 0, 0);
     s.add_triangle({a, c, d}, 1, 0);
     const auto segments = edges_of(s, Vec3f(0.5f, 0.5f, 3.0f));
@@ -157,7 +160,8 @@ TEST(FeatureEdges, IntersectionLinesBetweenObjectsAndChainableKeys) {
     // of each meet has endpoints that do not chain.)
     Scene s;
     add_box(s, Vec3f(-0.5f), Vec3f(0.5f), 1);
-    add_quad(s, Vec3f(-2, -2.3f, 0.1f), Vec3f(2, -2, 0.1f), Vec3f(2, 2.3f, 0.1f), Vec3f(-2, 2, 0.1f), 0, 2);
+    add_quad(s, Vec3f(-2, -2.3f, 0.1f), Vec3f(2, -2, 0.1f), Vec3f(2, 2.3f, 0.1f),
+             Vec3f(-2, 2, 0.1f), 0, 2);
     ink::FeatureEdgeSettings settings;
     const auto segments = edges_of(s, Vec3f(1, 2, 5), settings);
     std::map<ink::EndpointKey, int> uses;

@@ -23,7 +23,8 @@ inline std::uint32_t add_vertex(Scene& s, const Vec3f& p) {
 /// A quad (two triangles, wound a b c / a c d) with its own four vertices.
 inline void add_quad(Scene& s, const Vec3f& a, const Vec3f& b, const Vec3f& c, const Vec3f& d,
                      std::uint32_t material = 0, std::uint32_t object = 0) {
-    const std::uint32_t ia = add_vertex(s, a), ib = add_vertex(s, b), ic = add_vertex(s, c), id = add_vertex(s, d);
+    const std::uint32_t ia = add_vertex(s, a), ib = add_vertex(s, b), ic = add_vertex(s, c),
+                        id = add_vertex(s, d);
     s.add_triangle({ia, ib, ic}, material, object);
     s.add_triangle({ia, ic, id}, material, object);
 }
@@ -31,7 +32,9 @@ inline void add_quad(Scene& s, const Vec3f& a, const Vec3f& b, const Vec3f& c, c
 /// An axis-aligned box from `lo` to `hi`, outward-wound, each face with its own vertices (as
 /// OBJ exporters with split normals write it).
 inline void add_box(Scene& s, const Vec3f& lo, const Vec3f& hi, std::uint32_t object = 0) {
-    auto c = [&](int i) { return Vec3f(i & 1 ? hi.x : lo.x, i & 2 ? hi.y : lo.y, i & 4 ? hi.z : lo.z); };
+    auto c = [&](int i) {
+        return Vec3f(i & 1 ? hi.x : lo.x, i & 2 ? hi.y : lo.y, i & 4 ? hi.z : lo.z);
+    };
     add_quad(s, c(0), c(2), c(3), c(1), 0, object);  // z = lo
     add_quad(s, c(4), c(5), c(7), c(6), 0, object);  // z = hi
     add_quad(s, c(0), c(1), c(5), c(4), 0, object);  // y = lo
@@ -41,7 +44,8 @@ inline void add_box(Scene& s, const Vec3f& lo, const Vec3f& hi, std::uint32_t ob
 }
 
 /// A UV sphere with shared vertices and unit vertex normals.
-inline void add_sphere(Scene& s, const Vec3f& centre, float radius, int rings, int segments, std::uint32_t object = 0) {
+inline void add_sphere(Scene& s, const Vec3f& centre, float radius, int rings, int segments,
+                       std::uint32_t object = 0) {
     const auto base = static_cast<std::uint32_t>(s.positions.size());
     const auto nbase = static_cast<std::uint32_t>(s.normals.size());
     const float pi = std::numbers::pi_v<float>;
@@ -49,17 +53,26 @@ inline void add_sphere(Scene& s, const Vec3f& centre, float radius, int rings, i
         for (int k = 0; k < segments; ++k) {
             const float theta = pi * static_cast<float>(r) / static_cast<float>(rings);
             const float phi = 2 * pi * static_cast<float>(k) / static_cast<float>(segments);
-            Vec3f n(std::sin(theta) * std::cos(phi), std::cos(theta), std::sin(theta) * std::sin(phi));
-            if (r == 0 || r == rings) n = Vec3f(0.0f, r == 0 ? 1.0f : -1.0f, 0.0f);  // sin(pi) is not 0 in float
+            Vec3f n(std::sin(theta) * std::cos(phi), std::cos(theta),
+                    std::sin(theta) * std::sin(phi));
+            if (r == 0 || r == rings)
+                n = Vec3f(0.0f, r == 0 ? 1.0f : -1.0f, 0.0f);  // sin(pi) is not 0 in float
             s.positions.push_back(centre + n * radius);
             s.normals.push_back(n);
         }
-    auto id = [&](int r, int k) { return static_cast<std::uint32_t>(r * segments + (k % segments)); };
+    auto id = [&](int r, int k) {
+        return static_cast<std::uint32_t>(r * segments + (k % segments));
+    };
     for (int r = 0; r < rings; ++r)
         for (int k = 0; k < segments; ++k) {
-            const std::uint32_t a = id(r, k), b = id(r, k + 1), c = id(r + 1, k + 1), d = id(r + 1, k);
-            if (r > 0) s.add_triangle({base + a, base + b, base + c}, 0, object, {nbase + a, nbase + b, nbase + c});
-            if (r + 1 < rings) s.add_triangle({base + a, base + c, base + d}, 0, object, {nbase + a, nbase + c, nbase + d});
+            const std::uint32_t a = id(r, k), b = id(r, k + 1), c = id(r + 1, k + 1),
+                                d = id(r + 1, k);
+            if (r > 0)
+                s.add_triangle({base + a, base + b, base + c}, 0, object,
+                               {nbase + a, nbase + b, nbase + c});
+            if (r + 1 < rings)
+                s.add_triangle({base + a, base + c, base + d}, 0, object,
+                               {nbase + a, nbase + c, nbase + d});
         }
 }
 
@@ -85,15 +98,16 @@ inline TriangleAccel build_accel(const Scene& s) {
 
 /// The occluders of `point` as count_occluders defines them, by testing every triangle.
 inline int brute_force_occluders(const Scene& s, const Vec3f& point, const Vec3f& eye,
-                                 const std::vector<std::uint32_t>& ignored, const ink::VisibilitySettings& settings) {
+                                 const std::vector<std::uint32_t>& ignored,
+                                 const ink::VisibilitySettings& settings) {
     int count = 0;
     const Vec3f dir = eye - point;
     for (std::uint32_t t = 0; t < s.triangle_count(); ++t) {
         if (std::binary_search(ignored.begin(), ignored.end(), t)) continue;
         const auto& v = s.tri_positions[t];
         float hit_t, u, w;
-        if (intersect_triangle(Ray{point, dir, 1.0f - settings.self_epsilon}, s.positions[v[0]], s.positions[v[1]],
-                               s.positions[v[2]], hit_t, u, w) &&
+        if (intersect_triangle(Ray{point, dir, 1.0f - settings.self_epsilon}, s.positions[v[0]],
+                               s.positions[v[1]], s.positions[v[2]], hit_t, u, w) &&
             hit_t > settings.self_epsilon)
             ++count;
     }

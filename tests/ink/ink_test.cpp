@@ -16,9 +16,11 @@
 namespace toonray {
 namespace {
 
-void write_svg(const std::filesystem::path& path, std::span<const ink::Stroke> strokes, const ink::SvgSettings& svg) {
+void write_svg(const std::filesystem::path& path, std::span<const ink::Stroke> strokes,
+               const ink::SvgSettings& svg) {
     const std::string text = ink::svg_text(strokes, svg);
-    write_file_atomic(path, std::span(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()));
+    write_file_atomic(path,
+                      std::span(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()));
 }
 
 struct Teapot {
@@ -47,7 +49,8 @@ double agreement(const std::vector<bool>& a, const std::vector<bool>& b, int w, 
             for (int dy = -1; dy <= 1 && !found; ++dy)
                 for (int dx = -1; dx <= 1 && !found; ++dx) {  // 1.5 px: the 8 neighbours
                     const int nx = x + dx, ny = y + dy;
-                    found = nx >= 0 && ny >= 0 && nx < w && ny < h && b[static_cast<std::size_t>(ny) * w + nx];
+                    found = nx >= 0 && ny >= 0 && nx < w && ny < h &&
+                            b[static_cast<std::size_t>(ny) * w + nx];
                 }
             near += found;
         }
@@ -63,11 +66,13 @@ TEST(InkLines, TeapotHasLinesOfEveryStageAndIsThreadIndependent) {
     EXPECT_GT(one.pieces.size(), 100u);
     EXPECT_GT(one.strokes.size(), 5u);
     ASSERT_EQ(one.coverage.size(), many.coverage.size());
-    for (std::size_t i = 0; i < one.coverage.size(); ++i) ASSERT_EQ(one.coverage.data()[i], many.coverage.data()[i]);
+    for (std::size_t i = 0; i < one.coverage.size(); ++i)
+        ASSERT_EQ(one.coverage.data()[i], many.coverage.data()[i]);
     // The teapot has no vertex normals: its outline is made of polygonal silhouettes, and it
     // covers a good part of the frame's lines.
     int silhouettes = 0;
-    for (const auto& s : one.strokes) silhouettes += s.type == ink::EdgeType::Silhouette && s.visible;
+    for (const auto& s : one.strokes)
+        silhouettes += s.type == ink::EdgeType::Silhouette && s.visible;
     EXPECT_GT(silhouettes, 0);
     long covered = 0;
     for (std::size_t i = 0; i < one.coverage.size(); ++i) covered += one.coverage.data()[i] > 0.5f;
@@ -93,13 +98,16 @@ TEST(InkSvg, ParsesAsXmlWithTheLayersAndGroups) {
     // Without hidden lines there is only the visible layer.
     svg.hidden = false;
     write_svg(dir / "visible.svg", lines.strokes, svg);
-    const std::string check_visible = std::string("python3 ") + TOONRAY_TESTS_DIR + "/ink/check_svg.py " +
-                                      (dir / "visible.svg").string() + " 640 360 0 10";
+    const std::string check_visible = std::string("python3 ") + TOONRAY_TESTS_DIR +
+                                      "/ink/check_svg.py " + (dir / "visible.svg").string() +
+                                      " 640 360 0 10";
     EXPECT_EQ(std::system(check_visible.c_str()), 0) << check_visible;
     // The text itself: one path per visible stroke.
     const std::string text = ink::svg_text(lines.strokes, svg);
     std::size_t paths = 0;
-    for (std::size_t at = text.find("<path"); at != std::string::npos; at = text.find("<path", at + 1)) ++paths;
+    for (std::size_t at = text.find("<path"); at != std::string::npos;
+         at = text.find("<path", at + 1))
+        ++paths;
     std::size_t visible = 0;
     for (const auto& s : lines.strokes) visible += s.visible;
     EXPECT_EQ(paths, visible);

@@ -33,8 +33,9 @@ ink::ChainSettings plain() {
 
 TEST(ChainPieces, SquareLoopBecomesOneClosedStroke) {
     // Pieces in any direction and order.
-    const std::vector<EdgePiece> pieces{piece(0, {0, 0}, {10, 0}, 0, 1), piece(1, {10, 10}, {0, 10}, 2, 3),
-                                        piece(2, {10, 10}, {10, 0}, 2, 1), piece(3, {0, 0}, {0, 10}, 0, 3)};
+    const std::vector<EdgePiece> pieces{
+        piece(0, {0, 0}, {10, 0}, 0, 1), piece(1, {10, 10}, {0, 10}, 2, 3),
+        piece(2, {10, 10}, {10, 0}, 2, 1), piece(3, {0, 0}, {0, 10}, 0, 3)};
     const auto strokes = ink::chain_pieces(pieces, plain());
     ASSERT_EQ(strokes.size(), 1u);
     EXPECT_TRUE(strokes[0].closed);
@@ -44,7 +45,8 @@ TEST(ChainPieces, SquareLoopBecomesOneClosedStroke) {
 }
 
 TEST(ChainPieces, TypesAndVisibilityDoNotMix) {
-    const std::vector<EdgePiece> pieces{piece(0, {0, 0}, {10, 0}, 0, 1), piece(1, {10, 0}, {20, 0}, 1, 2, EdgeType::Border),
+    const std::vector<EdgePiece> pieces{piece(0, {0, 0}, {10, 0}, 0, 1),
+                                        piece(1, {10, 0}, {20, 0}, 1, 2, EdgeType::Border),
                                         piece(2, {20, 0}, {30, 0}, 2, 3, EdgeType::Border, 1)};
     auto settings = plain();
     EXPECT_EQ(ink::chain_pieces(pieces, settings).size(), 2u);  // the hidden piece is left out
@@ -56,7 +58,8 @@ TEST(ChainPieces, TypesAndVisibilityDoNotMix) {
 
 TEST(ChainPieces, JunctionContinuesWithTheStraightestPiece) {
     // A line through vertex 1 with a branch leaving it at 90 degrees.
-    const std::vector<EdgePiece> pieces{piece(0, {0, 0}, {10, 0}, 0, 1), piece(1, {10, 0}, {10, 10}, 1, 2),
+    const std::vector<EdgePiece> pieces{piece(0, {0, 0}, {10, 0}, 0, 1),
+                                        piece(1, {10, 0}, {10, 10}, 1, 2),
                                         piece(2, {10, 0}, {20, 1}, 1, 3)};
     const auto strokes = ink::chain_pieces(pieces, plain());
     ASSERT_EQ(strokes.size(), 2u);
@@ -64,23 +67,27 @@ TEST(ChainPieces, JunctionContinuesWithTheStraightestPiece) {
     EXPECT_EQ(strokes[0].points[2], (Point2{20, 1}));
     // With only sharp turns on offer at a junction, the stroke stops there; the two branches
     // then make one straight stroke.
-    const std::vector<EdgePiece> fork{piece(0, {0, 0}, {10, 0}, 0, 1), piece(1, {10, 0}, {10, 10}, 1, 2),
+    const std::vector<EdgePiece> fork{piece(0, {0, 0}, {10, 0}, 0, 1),
+                                      piece(1, {10, 0}, {10, 10}, 1, 2),
                                       piece(2, {10, 0}, {10, -10}, 1, 3)};
     const auto forked = ink::chain_pieces(fork, plain());
     ASSERT_EQ(forked.size(), 2u);
     EXPECT_EQ(forked[0].points.size(), 2u);
     EXPECT_EQ(forked[1].points.size(), 3u);
     // A corner with no other choice is followed whatever the angle.
-    const std::vector<EdgePiece> corner{piece(0, {0, 0}, {10, 0}, 0, 1), piece(1, {10, 0}, {1, 1}, 1, 2)};
+    const std::vector<EdgePiece> corner{piece(0, {0, 0}, {10, 0}, 0, 1),
+                                        piece(1, {10, 0}, {1, 1}, 1, 2)};
     EXPECT_EQ(ink::chain_pieces(corner, plain()).size(), 1u);
 }
 
 TEST(ChainPieces, SubPixelVisibilityFlickerIsAbsorbed) {
     // One segment: visible, hidden for 0.5 px, visible.
-    std::vector<EdgePiece> pieces{piece(0, {0, 0}, {10, 0}, 0, kNoIndex), piece(0, {10, 0}, {10.5f, 0}, kNoIndex, kNoIndex),
+    std::vector<EdgePiece> pieces{piece(0, {0, 0}, {10, 0}, 0, kNoIndex),
+                                  piece(0, {10, 0}, {10.5f, 0}, kNoIndex, kNoIndex),
                                   piece(0, {10.5f, 0}, {20, 0}, kNoIndex, 1)};
     pieces[1].invisibility = 1;
-    pieces[0].t0 = 0, pieces[0].t1 = 0.5f, pieces[1].t0 = 0.5f, pieces[1].t1 = 0.525f, pieces[2].t0 = 0.525f;
+    pieces[0].t0 = 0, pieces[0].t1 = 0.5f, pieces[1].t0 = 0.5f, pieces[1].t1 = 0.525f,
+    pieces[2].t0 = 0.525f;
     const auto strokes = ink::chain_pieces(pieces, plain());
     ASSERT_EQ(strokes.size(), 1u);
     EXPECT_EQ(strokes[0].points.front(), (Point2{0, 0}));
@@ -92,7 +99,8 @@ TEST(ChainPieces, SubPixelVisibilityFlickerIsAbsorbed) {
 
 TEST(SimplifyPolyline, DropsPointsWithinTheTolerance) {
     std::vector<Point2> pts;
-    for (int i = 0; i <= 100; ++i) pts.push_back({static_cast<float>(i), 0.05f * ((i % 2) ? 1.0f : -1.0f)});
+    for (int i = 0; i <= 100; ++i)
+        pts.push_back({static_cast<float>(i), 0.05f * ((i % 2) ? 1.0f : -1.0f)});
     pts.push_back({100, 20});
     const auto simple = ink::simplify_polyline(pts, 0.1f);
     ASSERT_EQ(simple.size(), 3u);
@@ -103,7 +111,8 @@ TEST(SimplifyPolyline, DropsPointsWithinTheTolerance) {
 }
 
 TEST(ChainPieces, ShortStrokesCanBeDropped) {
-    const std::vector<EdgePiece> pieces{piece(0, {0, 0}, {1.5f, 0}, 0, 1), piece(1, {5, 5}, {15, 5}, 2, 3)};
+    const std::vector<EdgePiece> pieces{piece(0, {0, 0}, {1.5f, 0}, 0, 1),
+                                        piece(1, {5, 5}, {15, 5}, 2, 3)};
     auto settings = plain();
     settings.min_length = 2.0f;
     const auto strokes = ink::chain_pieces(pieces, settings);

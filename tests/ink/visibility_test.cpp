@@ -29,7 +29,8 @@ struct Frame {
 
 TEST(ScreenProjection, AgreesWithTheViewPlane) {
     const CameraSpec camera{Vec3f(1, 2, 5), Vec3f(0.8f, 1.9f, 4.0f), normalize(Vec3f(0, 1, -0.1f))};
-    const ViewPlane plane = make_view_plane(CameraSpec{camera.eye, camera.gaze, Vec3f(0, 1, 0)}, 320, 200);
+    const ViewPlane plane =
+        make_view_plane(CameraSpec{camera.eye, camera.gaze, Vec3f(0, 1, 0)}, 320, 200);
     const ink::ScreenProjection view(plane, 320, 200);
     // The point seen through pixel (x, y)'s centre projects to (x + 0.5, y + 0.5).
     for (const auto& [x, y] : {std::pair{0, 0}, {319, 199}, {100, 37}}) {
@@ -44,11 +45,15 @@ TEST(Visibility, OccluderCutsALineWhereItsEdgesProject) {
     // A border line along x at z = 0, and a quad at z = 1 hiding its middle from an eye at z = 5.
     Scene s;
     add_quad(s, Vec3f(-1, 0, 0), Vec3f(1, 0, 0), Vec3f(1, -0.01f, -1), Vec3f(-1, -0.01f, -1));
-    add_quad(s, Vec3f(-0.25f, -1, 1), Vec3f(0.25f, -1, 1), Vec3f(0.25f, 1, 1), Vec3f(-0.25f, 1, 1), 0, 1);
-    const Frame f(std::move(s), CameraSpec{Vec3f(0, 0, 5), Vec3f(0, 0, 4), Vec3f(0, 1, 0)}, 640, 480);
+    add_quad(s, Vec3f(-0.25f, -1, 1), Vec3f(0.25f, -1, 1), Vec3f(0.25f, 1, 1), Vec3f(-0.25f, 1, 1),
+             0, 1);
+    const Frame f(std::move(s), CameraSpec{Vec3f(0, 0, 5), Vec3f(0, 0, 4), Vec3f(0, 1, 0)}, 640,
+                  480);
     const auto pieces = ink::split_by_visibility(f.segments, f.context(), {}, 1);
     std::uint32_t index = 0;
-    while (index < f.segments.size() && !(f.segments[index].p0.z == 0 && f.segments[index].p1.z == 0)) ++index;
+    while (index < f.segments.size() &&
+           !(f.segments[index].p0.z == 0 && f.segments[index].p1.z == 0))
+        ++index;
     ASSERT_LT(index, f.segments.size());
     std::vector<ink::EdgePiece> line;
     for (const auto& p : pieces)
@@ -58,12 +63,16 @@ TEST(Visibility, OccluderCutsALineWhereItsEdgesProject) {
     EXPECT_EQ(line[1].invisibility, 1);
     EXPECT_EQ(line[2].invisibility, 0);
     // The occluder's edges at x = +-0.25, depth 4, fall on x = +-0.3125 at depth 5.
-    const float cut_a = f.view.project(Vec3f(-0.25f, 0, 1)).x, cut_b = f.view.project(Vec3f(0.25f, 0, 1)).x;
-    const float x0 = std::min(line[1].s0.x, line[1].s1.x), x1 = std::max(line[1].s0.x, line[1].s1.x);
+    const float cut_a = f.view.project(Vec3f(-0.25f, 0, 1)).x,
+                cut_b = f.view.project(Vec3f(0.25f, 0, 1)).x;
+    const float x0 = std::min(line[1].s0.x, line[1].s1.x),
+                x1 = std::max(line[1].s0.x, line[1].s1.x);
     EXPECT_NEAR(x0, std::min(cut_a, cut_b), 1.0f / 16);
     EXPECT_NEAR(x1, std::max(cut_a, cut_b), 1.0f / 16);
-    EXPECT_EQ(line[0].t0 == 0 ? line[0].key0 : line[2].key1, line[0].t0 == 0 ? f.segments[index].key0 : f.segments[index].key1);  // the uncut end keeps its key
-    EXPECT_EQ(line[0].key1.a, kNoIndex);  // a cut end has none
+    EXPECT_EQ(line[0].t0 == 0 ? line[0].key0 : line[2].key1,
+              line[0].t0 == 0 ? f.segments[index].key0
+                              : f.segments[index].key1);  // the uncut end keeps its key
+    EXPECT_EQ(line[0].key1.a, kNoIndex);                  // a cut end has none
 }
 
 // Rays from the eye to points along every piece agree with the piece's state (checked against
@@ -74,8 +83,9 @@ void check_against_brute_force(int max_invisibility) {
     for (unsigned seed : {1u, 2u, 3u}) {
         Scene s = test_support::random_scene(150, seed);
         test_support::add_sphere(s, Vec3f(0.1f, -0.2f, 0.3f), 0.45f, 10, 20, 1);
-        const Frame f(std::move(s), CameraSpec{Vec3f(2.5f, 1.5f, 3.5f), Vec3f(1.8f, 1.1f, 2.5f),
-                                               normalize(Vec3f(-0.2f, 1.0f, -0.1f))},
+        const Frame f(std::move(s),
+                      CameraSpec{Vec3f(2.5f, 1.5f, 3.5f), Vec3f(1.8f, 1.1f, 2.5f),
+                                 normalize(Vec3f(-0.2f, 1.0f, -0.1f))},
                       320, 240);
         ink::VisibilitySettings settings;
         settings.max_invisibility = max_invisibility;
@@ -98,7 +108,8 @@ void check_against_brute_force(int max_invisibility) {
                 return seg.p0 + (seg.p1 - seg.p0) * (0.5f * (lo + hi));
             };
             auto truth = [&](float d) {
-                return test_support::brute_force_occluders(f.scene, point_at(d), f.view.eye(), ignored, settings);
+                return test_support::brute_force_occluders(f.scene, point_at(d), f.view.eye(),
+                                                           ignored, settings);
             };
             for (float u : {0.0f, 0.25f, 0.5f, 0.75f, 1.0f}) {
                 const float d = 1.5f + (len - 3.0f) * u;  // at least 1.5 px from the piece's ends
@@ -109,8 +120,11 @@ void check_against_brute_force(int max_invisibility) {
                     ++near_change;
                     continue;
                 }
-                EXPECT_EQ(ink::count_occluders(f.accel, point_at(d), f.view.eye(), ignored, settings), expected);
-                ASSERT_EQ(p.invisibility == 0, expected == 0) << "seed " << seed << " segment " << p.segment;
+                EXPECT_EQ(
+                    ink::count_occluders(f.accel, point_at(d), f.view.eye(), ignored, settings),
+                    expected);
+                ASSERT_EQ(p.invisibility == 0, expected == 0)
+                    << "seed " << seed << " segment " << p.segment;
                 EXPECT_EQ(p.invisibility, expected) << "seed " << seed << " segment " << p.segment;
                 ++checked;
                 hidden += expected > 0;
@@ -132,12 +146,15 @@ void check_against_brute_force(int max_invisibility) {
 TEST(Visibility, PiecesAgreeWithBruteForceRaysOnRandomScenes) { check_against_brute_force(255); }
 
 // Telling only hidden from visible, the samples are traced as packets from the eye.
-TEST(Visibility, HiddenOrNotAgreesWithBruteForceRaysOnRandomScenes) { check_against_brute_force(1); }
+TEST(Visibility, HiddenOrNotAgreesWithBruteForceRaysOnRandomScenes) {
+    check_against_brute_force(1);
+}
 
 TEST(Visibility, SameForAnyThreadCount) {
     Scene s = test_support::random_scene(300, 11);
-    const Frame f(std::move(s), CameraSpec{Vec3f(2.5f, 1.5f, 3.5f), Vec3f(1.8f, 1.1f, 2.5f),
-                                           normalize(Vec3f(-0.2f, 1.0f, -0.1f))},
+    const Frame f(std::move(s),
+                  CameraSpec{Vec3f(2.5f, 1.5f, 3.5f), Vec3f(1.8f, 1.1f, 2.5f),
+                             normalize(Vec3f(-0.2f, 1.0f, -0.1f))},
                   320, 240);
     for (int max_invisibility : {255, 1}) {
         ink::VisibilitySettings settings;
@@ -158,14 +175,17 @@ TEST(Visibility, LinesOnTheFarSideOfClosedSolidsAreHiddenWithoutRays) {
     Scene s;
     test_support::add_box(s, Vec3f(-1.0f), Vec3f(0.0f), 0);
     test_support::add_box(s, Vec3f(0.2f), Vec3f(1.0f), 1);
-    test_support::add_box(s, Vec3f(-0.5f, 0.3f, -0.5f), Vec3f(0.6f, 0.5f, 0.4f), 2);  // crosses box 1
+    test_support::add_box(s, Vec3f(-0.5f, 0.3f, -0.5f), Vec3f(0.6f, 0.5f, 0.4f),
+                          2);  // crosses box 1
     // An open box (no top) is not closed: its far edges may be seen from inside.
     Scene open_box;
     test_support::add_box(open_box, Vec3f(-0.5f), Vec3f(0.5f));
-    open_box.tri_positions.erase(open_box.tri_positions.begin() + 6, open_box.tri_positions.begin() + 8);
-    open_box.tri_normals.resize(10), open_box.tri_texcoords.resize(10), open_box.tri_material.resize(10),
-        open_box.tri_object.resize(10);
-    const CameraSpec camera{Vec3f(2.5f, 2.0f, 3.0f), Vec3f(1.8f, 1.4f, 2.2f), normalize(Vec3f(-0.3f, 1.0f, -0.3f))};
+    open_box.tri_positions.erase(open_box.tri_positions.begin() + 6,
+                                 open_box.tri_positions.begin() + 8);
+    open_box.tri_normals.resize(10), open_box.tri_texcoords.resize(10),
+        open_box.tri_material.resize(10), open_box.tri_object.resize(10);
+    const CameraSpec camera{Vec3f(2.5f, 2.0f, 3.0f), Vec3f(1.8f, 1.4f, 2.2f),
+                            normalize(Vec3f(-0.3f, 1.0f, -0.3f))};
     const Frame f(std::move(s), camera, 320, 240);
     int certain = 0;
     for (const auto& seg : f.segments) certain += seg.certainly_hidden;
@@ -182,17 +202,20 @@ TEST(Visibility, LinesOnTheFarSideOfClosedSolidsAreHiddenWithoutRays) {
         if (f.segments[p.segment].certainly_hidden) {
             EXPECT_EQ(p.invisibility, 1);
         }
-    const Frame g(std::move(open_box), CameraSpec{Vec3f(0.3f, 3.0f, 0.2f), Vec3f(0.3f, 2.0f, 0.2f), Vec3f(0, 0, -1)}, 320,
-                  240);
+    const Frame g(std::move(open_box),
+                  CameraSpec{Vec3f(0.3f, 3.0f, 0.2f), Vec3f(0.3f, 2.0f, 0.2f), Vec3f(0, 0, -1)},
+                  320, 240);
     for (const auto& seg : g.segments) EXPECT_FALSE(seg.certainly_hidden);
 }
 
 TEST(Visibility, PartsBehindTheEyeOrOffTheImageAreLeftOut) {
     Scene s;
     // A long border line from behind the eye to far in front, and one far to the side.
-    add_quad(s, Vec3f(0, -0.2f, 10), Vec3f(0, -0.2f, -10), Vec3f(0.01f, -0.3f, -10), Vec3f(0.01f, -0.3f, 10));
+    add_quad(s, Vec3f(0, -0.2f, 10), Vec3f(0, -0.2f, -10), Vec3f(0.01f, -0.3f, -10),
+             Vec3f(0.01f, -0.3f, 10));
     add_quad(s, Vec3f(50, 0, -2), Vec3f(51, 0, -2), Vec3f(51, 1, -2), Vec3f(50, 1, -2), 0, 1);
-    const Frame f(std::move(s), CameraSpec{Vec3f(0, 0, 5), Vec3f(0, 0, 4), Vec3f(0, 1, 0)}, 320, 240);
+    const Frame f(std::move(s), CameraSpec{Vec3f(0, 0, 5), Vec3f(0, 0, 4), Vec3f(0, 1, 0)}, 320,
+                  240);
     const auto pieces = ink::split_by_visibility(f.segments, f.context(), {}, 1);
     ASSERT_FALSE(pieces.empty());
     for (const auto& p : pieces) {

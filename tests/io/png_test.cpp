@@ -17,7 +17,8 @@ namespace fs = std::filesystem;
 namespace {
 
 fs::path temp_dir(const std::string& name) {
-    fs::path dir = fs::temp_directory_path() / ("toonray_io_" + name + "_" + std::to_string(::getpid()));
+    fs::path dir =
+        fs::temp_directory_path() / ("toonray_io_" + name + "_" + std::to_string(::getpid()));
     fs::remove_all(dir);
     fs::create_directories(dir);
     return dir;
@@ -38,8 +39,10 @@ ImageRgb8 image_with_colours(int width, int height, int colours, std::uint32_t s
     };
     for (int y = 0; y < height; ++y)
         for (int x = 0; x < width; ++x)
-            image(x, y) = colour_of(((x / 7) + (y / 5) * 3 + static_cast<int>(rng() % 2)) % colours);
-    for (int i = 0; i < colours && i < width * height; ++i) image(i % width, i / width) = colour_of(i);
+            image(x, y) =
+                colour_of(((x / 7) + (y / 5) * 3 + static_cast<int>(rng() % 2)) % colours);
+    for (int i = 0; i < colours && i < width * height; ++i)
+        image(i % width, i / width) = colour_of(i);
     return image;
 }
 
@@ -52,7 +55,8 @@ void expect_round_trip(const ImageRgb8& image, const PngOptions& options, int ex
     ASSERT_EQ(decoded.height, image.height());
     for (int y = 0; y < image.height(); ++y)
         for (int x = 0; x < image.width(); ++x)
-            ASSERT_EQ(decoded.rgb(x, y), image(x, y)) << x << "," << y << " of " << image.width() << "x" << image.height();
+            ASSERT_EQ(decoded.rgb(x, y), image(x, y))
+                << x << "," << y << " of " << image.width() << "x" << image.height();
 }
 
 }  // namespace
@@ -97,7 +101,8 @@ TEST(Png, TruncatedOrCorruptFilesAreInvalid) {
     fs::path dir = temp_dir("trunc");
     write_file_atomic(dir / "ok.png", bytes);
     EXPECT_TRUE(is_valid_png(dir / "ok.png"));
-    for (std::size_t cut : {std::size_t{0}, std::size_t{8}, std::size_t{30}, bytes.size() / 2, bytes.size() - 12}) {
+    for (std::size_t cut :
+         {std::size_t{0}, std::size_t{8}, std::size_t{30}, bytes.size() / 2, bytes.size() - 12}) {
         write_file_atomic(dir / "cut.png", std::span(bytes.data(), cut));
         EXPECT_FALSE(is_valid_png(dir / "cut.png")) << "cut at " << cut;
     }
@@ -145,7 +150,8 @@ TEST(Png, FewColoursAreIndexedAndRoundTrip) {
             ImageRgb8 image = image_with_colours(w, h, colours, 11);
             std::set<std::uint32_t> used;
             for (int y = 0; y < h; ++y)
-                for (int x = 0; x < w; ++x) used.insert(image(x, y)[0] << 16 | image(x, y)[1] << 8 | image(x, y)[2]);
+                for (int x = 0; x < w; ++x)
+                    used.insert(image(x, y)[0] << 16 | image(x, y)[1] << 8 | image(x, y)[2]);
             for (int level : {1, 12}) expect_round_trip(image, {level}, used.size() <= 256 ? 3 : 2);
         }
     }

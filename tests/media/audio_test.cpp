@@ -113,9 +113,9 @@ TEST(Audio, DurationIsScoreEndPlusTail) {
 
 TEST(Audio, WindowShiftsNotesAndCutsWithAFade) {
     Score s;
-    s.notes.push_back({0.5, 3.0, 48, 100, 0});   // before the window: not played
-    s.notes.push_back({1.5, 3.0, 60, 100, 0});   // in the window, lasts past its end
-    s.notes.push_back({2.5, 3.0, 67, 100, 0});   // after the window
+    s.notes.push_back({0.5, 3.0, 48, 100, 0});  // before the window: not played
+    s.notes.push_back({1.5, 3.0, 60, 100, 0});  // in the window, lasts past its end
+    s.notes.push_back({2.5, 3.0, 67, 100, 0});  // after the window
     AudioOptions o;
     o.start = 1.0;
     o.length = 1.0;
@@ -185,7 +185,7 @@ TEST(Audio, OverlappingSameKeyNotesKeepSounding) {
     Score s = one_note(0.0, 1.0, 60, 100);
     s.notes.push_back({0.5, 2.0, 60, 100, 0});
     Score single = one_note(0.0, 1.0, 60, 100);
-    const double overlapped = rms(synthesize_score(s, o).audio, 66150, 79380);     // 1.5..1.8 s
+    const double overlapped = rms(synthesize_score(s, o).audio, 66150, 79380);  // 1.5..1.8 s
     const double released = rms(synthesize_score(single, o).audio, 66150, 79380);
     EXPECT_GT(overlapped, 10 * released + 1e-4);
 }

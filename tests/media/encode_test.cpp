@@ -19,8 +19,8 @@
 namespace toonray {
 namespace {
 
-using toonray::test_support::TempDir;
 using toonray::test_support::error_of;
+using toonray::test_support::TempDir;
 
 namespace fs = std::filesystem;
 
@@ -55,7 +55,8 @@ fs::path write_tone(const fs::path& path, double seconds, double onset = 0.0) {
 }
 
 std::size_t count_entries(const fs::path& dir) {
-    return static_cast<std::size_t>(std::distance(fs::directory_iterator(dir), fs::directory_iterator()));
+    return static_cast<std::size_t>(
+        std::distance(fs::directory_iterator(dir), fs::directory_iterator()));
 }
 
 constexpr double kFrame = 1.0 / 24.0;
@@ -334,16 +335,19 @@ TEST(FrameSequence, NoFramesMismatchedSizesAndNonPngs) {
     fs::create_directories(tmp.path / "empty");
     EXPECT_NE(error_of([&] { find_frame_sequence(tmp.path / "empty"); }).find("no PNG frames"),
               std::string::npos);
-    EXPECT_NE(error_of([&] { find_frame_sequence(tmp.path / "nowhere"); })
-                  .find("frame directory not found"),
+    EXPECT_NE(error_of([&] {
+                  find_frame_sequence(tmp.path / "nowhere");
+              }).find("frame directory not found"),
               std::string::npos);
     write_frames(tmp.path / "s", "f{:02d}.png", 1, 2, 64, 48);
     write_frames(tmp.path / "s", "f{:02d}.png", 3, 1, 32, 48);
     std::string e = error_of([&] { find_frame_sequence(tmp.path / "s"); });
     EXPECT_NE(e.find("f03.png: frame is 32x48 but the first frame f01.png is 64x48"),
-              std::string::npos) << e;
+              std::string::npos)
+        << e;
     write_frames(tmp.path / "t", "f{:02d}.png", 1, 2);
-    write_file_atomic(tmp.path / "t" / "f03.png", {reinterpret_cast<const std::uint8_t*>("GIF89a"), 6});
+    write_file_atomic(tmp.path / "t" / "f03.png",
+                      {reinterpret_cast<const std::uint8_t*>("GIF89a"), 6});
     e = error_of([&] { find_frame_sequence(tmp.path / "t"); });
     EXPECT_NE(e.find("f03.png: frame is not a PNG"), std::string::npos) << e;
 }
@@ -362,7 +366,9 @@ TEST(Process, ArgvIsPassedWithoutAShell) {
 
 TEST(Probe, UnreadableFileIsAnError) {
     TempDir tmp;
-    EXPECT_NE(error_of([&] { probe_media(tmp.path / "missing.mp4"); }).find("missing.mp4: ffprobe failed"),
+    EXPECT_NE(error_of([&] {
+                  probe_media(tmp.path / "missing.mp4");
+              }).find("missing.mp4: ffprobe failed"),
               std::string::npos);
 }
 

@@ -21,19 +21,19 @@ Score hand_score() {
     add(0.5, 0.9, 62);
     add(1.0, 1.4, 64);
     for (int k : {60, 64, 67}) add(1.5, 2.5, k);  // chord
-    add(0.2, 3.0, 36);                              // long bass note
-    add(2.6, 2.62, 72);                             // staccato, 20 ms
+    add(0.2, 3.0, 36);                            // long bass note
+    add(2.6, 2.62, 72);                           // staccato, 20 ms
     add(2.7, 2.71, 74);
-    add(3.0, 3.5, 69);                              // repeated, back to back
+    add(3.0, 3.5, 69);  // repeated, back to back
     add(3.5, 4.0, 69);
     add(4.0, 4.6, 69);
-    add(5.0, 5.6, 57);                              // repeated, overlapping in the score
+    add(5.0, 5.6, 57);  // repeated, overlapping in the score
     add(5.4, 6.0, 57);
-    add(6.2, 6.32, 50);                             // quick repeats, 125 ms apart
+    add(6.2, 6.32, 50);  // quick repeats, 125 ms apart
     add(6.325, 6.45, 50);
     add(6.45, 6.6, 50);
-    add(1.0, 1.2, 12);                              // below A0
-    add(1.0, 1.2, 115);                             // above C8
+    add(1.0, 1.2, 12);   // below A0
+    add(1.0, 1.2, 115);  // above C8
     std::sort(s.notes.begin(), s.notes.end(), [](const Note& a, const Note& b) {
         return a.start < b.start || (a.start == b.start && a.key < b.key);
     });
@@ -49,7 +49,8 @@ TEST(PianoPlayback, EveryKeyIsDownFromItsOnsetForAFrame) {
         // Fully down at the onset itself and for a whole 24 fps frame after it, so the frame
         // showing the onset shows the key down.
         for (double dt : {0.0, 0.5 * kFrame, kFrame})
-            EXPECT_GE(play.key_depth(n.key, n.start + dt), 1.0f) << "key " << n.key << " at " << n.start << "+" << dt;
+            EXPECT_GE(play.key_depth(n.key, n.start + dt), 1.0f)
+                << "key " << n.key << " at " << n.start << "+" << dt;
         // The press starts before the onset: already half down half an attack earlier.
         EXPECT_GT(play.key_depth(n.key, n.start - 0.5 * play.settings().attack), 0.4f);
         ++checked;

@@ -91,9 +91,9 @@ TEST(PianoModel, OverallSizeAndPlacement) {
     EXPECT_NEAR(e.x, 1.55f, 0.155f);
     EXPECT_NEAR(e.y, 1.35f, 0.135f);
     EXPECT_NEAR(e.z, 0.68f, 0.068f);
-    EXPECT_FLOAT_EQ(m.bounds.lo.y, 0.0f);                  // stands on the floor
+    EXPECT_FLOAT_EQ(m.bounds.lo.y, 0.0f);                     // stands on the floor
     EXPECT_NEAR(m.bounds.lo.x + m.bounds.hi.x, 0.0f, 1e-4f);  // centred on x = 0
-    EXPECT_NEAR(m.bounds.lo.z, -0.34f, 0.01f);            // back of the case
+    EXPECT_NEAR(m.bounds.lo.z, -0.34f, 0.01f);                // back of the case
     // The whole scene includes a floor at y = 0, larger than the piano.
     const std::uint32_t floor = object_index(m.scene, "floor");
     ASSERT_NE(floor, kNoIndex);

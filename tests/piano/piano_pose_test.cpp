@@ -240,10 +240,10 @@ TEST(PianoRoll, ASlotReachesTheTrackerBarAtItsOnset) {
     pose.roll_position = static_cast<float>(3.0 * g.paper_speed);
     ASSERT_EQ(pose_piano(m, pose, &roll, posed).visible_holes, 1u);
     const Vec3f* q = &posed.positions[m.holes.first_position];
-    EXPECT_NEAR(q[0].y, g.tracker_y, 1e-5f);                      // leading edge at the bar
-    EXPECT_NEAR(q[2].y - q[0].y, 0.5f * g.paper_speed, 1e-5f);    // length by duration
-    EXPECT_NEAR(0.5f * (q[0].x + q[1].x), g.hole_x(69), 1e-6f);   // column by pitch
-    EXPECT_LT(g.hole_x(60), g.hole_x(61));                        // bass to the left
+    EXPECT_NEAR(q[0].y, g.tracker_y, 1e-5f);                     // leading edge at the bar
+    EXPECT_NEAR(q[2].y - q[0].y, 0.5f * g.paper_speed, 1e-5f);   // length by duration
+    EXPECT_NEAR(0.5f * (q[0].x + q[1].x), g.hole_x(69), 1e-6f);  // column by pitch
+    EXPECT_LT(g.hole_x(60), g.hole_x(61));                       // bass to the left
     // Later, the slot has moved down the paper.
     pose.roll_position = static_cast<float>(3.5 * g.paper_speed);
     pose_piano(m, pose, &roll, posed);

@@ -126,9 +126,9 @@ TEST(PianoRender, EverySurfaceSeenFromOutsideFacesTheViewer) {
     const Scene& s = model.scene;
     TriangleAccel accel;
     accel.build(s.positions, s.tri_positions);
-    const Vec3f eyes[] = {{0.0f, 1.0f, 3.0f},  {2.5f, 1.2f, 2.0f},  {-2.5f, 0.9f, 1.5f},
+    const Vec3f eyes[] = {{0.0f, 1.0f, 3.0f},  {2.5f, 1.2f, 2.0f},   {-2.5f, 0.9f, 1.5f},
                           {3.0f, 0.7f, -0.2f}, {-3.0f, 1.4f, -0.5f}, {0.5f, 3.0f, 0.8f},
-                          {0.3f, 0.25f, 1.2f}, {0.0f, 1.0f, 0.7f},  {1.0f, 1.5f, -3.0f},
+                          {0.3f, 0.25f, 1.2f}, {0.0f, 1.0f, 0.7f},   {1.0f, 1.5f, -3.0f},
                           {0.2f, 0.95f, 0.45f}};
     std::size_t hits = 0, wrong = 0;
     for (const Vec3f& eye : eyes) {

@@ -61,7 +61,8 @@ TEST(ClassicSobel, VerticalStepMarksTwoColumnsAboveThreshold) {
         for (int y = 0; y < 5; ++y)
             for (int x = 0; x < 8; ++x) {
                 bool expect_edge = step == 3 && (x == 3 || x == 4);
-                EXPECT_EQ(edges(x, y), expect_edge ? 0 : 255) << "step " << step << " at " << x << "," << y;
+                EXPECT_EQ(edges(x, y), expect_edge ? 0 : 255)
+                    << "step " << step << " at " << x << "," << y;
             }
     }
 }
@@ -209,7 +210,8 @@ TEST(ClassicRounding, RoundHalfAwayIsLroundf) {
     std::vector<float> values;
     for (int k = -600; k <= 600; ++k) {
         float half = static_cast<float>(k) * 0.5f;  // every half and whole number
-        values.insert(values.end(), {half, std::nextafter(half, -1e9f), std::nextafter(half, 1e9f)});
+        values.insert(values.end(),
+                      {half, std::nextafter(half, -1e9f), std::nextafter(half, 1e9f)});
     }
     std::mt19937 rng(7);
     std::uniform_real_distribution<float> any(-300.0f, 300.0f);
@@ -263,7 +265,8 @@ TEST(ClassicStages, MatchTheSeedsPerPixelDefinitionsOnRandomImages) {
             for (int x = 0; x < w; ++x) {
                 // Smooth-ish values so both sides of the thresholds occur.
                 gray(x, y) = static_cast<std::uint8_t>(byte(rng) / 16 + 8 * x);
-                rgb(x, y) = {static_cast<std::uint8_t>(byte(rng) / 32), static_cast<std::uint8_t>(4 * y),
+                rgb(x, y) = {static_cast<std::uint8_t>(byte(rng) / 32),
+                             static_cast<std::uint8_t>(4 * y),
                              static_cast<std::uint8_t>(byte(rng))};
                 colour(x, y) = {unit(rng), unit(rng), unit(rng)};
                 flags(x, y) = byte(rng) < 40 ? 0 : 255;
@@ -272,9 +275,11 @@ TEST(ClassicStages, MatchTheSeedsPerPixelDefinitionsOnRandomImages) {
             for (int threads : {1, 2}) {
                 ImageGray8 edges;
                 sobel_edges(gray, threshold, edges, threads);
-                EXPECT_TRUE(same(edges, reference_sobel(gray, threshold))) << w << "x" << h << " t " << threshold;
+                EXPECT_TRUE(same(edges, reference_sobel(gray, threshold)))
+                    << w << "x" << h << " t " << threshold;
                 sobel_edges(rgb, threshold, edges, threads);
-                EXPECT_TRUE(same(edges, reference_sobel(rgb, threshold))) << w << "x" << h << " t " << threshold;
+                EXPECT_TRUE(same(edges, reference_sobel(rgb, threshold)))
+                    << w << "x" << h << " t " << threshold;
             }
         }
         ImageRgb8 out, out_with_cel, cel;
@@ -307,7 +312,8 @@ TEST(ClassicNormalMap, EveryChannelRoundsAsLroundf) {
             continue;
         }
         for (int c = 0; c < 3; ++c)
-            EXPECT_EQ(out(x, 0)[c], static_cast<std::uint8_t>(std::lround((n(x, 0)[c] * 0.5f + 0.5f) * 255.0f)))
+            EXPECT_EQ(out(x, 0)[c],
+                      static_cast<std::uint8_t>(std::lround((n(x, 0)[c] * 0.5f + 0.5f) * 255.0f)))
                 << x << " " << c;
     }
 }

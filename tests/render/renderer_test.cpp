@@ -50,7 +50,8 @@ std::uint64_t bytes_of(const Image<T>& image) {
     return image.size() * sizeof(T);
 }
 
-const Image<Vec3f>& render_scene(Renderer& r, const Scene& s, const CameraSpec& cam, RenderSettings settings) {
+const Image<Vec3f>& render_scene(Renderer& r, const Scene& s, const CameraSpec& cam,
+                                 RenderSettings settings) {
     static TriangleAccel accel;
     accel.build(s.positions, s.tri_positions);
     r.render(s, accel, cam, settings);
@@ -65,17 +66,18 @@ TEST(Renderer, FlatSquareFacingTheLightIsItsKdWithoutLines) {
     // constant, and a light far along the normal gives l.n close to 1 everywhere.
     CameraSpec cam{{0, 0, 5}, {0, 0, 1}, {0, 1, 0}};
     for (EdgeMode mode : {EdgeMode::Classic, EdgeMode::Robust}) {
-    RenderSettings settings;
-    settings.edges = mode;
-    settings.width = 128;
-    settings.height = 96;
-    settings.light = Vec3f(0, 0, 1e4f);
-    Renderer r;
-    TriangleAccel accel;
-    accel.build(s.positions, s.tri_positions);
-    const ImageRgb8& out = r.render(s, accel, cam, settings);
-    for (int y = 0; y < settings.height; ++y)
-        for (int x = 0; x < settings.width; ++x) ASSERT_EQ(out(x, y), (Rgb8{51, 102, 153})) << x << "," << y;
+        RenderSettings settings;
+        settings.edges = mode;
+        settings.width = 128;
+        settings.height = 96;
+        settings.light = Vec3f(0, 0, 1e4f);
+        Renderer r;
+        TriangleAccel accel;
+        accel.build(s.positions, s.tri_positions);
+        const ImageRgb8& out = r.render(s, accel, cam, settings);
+        for (int y = 0; y < settings.height; ++y)
+            for (int x = 0; x < settings.width; ++x)
+                ASSERT_EQ(out(x, y), (Rgb8{51, 102, 153})) << x << "," << y;
     }
 }
 
@@ -112,7 +114,8 @@ TEST(Renderer, CelBandsFollowThePointLight) {
 
 TEST(Renderer, SilhouetteOfASquareOnBackgroundIsOutlined) {
     Scene s = square(1.0f, {0.5f, 0.5f, 0.5f});
-    CameraSpec cam{{0, 0, 4}, {0, 0, 3}, {0, 1, 0}};  // sees x in [-4, 4]: the square is the middle quarter
+    CameraSpec cam{
+        {0, 0, 4}, {0, 0, 3}, {0, 1, 0}};  // sees x in [-4, 4]: the square is the middle quarter
     RenderSettings settings;
     settings.edges = EdgeMode::Classic;
     settings.width = 200;
@@ -134,9 +137,9 @@ TEST(Renderer, SilhouetteOfASquareOnBackgroundIsOutlined) {
     }
     EXPECT_EQ(r.aovs().edges(75, 100), 0);
     EXPECT_EQ(r.aovs().edges(100, 100), 255);
-    EXPECT_EQ(r.aovs().depth(10, 10), 255);                     // miss: white
-    EXPECT_EQ(r.aovs().normal(10, 10), (Rgb8{0, 0, 0}));         // miss: black
-    EXPECT_EQ(r.aovs().normal(100, 100), (Rgb8{128, 128, 255})); // facing +z
+    EXPECT_EQ(r.aovs().depth(10, 10), 255);                       // miss: white
+    EXPECT_EQ(r.aovs().normal(10, 10), (Rgb8{0, 0, 0}));          // miss: black
+    EXPECT_EQ(r.aovs().normal(100, 100), (Rgb8{128, 128, 255}));  // facing +z
 }
 
 TEST(Renderer, NormalsFaceTheViewer) {
@@ -155,8 +158,8 @@ TEST(Renderer, NormalsFaceTheViewer) {
 TEST(Renderer, InterpolatesVertexNormalsOnlyWhenAllCornersHaveThem) {
     Scene s = square(1.0f, {1, 1, 1});
     s.normals = {normalize(Vec3f(1, 0, 1)), normalize(Vec3f(-1, 0, 1))};
-    s.tri_normals[0] = {0, 1, 1};                 // all corners: interpolated
-    s.tri_normals[1] = {0, kNoIndex, 1};          // one missing: geometric
+    s.tri_normals[0] = {0, 1, 1};         // all corners: interpolated
+    s.tri_normals[1] = {0, kNoIndex, 1};  // one missing: geometric
     CameraSpec cam{{0, 0, 4}, {0, 0, 3}, {0, 1, 0}};
     RenderSettings settings;
     settings.edges = EdgeMode::Classic;
@@ -197,16 +200,16 @@ TEST(Renderer, OutputIsIdenticalForEveryThreadCount) {
     Renderer one, two, many;
     settings.threads = 1;
     for (EdgeMode mode : {EdgeMode::Classic, EdgeMode::Robust}) {
-    settings.edges = mode;
-    settings.threads = 1;
-    ImageRgb8 a = one.render(s, accel, cam, settings);
-    settings.threads = 2;
-    ImageRgb8 b = two.render(s, accel, cam, settings);
-    settings.threads = 7;
-    ImageRgb8 c = many.render(s, accel, cam, settings);
-    ASSERT_EQ(0, std::memcmp(a.data(), b.data(), a.size() * 3));
-    ASSERT_EQ(0, std::memcmp(a.data(), c.data(), a.size() * 3));
-    ASSERT_EQ(0, std::memcmp(one.aovs().depth.data(), two.aovs().depth.data(), a.size()));
+        settings.edges = mode;
+        settings.threads = 1;
+        ImageRgb8 a = one.render(s, accel, cam, settings);
+        settings.threads = 2;
+        ImageRgb8 b = two.render(s, accel, cam, settings);
+        settings.threads = 7;
+        ImageRgb8 c = many.render(s, accel, cam, settings);
+        ASSERT_EQ(0, std::memcmp(a.data(), b.data(), a.size() * 3));
+        ASSERT_EQ(0, std::memcmp(a.data(), c.data(), a.size() * 3));
+        ASSERT_EQ(0, std::memcmp(one.aovs().depth.data(), two.aovs().depth.data(), a.size()));
     }
 }
 
@@ -233,7 +236,8 @@ TEST(Renderer, MatchesABruteForceReference) {
                 float t, u, v;
                 const auto& tri = s.tri_positions[i];
                 ray.tmax = best;
-                if (intersect_triangle(ray, s.positions[tri[0]], s.positions[tri[1]], s.positions[tri[2]], t, u, v))
+                if (intersect_triangle(ray, s.positions[tri[0]], s.positions[tri[1]],
+                                       s.positions[tri[2]], t, u, v))
                     best = t;
             }
             float got = r.gbuffer().distance(x, y);
@@ -255,7 +259,8 @@ TEST(Renderer, TeapotMatchesTheGoldenImage) {
     accel.build(s.positions, s.tri_positions);
     Renderer r;
     const ImageRgb8& out = r.render(s, accel, cam, settings);
-    DecodedPng golden = read_png(std::string(TOONRAY_TEST_DATA_DIR) + "/golden/teapot_classic_1280x720.png");
+    DecodedPng golden =
+        read_png(std::string(TOONRAY_TEST_DATA_DIR) + "/golden/teapot_classic_1280x720.png");
     ASSERT_EQ(golden.width, out.width());
     ASSERT_EQ(golden.height, out.height());
     std::size_t differ = 0;
@@ -282,8 +287,10 @@ TEST(Renderer, FeatureImagesAreComputedOnlyWhenAskedAndChangeNothingElse) {
         ASSERT_EQ(a.size(), b.size());
         EXPECT_EQ(0, std::memcmp(a.data(), b.data(), a.size() * sizeof(Rgb8)));
         for (const FeatureImage& f : feature_images()) {
-            const std::size_t asked = std::visit([&](auto m) { return (with.aovs().*m).size(); }, f.image);
-            const std::size_t not_asked = std::visit([&](auto m) { return (without.aovs().*m).size(); }, f.image);
+            const std::size_t asked =
+                std::visit([&](auto m) { return (with.aovs().*m).size(); }, f.image);
+            const std::size_t not_asked =
+                std::visit([&](auto m) { return (without.aovs().*m).size(); }, f.image);
             EXPECT_EQ(asked, f.in(mode) ? a.size() : 0u) << f.name;
             EXPECT_EQ(not_asked, 0u) << f.name;
         }
@@ -301,11 +308,14 @@ TEST(Renderer, FeatureImageTableListsEachModesImages) {
         if (f.in(EdgeMode::Robust)) robust.push_back(f.name);
         if (f.in(EdgeMode::Ink)) ink.push_back(f.name);
     }
-    EXPECT_EQ(ink, (std::vector<std::string_view>{"depth", "normal", "edges", "cel", "object_id", "material_id"}));
-    EXPECT_EQ(classic, (std::vector<std::string_view>{"depth", "normal", "edges_depth", "edges_normal", "edges", "cel"}));
-    EXPECT_EQ(robust, (std::vector<std::string_view>{"depth", "normal", "edges", "cel", "lines_silhouette",
-                                                      "lines_crease", "lines_depth", "lines_object", "lines_material",
-                                                      "object_id", "material_id"}));
+    EXPECT_EQ(ink, (std::vector<std::string_view>{"depth", "normal", "edges", "cel", "object_id",
+                                                  "material_id"}));
+    EXPECT_EQ(classic, (std::vector<std::string_view>{"depth", "normal", "edges_depth",
+                                                      "edges_normal", "edges", "cel"}));
+    EXPECT_EQ(robust,
+              (std::vector<std::string_view>{"depth", "normal", "edges", "cel", "lines_silhouette",
+                                             "lines_crease", "lines_depth", "lines_object",
+                                             "lines_material", "object_id", "material_id"}));
 }
 
 // frame_buffer_bytes counts exactly the buffers a renderer holds after a frame.
@@ -333,22 +343,26 @@ TEST(Renderer, FrameBufferBytesCountTheBuffersRendererHolds) {
         Renderer r;
         const ImageRgb8& out = r.render(s, accel, cam, settings);
         const GBuffer& g = r.gbuffer();
-        std::uint64_t held = bytes_of(out) + bytes_of(g.distance) + bytes_of(g.normal) + bytes_of(g.view_depth) +
-                             bytes_of(g.geometric_normal) + bytes_of(g.colour) + bytes_of(g.material) +
-                             bytes_of(g.object) + bytes_of(r.line_seeds());
+        std::uint64_t held = bytes_of(out) + bytes_of(g.distance) + bytes_of(g.normal) +
+                             bytes_of(g.view_depth) + bytes_of(g.geometric_normal) +
+                             bytes_of(g.colour) + bytes_of(g.material) + bytes_of(g.object) +
+                             bytes_of(r.line_seeds());
         std::uint64_t features = 0;
         for (const FeatureImage& f : feature_images())
             features += std::visit([&](auto m) { return bytes_of(r.aovs().*m); }, f.image);
         held += features;
         const bool full_distance = c.line_width > 50.0f;
         if (full_distance) {
-            EXPECT_GT(line_distance_band(line_thickness(c.line_width, settings.height, 2)), kMaxDistanceBand);
-            held += bytes_of(g.colour) / sizeof(Vec3f) * sizeof(float);  // allocated while resolving
+            EXPECT_GT(line_distance_band(line_thickness(c.line_width, settings.height, 2)),
+                      kMaxDistanceBand);
+            held +=
+                bytes_of(g.colour) / sizeof(Vec3f) * sizeof(float);  // allocated while resolving
         }
         EXPECT_EQ(frame_buffer_bytes(settings), held) << c.samples;
         // Without feature images: classic keeps the maps its lines come from, less cel.
         settings.feature_images = false;
-        const std::uint64_t kept = c.mode == EdgeMode::Classic ? features - bytes_of(r.aovs().cel) : 0;
+        const std::uint64_t kept =
+            c.mode == EdgeMode::Classic ? features - bytes_of(r.aovs().cel) : 0;
         EXPECT_EQ(frame_buffer_bytes(settings), held - features + kept) << c.samples;
     }
     RenderSettings huge;
@@ -363,7 +377,8 @@ TEST(Renderer, SampleCountsAreSquareGrids) {
         (void)samples_per_side(5);
         FAIL();
     } catch (const Error& e) {
-        EXPECT_EQ(std::string(e.what()), "5 samples per pixel: must be 1, 4, 9 or 16 (a square grid per pixel)");
+        EXPECT_EQ(std::string(e.what()),
+                  "5 samples per pixel: must be 1, 4, 9 or 16 (a square grid per pixel)");
     }
 }
 

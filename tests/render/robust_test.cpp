@@ -52,7 +52,8 @@ Vec2f project(const ViewPlane& v, const Vec3f& p) {
     return {dot(q, v.step_x) / dot(v.step_x, v.step_x), dot(q, v.step_y) / dot(v.step_y, v.step_y)};
 }
 
-CameraSpec look_at(const Vec3f& eye, const Vec3f& target, float fov_degrees, const Vec3f& world_up = {0, 1, 0}) {
+CameraSpec look_at(const Vec3f& eye, const Vec3f& target, float fov_degrees,
+                   const Vec3f& world_up = {0, 1, 0}) {
     Vec3f fwd = normalize(target - eye);
     Vec3f right = normalize(cross(fwd, world_up));
     Vec3f up = cross(right, fwd);
@@ -95,7 +96,8 @@ Scene voxels(const std::vector<std::array<int, 3>>& cells, float scale,
 }
 
 // Visible samples along a 3D segment, projected; ends within `margin` pixels are skipped.
-std::vector<Vec2f> visible_samples(const Frame& f, const Scene& scene, Vec3f a, Vec3f b, float margin) {
+std::vector<Vec2f> visible_samples(const Frame& f, const Scene& scene, Vec3f a, Vec3f b,
+                                   float margin) {
     TriangleAccel accel;
     accel.build(scene.positions, scene.tri_positions);
     std::vector<Vec2f> out;
@@ -107,7 +109,8 @@ std::vector<Vec2f> visible_samples(const Frame& f, const Scene& scene, Vec3f a, 
         if (u * len < margin || (1 - u) * len < margin) continue;
         Vec3f p = a + (b - a) * u;
         Vec2f q = project(f.view, p);
-        if (q.x < 2 || q.y < 2 || q.x > f.settings.width - 2 || q.y > f.settings.height - 2) continue;
+        if (q.x < 2 || q.y < 2 || q.x > f.settings.width - 2 || q.y > f.settings.height - 2)
+            continue;
         // Visible when nothing is hit well before the point.
         Vec3f d = p - f.view.eye;
         float dist = length(d);
@@ -131,14 +134,16 @@ float coverage_near(const Frame& f, Vec2f q) {
 }
 
 // Fraction of samples along the edges that are drawn.
-float drawn_fraction(const Frame& f, const Scene& scene, const std::vector<std::pair<Vec3f, Vec3f>>& edges,
+float drawn_fraction(const Frame& f, const Scene& scene,
+                     const std::vector<std::pair<Vec3f, Vec3f>>& edges,
                      int* samples_out = nullptr) {
     int samples = 0, drawn = 0;
     for (const auto& [a, b] : edges)
         for (Vec2f q : visible_samples(f, scene, a, b, 3.0f)) {
             ++samples;
             if (coverage_near(f, q) > 0.5f) ++drawn;
-            else if (std::getenv("TOONRAY_DEBUG_LINES")) std::printf("undrawn sample at %.2f %.2f\n", q.x, q.y);
+            else if (std::getenv("TOONRAY_DEBUG_LINES"))
+                std::printf("undrawn sample at %.2f %.2f\n", q.x, q.y);
         }
     if (samples_out) *samples_out = samples;
     return samples ? static_cast<float>(drawn) / samples : 0.0f;
@@ -169,7 +174,8 @@ Scene floor_plane(float half, int cells) {
     Scene s;
     for (int j = 0; j <= cells; ++j)
         for (int i = 0; i <= cells; ++i)
-            s.positions.push_back({-half + 2 * half * i / cells, 0.0f, -half + 2 * half * j / cells});
+            s.positions.push_back(
+                {-half + 2 * half * i / cells, 0.0f, -half + 2 * half * j / cells});
     for (int j = 0; j < cells; ++j)
         for (int i = 0; i < cells; ++i) {
             std::uint32_t a = j * (cells + 1) + i, b = a + 1, c = a + cells + 1, d = c + 1;
@@ -185,7 +191,8 @@ Scene sphere(int segments, int rings, float r) {
         float phi = kPi * j / rings;
         for (int i = 0; i < segments; ++i) {
             float theta = 2 * kPi * i / segments;
-            s.positions.push_back({r * std::sin(phi) * std::cos(theta), r * std::cos(phi), r * std::sin(phi) * std::sin(theta)});
+            s.positions.push_back({r * std::sin(phi) * std::cos(theta), r * std::cos(phi),
+                                   r * std::sin(phi) * std::sin(theta)});
         }
     }
     for (int j = 0; j < rings; ++j)
@@ -225,8 +232,8 @@ TEST(RobustLines, GrazingPlaneHasNoLinesInside) {
                 if (coverage(f, x, y) > 0.0f) ++lines;
             false_lines[mode == EdgeMode::Robust] = lines;
         }
-        std::printf("grazing plane at %.0f deg: false line pixels classic %d, robust %d\n", angle, false_lines[0],
-                    false_lines[1]);
+        std::printf("grazing plane at %.0f deg: false line pixels classic %d, robust %d\n", angle,
+                    false_lines[0], false_lines[1]);
         EXPECT_EQ(false_lines[1], 0) << angle;
     }
 }
@@ -246,7 +253,9 @@ TEST(RobustLines, TessellatedSphereHasLinesOnlyAtItsSilhouette) {
         const GBuffer& g = f.renderer.gbuffer();
         const int sub = g.sub;
         // Distance of each pixel to the silhouette, from the per-pixel hit mask.
-        auto hit = [&](int x, int y) { return g.material(x * sub + sub / 2, y * sub + sub / 2) != kNoIndex; };
+        auto hit = [&](int x, int y) {
+            return g.material(x * sub + sub / 2, y * sub + sub / 2) != kNoIndex;
+        };
         const float width = f.settings.lines.width;  // pixels at 720 lines
         const int near = static_cast<int>(std::ceil(width * f.settings.height / 720.0f)) + 1;
         int silhouette = 0, silhouette_drawn = 0;
@@ -254,11 +263,13 @@ TEST(RobustLines, TessellatedSphereHasLinesOnlyAtItsSilhouette) {
             for (int x = near; x < f.settings.width - near; ++x) {
                 bool near_miss = false, near_hit = false;
                 for (int dy = -near; dy <= near; ++dy)
-                    for (int dx = -near; dx <= near; ++dx) (hit(x + dx, y + dy) ? near_hit : near_miss) = true;
+                    for (int dx = -near; dx <= near; ++dx)
+                        (hit(x + dx, y + dy) ? near_hit : near_miss) = true;
                 float c = coverage(f, x, y);
                 if (hit(x, y) && !near_miss && c > 0.0f) ++false_lines[mode == EdgeMode::Robust];
                 // Silhouette pixels: a hit with a miss as a 4-neighbour.
-                if (hit(x, y) && (!hit(x - 1, y) || !hit(x + 1, y) || !hit(x, y - 1) || !hit(x, y + 1))) {
+                if (hit(x, y) &&
+                    (!hit(x - 1, y) || !hit(x + 1, y) || !hit(x, y - 1) || !hit(x, y + 1))) {
                     ++silhouette;
                     if (coverage_near(f, {x + 0.5f, y + 0.5f}) > 0.5f) ++silhouette_drawn;
                 }
@@ -314,10 +325,12 @@ TEST(RobustLines, EveryVisibleCreaseOfACubeAndAStairIsDrawn) {
     std::vector<std::pair<Vec3f, Vec3f>> stair_edges;
     for (int step = 0; step < 3; ++step) {
         float x = 3.0f - step, y = step + 1.0f;
-        stair_edges.push_back({{x, y, 0}, {x, y, 2}});                  // convex nosing
-        stair_edges.push_back({{x, y - 1, 2}, {x, y, 2}});              // riser, front side edge
-        if (step < 2) stair_edges.push_back({{x - 1, y, 0}, {x - 1, y, 2}});  // concave foot of the next riser
-        stair_edges.push_back({{x - 1, y, 2}, {x, y, 2}});              // tread, front side edge
+        stair_edges.push_back({{x, y, 0}, {x, y, 2}});      // convex nosing
+        stair_edges.push_back({{x, y - 1, 2}, {x, y, 2}});  // riser, front side edge
+        if (step < 2)
+            stair_edges.push_back(
+                {{x - 1, y, 0}, {x - 1, y, 2}});            // concave foot of the next riser
+        stair_edges.push_back({{x - 1, y, 2}, {x, y, 2}});  // tread, front side edge
     }
     float stair_drawn = drawn_fraction(g, stair, stair_edges, &samples);
     EXPECT_GT(samples, 300);
@@ -346,8 +359,12 @@ TEST(RobustLines, BoundariesBetweenMaterialsAndObjects) {
     EXPECT_EQ(drawn_fraction(f, same, boundary), 0.0f);
     // Two objects of one material: the object lines mark it.
     for (std::size_t t = 0; t < same.triangle_count(); ++t)
-        same.tri_object[t] = same.positions[same.tri_positions[t][0]].x + same.positions[same.tri_positions[t][1]].x +
-                                         same.positions[same.tri_positions[t][2]].x > 3.0f ? 1u : 0u;
+        same.tri_object[t] = same.positions[same.tri_positions[t][0]].x +
+                                         same.positions[same.tri_positions[t][1]].x +
+                                         same.positions[same.tri_positions[t][2]].x >
+                                     3.0f
+                                 ? 1u
+                                 : 0u;
     same.objects.push_back("right");
     render(f, same);
     EXPECT_EQ(drawn_fraction(f, same, boundary), 1.0f);
@@ -409,21 +426,24 @@ TEST(RobustLines, LinesChangeSmoothlyUnderASlowCameraMove) {
         double mean = 0.5 * (amount[i - 1] + amount[i + 1]);
         worst = std::max(worst, std::abs(amount[i] - mean) / mean);
     }
-    std::printf("slow camera move: largest deviation of a frame's line amount from its neighbours' mean: %.4f\n",
-                worst);
+    std::printf(
+        "slow camera move: largest deviation of a frame's line amount from its neighbours' mean: %.4f\n",
+        worst);
     EXPECT_LT(worst, 0.01);
 }
 
 TEST(RobustLines, ParsesLineTypes) {
     EXPECT_EQ(parse_line_types("all"), static_cast<unsigned>(kLineAll));
     EXPECT_EQ(parse_line_types("none"), 0u);
-    EXPECT_EQ(parse_line_types("silhouette,crease"), static_cast<unsigned>(kLineSilhouette | kLineCrease));
+    EXPECT_EQ(parse_line_types("silhouette,crease"),
+              static_cast<unsigned>(kLineSilhouette | kLineCrease));
     EXPECT_THROW(parse_line_types("silhouette,outline"), Error);
     try {
         (void)parse_line_types("silhouette,outline");
     } catch (const Error& e) {
-        EXPECT_EQ(std::string(e.what()), "unknown line type 'outline' (choose from silhouette, crease, depth, "
-                                         "object, material, all, none)");
+        EXPECT_EQ(std::string(e.what()),
+                  "unknown line type 'outline' (choose from silhouette, crease, depth, "
+                  "object, material, all, none)");
     }
 }
 
@@ -435,7 +455,8 @@ TEST(RobustLines, DistanceTransformIsExact) {
     distance_to_seeds(seeds, d, 1);
     for (int y = 0; y < 7; ++y)
         for (int x = 0; x < 9; ++x) {
-            float a = float((x - 2) * (x - 2) + (y - 3) * (y - 3)), b = float((x - 7) * (x - 7) + (y - 1) * (y - 1));
+            float a = float((x - 2) * (x - 2) + (y - 3) * (y - 3)),
+                  b = float((x - 7) * (x - 7) + (y - 1) * (y - 1));
             EXPECT_EQ(d(x, y), std::min(a, b)) << x << "," << y;
         }
     Image<std::uint8_t> none(4, 4, 0);
@@ -460,9 +481,12 @@ Image<std::uint8_t> reference_seeds(const FineBuffers& fine, const RobustLineSet
         if (!hit_a && !hit_b) return 0;
         if (hit_a != hit_b) return s.types & kLineSilhouette;
         unsigned bits = 0;
-        if ((s.types & kLineObject) && fine.object(ax, ay) != fine.object(bx, by)) bits |= kLineObject;
-        if ((s.types & kLineMaterial) && fine.material(ax, ay) != fine.material(bx, by)) bits |= kLineMaterial;
-        if ((s.types & kLineCrease) && dot(fine.geometric_normal(ax, ay), fine.geometric_normal(bx, by)) < cos_crease)
+        if ((s.types & kLineObject) && fine.object(ax, ay) != fine.object(bx, by))
+            bits |= kLineObject;
+        if ((s.types & kLineMaterial) && fine.material(ax, ay) != fine.material(bx, by))
+            bits |= kLineMaterial;
+        if ((s.types & kLineCrease) &&
+            dot(fine.geometric_normal(ax, ay), fine.geometric_normal(bx, by)) < cos_crease)
             bits |= kLineCrease;
         return bits;
     };
@@ -512,19 +536,19 @@ struct RandomGBuffer {
         : depth(w, h), normal(w, h), object(w, h), material(w, h) {
         std::srand(seed);
         auto unit = [] { return static_cast<float>(std::rand()) / static_cast<float>(RAND_MAX); };
-        const Vec3f normals[4] = {normalize(Vec3f(0, 0, 1)), normalize(Vec3f(0.2f, 0, 1)), normalize(Vec3f(1, 0, 1)),
-                                  normalize(Vec3f(0, 1, 0.3f))};
+        const Vec3f normals[4] = {normalize(Vec3f(0, 0, 1)), normalize(Vec3f(0.2f, 0, 1)),
+                                  normalize(Vec3f(1, 0, 1)), normalize(Vec3f(0, 1, 0.3f))};
         const float a = 0.3f + unit(), b = unit() * 0.01f, c = unit() * 0.01f;
         for (int y = 0; y < h; ++y)
             for (int x = 0; x < w; ++x) {
                 float r = unit();
                 float plane = 1.0f / (a + b * x + c * y);  // 1/z affine: no depth lines inside
-                float z = r < 0.1f ? std::numeric_limits<float>::infinity()
-                        : r < 0.5f ? plane
-                        : r < 0.6f ? plane * (1.0f + 4e-6f)  // a tie with the plane
-                        : r < 0.75f ? plane * 1.05f           // a small step (depth line)
-                        : r < 0.9f ? plane * 1.5f             // a large step (silhouette)
-                                   : 0.5f + 10.0f * unit();
+                float z = r < 0.1f    ? std::numeric_limits<float>::infinity()
+                          : r < 0.5f  ? plane
+                          : r < 0.6f  ? plane * (1.0f + 4e-6f)  // a tie with the plane
+                          : r < 0.75f ? plane * 1.05f           // a small step (depth line)
+                          : r < 0.9f  ? plane * 1.5f            // a large step (silhouette)
+                                      : 0.5f + 10.0f * unit();
                 depth(x, y) = z;
                 bool hit = z != std::numeric_limits<float>::infinity();
                 normal(x, y) = hit ? normals[std::rand() % 4] : Vec3f(0.0f);
@@ -549,8 +573,9 @@ Image<std::uint8_t> random_seeds(int w, int h, float density, unsigned seed) {
 }
 
 // resolve_lines as it was first written, pixel by pixel, with to_byte.
-void reference_resolve(const Image<Vec3f>& fine_colour, const ImageF& squared_distance, float thickness, int sub,
-                       const Vec3f& line_colour, ImageRgb8& final_image, ImageRgb8& cel, ImageGray8& lines) {
+void reference_resolve(const Image<Vec3f>& fine_colour, const ImageF& squared_distance,
+                       float thickness, int sub, const Vec3f& line_colour, ImageRgb8& final_image,
+                       ImageRgb8& cel, ImageGray8& lines) {
     const int w = fine_colour.width() / sub, h = fine_colour.height() / sub;
     final_image.resize(w, h);
     cel.resize(w, h);
@@ -583,7 +608,9 @@ float brute_force_squared_distance(const Image<std::uint8_t>& seeds, int x, int 
     float best = std::numeric_limits<float>::infinity();
     for (int sy = 0; sy < seeds.height(); ++sy)
         for (int sx = 0; sx < seeds.width(); ++sx)
-            if (seeds(sx, sy)) best = std::min(best, static_cast<float>((sx - x) * (sx - x) + (sy - y) * (sy - y)));
+            if (seeds(sx, sy))
+                best =
+                    std::min(best, static_cast<float>((sx - x) * (sx - x) + (sy - y) * (sy - y)));
     return best;
 }
 
@@ -594,7 +621,8 @@ TEST(RobustLines, SeedsMatchThePerPixelReference) {
     unsigned seed = 1;
     int lines_found = 0;
     for (const auto& size : sizes)
-        for (unsigned types : {unsigned(kLineAll), unsigned(kLineSilhouette | kLineDepth), unsigned(kLineCrease), 0u})
+        for (unsigned types : {unsigned(kLineAll), unsigned(kLineSilhouette | kLineDepth),
+                               unsigned(kLineCrease), 0u})
             for (int threads : {1, 2, 3}) {
                 RandomGBuffer g(size[0], size[1], ++seed);
                 RobustLineSettings settings;
@@ -606,7 +634,8 @@ TEST(RobustLines, SeedsMatchThePerPixelReference) {
                 for (int y = 0; y < size[1]; ++y)
                     for (int x = 0; x < size[0]; ++x) {
                         ASSERT_EQ(seeds(x, y), expected(x, y))
-                            << x << "," << y << " in " << size[0] << "x" << size[1] << ", types " << types;
+                            << x << "," << y << " in " << size[0] << "x" << size[1] << ", types "
+                            << types;
                         lines_found += seeds(x, y) != 0;
                     }
             }
@@ -658,34 +687,43 @@ TEST(RobustLines, ResolvingMatchesThePerPixelReference) {
                 // Colours partly outside [0, 1] (as with specular highlights), to test the clamp.
                 Image<Vec3f> colour(w * sub, h * sub);
                 for (std::size_t i = 0; i < colour.size(); ++i)
-                    colour.data()[i] = Vec3f(static_cast<float>(std::rand() % 1000) / 997.0f,
-                                             static_cast<float>(std::rand() % 2000) / 991.0f - 0.5f, 0.25f);
+                    colour.data()[i] =
+                        Vec3f(static_cast<float>(std::rand() % 1000) / 997.0f,
+                              static_cast<float>(std::rand() % 2000) / 991.0f - 0.5f, 0.25f);
                 const Vec3f line_colour(0.1f, 0.2f, 0.05f);
                 ImageF distance;
                 ImageRgb8 final_ref, cel_ref, final_a, cel_a, final_b, cel_b;
                 ImageGray8 lines_ref, lines_a, lines_b;
                 distance_to_seeds(seeds, distance, 1);
-                reference_resolve(colour, distance, thickness, sub, line_colour, final_ref, cel_ref, lines_ref);
-                resolve_lines(colour, distance, thickness, sub, line_colour, final_a, &cel_a, &lines_a, threads);
-                resolve_lines_from_seeds(colour, seeds, thickness, sub, line_colour, final_b, &cel_b, &lines_b, threads);
+                reference_resolve(colour, distance, thickness, sub, line_colour, final_ref, cel_ref,
+                                  lines_ref);
+                resolve_lines(colour, distance, thickness, sub, line_colour, final_a, &cel_a,
+                              &lines_a, threads);
+                resolve_lines_from_seeds(colour, seeds, thickness, sub, line_colour, final_b,
+                                         &cel_b, &lines_b, threads);
                 // Without the feature outputs, the same final image.
                 ImageRgb8 final_alone;
-                resolve_lines_from_seeds(colour, seeds, thickness, sub, line_colour, final_alone, nullptr, nullptr,
-                                         threads);
+                resolve_lines_from_seeds(colour, seeds, thickness, sub, line_colour, final_alone,
+                                         nullptr, nullptr, threads);
                 ASSERT_EQ(final_alone.size(), final_b.size());
-                ASSERT_EQ(0, std::memcmp(final_alone.data(), final_b.data(), final_b.size() * sizeof(Rgb8)));
+                ASSERT_EQ(0, std::memcmp(final_alone.data(), final_b.data(),
+                                         final_b.size() * sizeof(Rgb8)));
                 for (const ImageRgb8* image : {&final_a, &cel_a, &final_b, &cel_b}) {
                     ASSERT_EQ(image->width(), w);
                     ASSERT_EQ(image->height(), h);
                 }
                 for (int y = 0; y < h; ++y)
                     for (int x = 0; x < w; ++x) {
-                        ASSERT_EQ(final_a(x, y), final_ref(x, y)) << x << "," << y << " thickness " << thickness;
+                        ASSERT_EQ(final_a(x, y), final_ref(x, y))
+                            << x << "," << y << " thickness " << thickness;
                         ASSERT_EQ(cel_a(x, y), cel_ref(x, y));
-                        ASSERT_EQ(lines_a(x, y), lines_ref(x, y)) << x << "," << y << " thickness " << thickness;
-                        ASSERT_EQ(final_b(x, y), final_ref(x, y)) << x << "," << y << " thickness " << thickness;
+                        ASSERT_EQ(lines_a(x, y), lines_ref(x, y))
+                            << x << "," << y << " thickness " << thickness;
+                        ASSERT_EQ(final_b(x, y), final_ref(x, y))
+                            << x << "," << y << " thickness " << thickness;
                         ASSERT_EQ(cel_b(x, y), cel_ref(x, y));
-                        ASSERT_EQ(lines_b(x, y), lines_ref(x, y)) << x << "," << y << " thickness " << thickness;
+                        ASSERT_EQ(lines_b(x, y), lines_ref(x, y))
+                            << x << "," << y << " thickness " << thickness;
                     }
             }
 }
@@ -695,14 +733,16 @@ TEST(RobustLines, SeedTypeImagesCountSamples) {
         for (int threads : {1, 2}) {
             const int w = 19, h = 11;
             Image<std::uint8_t> seeds = random_seeds(w * sub, h * sub, 0.3f, 900 + sub);
-            for (unsigned type : {unsigned(kLineSilhouette), unsigned(kLineCrease), unsigned(kLineMaterial)}) {
+            for (unsigned type :
+                 {unsigned(kLineSilhouette), unsigned(kLineCrease), unsigned(kLineMaterial)}) {
                 ImageGray8 out;
                 resolve_seed_type(seeds, type, sub, out, threads);
                 for (int y = 0; y < h; ++y)
                     for (int x = 0; x < w; ++x) {
                         int n = 0;
                         for (int j = 0; j < sub; ++j)
-                            for (int i = 0; i < sub; ++i) n += (seeds(x * sub + i, y * sub + j) & type) != 0;
+                            for (int i = 0; i < sub; ++i)
+                                n += (seeds(x * sub + i, y * sub + j) & type) != 0;
                         const float inv_n = 1.0f / static_cast<float>(sub * sub);
                         ASSERT_EQ(out(x, y), to_byte(1.0f - static_cast<float>(n) * inv_n))
                             << x << "," << y << " sub " << sub;

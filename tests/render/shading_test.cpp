@@ -26,8 +26,8 @@ Scene square(float a, Vec3f kd = Vec3f(1.0f)) {
     return s;
 }
 
-const Image<Vec3f>& colours(Renderer& r, const Scene& s, RenderSettings settings, const CameraSpec& cam,
-                            const TextureSet* textures = nullptr) {
+const Image<Vec3f>& colours(Renderer& r, const Scene& s, RenderSettings settings,
+                            const CameraSpec& cam, const TextureSet* textures = nullptr) {
     static TriangleAccel accel;
     accel.build(s.positions, s.tri_positions);
     settings.edges = EdgeMode::Classic;  // one sample per pixel: colours are the shading's own
@@ -56,7 +56,8 @@ TEST(ToonRamp, ParsesLevelsAndThresholds) {
     EXPECT_EQ(r.level(0.69f), 0.8f);
     EXPECT_EQ(r.level(0.9f), 1.0f);
     EXPECT_EQ(parse_ramp("0.7").level(0.0f), 0.7f);  // one flat band
-    for (const char* bad : {"", "0.5,1@0.3,0.6", "0.5,1", "0.5,0.7,1@0.5,0.2", "a,1@0.5", "0.5,1@x"})
+    for (const char* bad :
+         {"", "0.5,1@0.3,0.6", "0.5,1", "0.5,0.7,1@0.5,0.2", "a,1@0.5", "0.5,1@x"})
         EXPECT_THROW(parse_ramp(bad), Error) << bad;
 }
 
@@ -95,10 +96,12 @@ TEST(Shading, DirectionalLightsAddUp) {
     Renderer r;
     // One directional light at 70 degrees from the normal: l.n = cos 70 = 0.34 -> 0.75 band.
     float a = 70.0f * 3.14159265f / 180.0f;
-    settings.shading.lights = {Light{Light::Kind::Directional, {std::sin(a), 0, -std::cos(a)}, 1.0f}};
+    settings.shading.lights = {
+        Light{Light::Kind::Directional, {std::sin(a), 0, -std::cos(a)}, 1.0f}};
     EXPECT_EQ(colours(r, s, settings, kTopDown)(16, 16).x, 0.75f);
     // Two of them: 0.68 -> the 1.0 band.
-    settings.shading.lights.push_back(Light{Light::Kind::Directional, {-std::sin(a), 0, -std::cos(a)}, 1.0f});
+    settings.shading.lights.push_back(
+        Light{Light::Kind::Directional, {-std::sin(a), 0, -std::cos(a)}, 1.0f});
     EXPECT_EQ(colours(r, s, settings, kTopDown)(16, 16).x, 1.0f);
     // Dimmed to a quarter each: 0.17 -> 0.5 band.
     for (Light& l : settings.shading.lights) l.intensity = 0.25f;
@@ -109,7 +112,8 @@ TEST(Shading, ToonShadowsDarkenWhatIsBlocked) {
     // A floor and a small square hovering above its middle, lit from straight above.
     Scene s = square(10.0f);
     auto base = static_cast<std::uint32_t>(s.positions.size());
-    for (Vec3f p : {Vec3f(-2, -2, 3), Vec3f(2, -2, 3), Vec3f(2, 2, 3), Vec3f(-2, 2, 3)}) s.positions.push_back(p);
+    for (Vec3f p : {Vec3f(-2, -2, 3), Vec3f(2, -2, 3), Vec3f(2, 2, 3), Vec3f(-2, 2, 3)})
+        s.positions.push_back(p);
     s.add_triangle({base, base + 1, base + 2}, 1, 0);
     s.add_triangle({base, base + 2, base + 3}, 1, 0);
     RenderSettings settings;
@@ -130,8 +134,8 @@ TEST(Shading, ToonShadowsDarkenWhatIsBlocked) {
             else if (shadowed(x, y).x == without(x, y).x) ++same;
             EXPECT_LE(shadowed(x, y).x, without(x, y).x);
         }
-    EXPECT_GT(darker, 20);   // the shadow on the floor
-    EXPECT_GT(same, 1000);   // everything else unchanged
+    EXPECT_GT(darker, 20);  // the shadow on the floor
+    EXPECT_GT(same, 1000);  // everything else unchanged
 }
 
 TEST(Shading, SpecularBandFromKsAndNs) {
@@ -141,13 +145,14 @@ TEST(Shading, SpecularBandFromKsAndNs) {
     RenderSettings settings;
     settings.width = 64;
     settings.height = 64;
-    settings.shading.lights = {Light{Light::Kind::Point, {0, 0, 8}, 1.0f}};  // at the eye: highlight in the middle
+    settings.shading.lights = {
+        Light{Light::Kind::Point, {0, 0, 8}, 1.0f}};  // at the eye: highlight in the middle
     Renderer r;
     EXPECT_EQ(colours(r, s, settings, kTopDown)(32, 32).x, 0.5f);  // off by default
     settings.shading.specular = true;
     const Image<Vec3f>& c = colours(r, s, settings, kTopDown);
     EXPECT_FLOAT_EQ(c(32, 32).x, 0.8f);  // Kd + Ks in the band
-    EXPECT_FLOAT_EQ(c(2, 2).x, 0.5f);  // far from it: no highlight (l.n = 0.58, the full band)
+    EXPECT_FLOAT_EQ(c(2, 2).x, 0.5f);    // far from it: no highlight (l.n = 0.58, the full band)
 }
 
 TEST(Shading, RimBandBrightensGrazingSurfaces) {
@@ -181,7 +186,8 @@ TEST(Shading, TexturesMultiplyKd) {
     ImageRgb8 tex(16, 16);
     for (int y = 0; y < 16; ++y)
         for (int x = 0; x < 16; ++x)
-            tex(x, y) = y < 8 ? (x < 8 ? Rgb8{255, 0, 0} : Rgb8{0, 255, 0}) : (x < 8 ? Rgb8{0, 0, 255} : Rgb8{255, 255, 255});
+            tex(x, y) = y < 8 ? (x < 8 ? Rgb8{255, 0, 0} : Rgb8{0, 255, 0})
+                              : (x < 8 ? Rgb8{0, 0, 255} : Rgb8{255, 255, 255});
     Scene s = square(8.0f);
     TextureSet textures(s.materials.size());
     textures[1] = std::make_shared<const ImageRgb8>(tex);
@@ -212,12 +218,14 @@ TEST(Shading, PlainPathEqualsTheGeneralOne) {
     RenderSettings settings;
     settings.width = 48;
     settings.height = 48;
-    settings.shading.lights = {Light{Light::Kind::Point, {6, 0, 1.5f}, 1.0f}};  // low: all three bands
+    settings.shading.lights = {
+        Light{Light::Kind::Point, {6, 0, 1.5f}, 1.0f}};  // low: all three bands
     Renderer r;
     const Image<Vec3f> plain = colours(r, s, settings, kTopDown);
     int bands[3] = {0, 0, 0};
     for (std::size_t i = 0; i < plain.size(); ++i)
-        for (int b = 0; b < 3; ++b) bands[b] += plain.data()[i].x == 0.8f * (b == 0 ? 0.5f : b == 1 ? 0.75f : 1.0f);
+        for (int b = 0; b < 3; ++b)
+            bands[b] += plain.data()[i].x == 0.8f * (b == 0 ? 0.5f : b == 1 ? 0.75f : 1.0f);
     EXPECT_GT(bands[0], 0);
     EXPECT_GT(bands[1], 0);
     EXPECT_GT(bands[2], 0);
@@ -228,6 +236,7 @@ TEST(Shading, PlainPathEqualsTheGeneralOne) {
     for (const RenderSettings& general : {shadowed, two_lights}) {
         const Image<Vec3f>& other = colours(r, s, general, kTopDown);
         ASSERT_EQ(other.size(), plain.size());
-        for (std::size_t i = 0; i < plain.size(); ++i) EXPECT_EQ(other.data()[i], plain.data()[i]) << i;
+        for (std::size_t i = 0; i < plain.size(); ++i)
+            EXPECT_EQ(other.data()[i], plain.data()[i]) << i;
     }
 }

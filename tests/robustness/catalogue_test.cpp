@@ -15,14 +15,17 @@ using namespace robustness;
 namespace {
 
 struct BadInput {
-    std::string name;      ///< test name
-    std::string args;      ///< toonray arguments; {data} = tests/robustness/data, {out} = a fresh directory
-    std::string error;     ///< the expected "toonray: error: " line, without that prefix
+    std::string name;  ///< test name
+    std::string
+        args;  ///< toonray arguments; {data} = tests/robustness/data, {out} = a fresh directory
+    std::string error;  ///< the expected "toonray: error: " line, without that prefix
 };
 
 std::string expand(std::string s, const std::string& out) {
-    for (auto [key, value] : {std::pair<std::string, std::string>{"{data}", TOONRAY_ROBUSTNESS_DATA}, {"{out}", out}}) {
-        for (std::size_t at; (at = s.find(key)) != std::string::npos;) s.replace(at, key.size(), value);
+    for (auto [key, value] :
+         {std::pair<std::string, std::string>{"{data}", TOONRAY_ROBUSTNESS_DATA}, {"{out}", out}}) {
+        for (std::size_t at; (at = s.find(key)) != std::string::npos;)
+            s.replace(at, key.size(), value);
     }
     return s;
 }
@@ -33,13 +36,17 @@ const std::string kTo = " -o {out}/frame.png --size 64x48 --threads 1";
 std::vector<BadInput> catalogue() {
     return {
         // --- files that are not OBJ text ---
-        {"EmptyObj", kRender + "empty.obj" + kTo, "{data}/empty.obj: empty file: no OBJ statements"},
-        {"BlankObj", kRender + "blank.obj" + kTo, "{data}/blank.obj: blank file: no OBJ statements"},
+        {"EmptyObj", kRender + "empty.obj" + kTo,
+         "{data}/empty.obj: empty file: no OBJ statements"},
+        {"BlankObj", kRender + "blank.obj" + kTo,
+         "{data}/blank.obj: blank file: no OBJ statements"},
         {"BinaryObj", kRender + "binary.obj" + kTo,
          "{data}/binary.obj:3: binary data (NUL byte): not an OBJ text file"},
         // --- numbers ---
-        {"NanCoordinate", kRender + "nan.obj" + kTo, "{data}/nan.obj:4: non-finite number 'nan' in 'v' statement"},
-        {"InfCoordinate", kRender + "inf.obj" + kTo, "{data}/inf.obj:4: non-finite number 'inf' in 'v' statement"},
+        {"NanCoordinate", kRender + "nan.obj" + kTo,
+         "{data}/nan.obj:4: non-finite number 'nan' in 'v' statement"},
+        {"InfCoordinate", kRender + "inf.obj" + kTo,
+         "{data}/inf.obj:4: non-finite number 'inf' in 'v' statement"},
         {"HugeCoordinate", kRender + "huge.obj" + kTo,
          "{data}/huge.obj:4: number '1e39' out of range in 'v' statement"},
         // --- face indices ---
@@ -74,7 +81,8 @@ std::vector<BadInput> catalogue() {
          "{data}/degenerate.obj: 204 bytes, more than the input size limit of 100 bytes (--max-input-size raises it)"},
         {"ImageTooLarge", kRender + "degenerate.obj -o {out}/frame.png --size 20000x20000",
          "image size 20000x20000: 400000000 pixels, more than the limit of 67108864 (--max-image-pixels raises it)"},
-        {"FrameBuffersOverMemory", kRender + "degenerate.obj -o {out}/frame.png --size 4096x4096 --max-memory 64M",
+        {"FrameBuffersOverMemory",
+         kRender + "degenerate.obj -o {out}/frame.png --size 4096x4096 --max-memory 64M",
          "a 4096x4096 frame needs about 3.0 GiB of memory, more than the limit of 64 MiB (--max-memory raises it)"},
         {"BadLimitValue", kRender + "degenerate.obj" + kTo + " --max-triangles lots",
          "--max-triangles: expected a positive number such as 50000000 or 50M, got 'lots'"},
@@ -103,7 +111,8 @@ std::vector<BadInput> catalogue() {
          "--size 64x48 --quiet",
          "the soundtrack (400000 s) needs about 131 GiB of memory, more than the limit of 1.0 GiB (--max-memory "
          "raises it)"},
-        {"DemoScoreLastingCenturies", "demo --score {data}/long.notes -o {out} --full --size 64x48 --quiet",
+        {"DemoScoreLastingCenturies",
+         "demo --score {data}/long.notes -o {out} --full --size 64x48 --quiet",
          "36028794871 s at 24 fps: over 2147483647 frames is more than the limit of 10000000"},
         {"DemoSoundtrackOverMemory",
          "demo --score {data}/good.mid -o {out} --seconds 400000 --fps 0.001 --max-memory 1G --size 64x48 --quiet",
@@ -113,14 +122,16 @@ std::vector<BadInput> catalogue() {
         {"CameraPathTimesDecrease",
          "piano --camera-path {data}/times_decrease.campath -o {out} --seconds 1 --size 64x48 --quiet",
          "{data}/times_decrease.campath:2: key times must increase: 1 s comes after 2 s (line 1)"},
-        {"BinaryCameraPath", "piano --camera-path {data}/binary.campath -o {out} --seconds 1 --size 64x48 --quiet",
+        {"BinaryCameraPath",
+         "piano --camera-path {data}/binary.campath -o {out} --seconds 1 --size 64x48 --quiet",
          "{data}/binary.campath:2: binary data (NUL byte): not a camera path file"},
         // --- frame ranges ---
         {"FrameRangeBackwards", "batch keys 5 4 --input {data} --output {out}",
          "frame range 5 4: the first frame is after the last"},
         {"FrameRangeTooLong", "batch keys 0 2000000000 --input {data} --output {out}",
          "frame range 0 2000000000: 2000000001 frames is more than the limit of 10000000"},
-        {"TooManyJobsForMemory", "batch keys 1 4 --input {data} --output {out} --size 1024x1024 --jobs 4 --max-memory 600M",
+        {"TooManyJobsForMemory",
+         "batch keys 1 4 --input {data} --output {out} --size 1024x1024 --jobs 4 --max-memory 600M",
          "4 frames at once (a 1024x1024 frame each) needs about 773 MiB of memory, more than the limit of 600 MiB "
          "(--max-memory raises it, or render fewer frames at once with --jobs)"},
     };
@@ -140,7 +151,8 @@ TEST_P(Catalogue, FailsWithTheExactErrorAndLeavesNothing) {
     std::vector<std::string> errors = error_lines(r.output);
     ASSERT_EQ(errors.size(), 1u) << r.output;
     EXPECT_EQ(errors[0], expand(c.error, out.path.string()));
-    EXPECT_EQ(files_under(out.path), std::vector<std::string>{}) << "a failed run must leave no output";
+    EXPECT_EQ(files_under(out.path), std::vector<std::string>{})
+        << "a failed run must leave no output";
 }
 
 INSTANTIATE_TEST_SUITE_P(BadInputs, Catalogue, ::testing::ValuesIn(catalogue()),
@@ -158,8 +170,8 @@ TEST(CatalogueCli, HelpListsTheLimitsAndTheirDefaults) {
     for (const char* command : {"render", "batch", "piano", "demo", "score convert"}) {
         CommandResult r = run_toonray(std::string(command) + " --help");
         ASSERT_EQ(r.exit_code, 0) << r.output;
-        for (const char* opt : {"--max-triangles", "--max-vertices", "--max-image-pixels", "--max-memory",
-                                "--max-input-size"})
+        for (const char* opt : {"--max-triangles", "--max-vertices", "--max-image-pixels",
+                                "--max-memory", "--max-input-size"})
             EXPECT_NE(r.output.find(opt), std::string::npos) << command << " " << opt;
         EXPECT_NE(r.output.find("default 50000000"), std::string::npos) << command;
         EXPECT_NE(r.output.find("default 67108864 = 8192x8192"), std::string::npos) << command;
@@ -208,11 +220,13 @@ TEST(CatalogueWorks, MissingMaterialLibraryIsAWarning) {
     CommandResult r = render_ok("missing_mtllib.obj", out);
     ASSERT_EQ(r.exit_code, 0) << r.output;
     const std::string data = TOONRAY_ROBUSTNESS_DATA;
-    EXPECT_NE(r.output.find("toonray: warning: " + data + "/missing_mtllib.obj:1: cannot read material library '" +
-                            data + "/does_not_exist.mtl' (" + data +
-                            "/does_not_exist.mtl: cannot open: No such file or directory); faces using its "
-                            "materials get the default material"),
-              std::string::npos)
+    EXPECT_NE(
+        r.output.find(
+            "toonray: warning: " + data + "/missing_mtllib.obj:1: cannot read material library '" +
+            data + "/does_not_exist.mtl' (" + data +
+            "/does_not_exist.mtl: cannot open: No such file or directory); faces using its "
+            "materials get the default material"),
+        std::string::npos)
         << r.output;
     EXPECT_TRUE(toonray::is_valid_png(out / "frame.png"));
 }

@@ -62,7 +62,8 @@ TEST(Filesystem, OutputPathThroughAFileIsAClearError) {
     const fs::path out = dir / "file" / "frame.png";
     CommandResult r = run_toonray("render " + kTeapot + " -o " + out.string() + " --size 64x48");
     EXPECT_EQ(r.exit_code, 1) << r.output;
-    EXPECT_EQ(error_lines(r.output), std::vector<std::string>{out.string() + ": cannot create file: Not a directory"});
+    EXPECT_EQ(error_lines(r.output),
+              std::vector<std::string>{out.string() + ": cannot create file: Not a directory"});
     EXPECT_EQ(files_under(dir.path), std::vector<std::string>{"file"});
 }
 
@@ -70,17 +71,20 @@ TEST(Filesystem, ReadOnlyOutputDirectory) {
     ReadOnlyDir ro("fs_readonly");
     if (ro.path.empty()) GTEST_SKIP() << ro.mount->why;
     const std::string err = ::geteuid() == 0 ? "Read-only file system" : "Permission denied";
-    CommandResult r = run_toonray("render " + kTeapot + " -o " + (ro.path / "frame.png").string() + " --size 64x48");
+    CommandResult r = run_toonray("render " + kTeapot + " -o " + (ro.path / "frame.png").string() +
+                                  " --size 64x48");
     EXPECT_EQ(r.exit_code, 1) << r.output;
-    EXPECT_EQ(error_lines(r.output),
-              std::vector<std::string>{(ro.path / "frame.png").string() + ": cannot create file: " + err});
+    EXPECT_EQ(error_lines(r.output), std::vector<std::string>{(ro.path / "frame.png").string() +
+                                                              ": cannot create file: " + err});
 
     TempDir in("fs_readonly_in");
     fs::copy_file(kTeapot, in / "keys_000001.obj");
-    r = run_toonray("batch keys 1 1 --quiet --input " + in.path.string() + " --output " + ro.path.string());
+    r = run_toonray("batch keys 1 1 --quiet --input " + in.path.string() + " --output " +
+                    ro.path.string());
     EXPECT_EQ(r.exit_code, 1) << r.output;
     EXPECT_EQ(error_lines(r.output),
-              std::vector<std::string>{ro.path.string() + ": output directory cannot be created or is not writable"});
+              std::vector<std::string>{ro.path.string() +
+                                       ": output directory cannot be created or is not writable"});
     EXPECT_EQ(files_under(ro.path), std::vector<std::string>{});
 }
 
@@ -89,9 +93,11 @@ TEST(Filesystem, FullDiskFailsTheFrameAndLeavesNoPartialFile) {
     ScratchMount disk("fs_full", "size=32k");
     if (!disk.ok) GTEST_SKIP() << disk.why;
     const fs::path out = disk.path / "frame.png";
-    CommandResult r = run_toonray("render " + kTeapot + " -o " + out.string() + " --size 1280x720 --edges classic");
+    CommandResult r = run_toonray("render " + kTeapot + " -o " + out.string() +
+                                  " --size 1280x720 --edges classic");
     EXPECT_EQ(r.exit_code, 1) << r.output;
-    EXPECT_EQ(error_lines(r.output), std::vector<std::string>{out.string() + ": write failed: No space left on device"});
+    EXPECT_EQ(error_lines(r.output),
+              std::vector<std::string>{out.string() + ": write failed: No space left on device"});
     EXPECT_EQ(files_under(disk.path), std::vector<std::string>{}) << "no partial or temporary file";
 
     // A batch goes on past a failed frame and reports it; small frames still fit.
@@ -101,7 +107,8 @@ TEST(Filesystem, FullDiskFailsTheFrameAndLeavesNoPartialFile) {
     r = run_toonray("batch keys 1 2 --quiet --jobs 1 --input " + in.path.string() + " --output " +
                     disk.path.string() + " --size 1280x720 --edges classic");
     EXPECT_EQ(r.exit_code, 1) << r.output;
-    EXPECT_NE(r.output.find("write failed: No space left on device"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("write failed: No space left on device"), std::string::npos)
+        << r.output;
     EXPECT_EQ(count_with(disk.path, ".tmp"), 0);
     EXPECT_EQ(count_with(disk.path, ".png"), 0);
 
@@ -114,7 +121,8 @@ TEST(Filesystem, FullDiskFailsTheFrameAndLeavesNoPartialFile) {
     r = run_toonray("score convert " + std::string(TOONRAY_DATA_DIR) + "/entertainer.midi " +
                     (disk.path / "out.notes").string());
     EXPECT_EQ(r.exit_code, 1) << r.output;
-    EXPECT_NE(r.output.find((disk.path / "out.notes").string() + ": "), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find((disk.path / "out.notes").string() + ": "), std::string::npos)
+        << r.output;
     EXPECT_EQ(files_under(disk.path), std::vector<std::string>{"fill"});
 }
 
@@ -147,10 +155,12 @@ TEST(Interruption, SigtermStopsABatchCleanly) {
     for (int f = 1; f <= frames; ++f)
         fs::create_symlink(kTeapot, dir / "in" / fmt::format("keys_{:06d}.obj", f));
     const fs::path out = dir / "png";
-    int status = interrupt_when({"batch", "keys", "1", std::to_string(frames), "--input", (dir / "in").string(),
-                                 "--output", out.string(), "--size", "320x240", "--quiet", "--jobs", "2"},
-                                out, 3, SIGTERM);
-    ASSERT_TRUE(WIFEXITED(status)) << "killed by signal " << (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
+    int status = interrupt_when(
+        {"batch", "keys", "1", std::to_string(frames), "--input", (dir / "in").string(), "--output",
+         out.string(), "--size", "320x240", "--quiet", "--jobs", "2"},
+        out, 3, SIGTERM);
+    ASSERT_TRUE(WIFEXITED(status))
+        << "killed by signal " << (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
     EXPECT_EQ(WEXITSTATUS(status), 130);
     const int done = count_with(out, ".png");
     EXPECT_GE(done, 3);
@@ -162,10 +172,11 @@ TEST(Interruption, SigtermStopsABatchCleanly) {
 TEST(Interruption, SigtermStopsAPianoMovieCleanly) {
     TempDir dir("fs_sigterm_piano");
     const fs::path out = dir / "png";
-    int status = interrupt_when({"piano", "-o", out.string(), "--seconds", "20", "--size", "160x120", "--quiet",
-                                 "--jobs", "1"},
+    int status = interrupt_when({"piano", "-o", out.string(), "--seconds", "20", "--size",
+                                 "160x120", "--quiet", "--jobs", "1"},
                                 out, 2, SIGTERM);
-    ASSERT_TRUE(WIFEXITED(status)) << "killed by signal " << (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
+    ASSERT_TRUE(WIFEXITED(status))
+        << "killed by signal " << (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
     EXPECT_EQ(WEXITSTATUS(status), 130);
     EXPECT_LT(count_with(out, ".png"), 480);
     EXPECT_EQ(count_with(out, ".tmp"), 0) << "no temporary file may remain";

@@ -70,11 +70,15 @@ TEST_P(FuzzReplay, SeedsAndPastCrashesPass) {
     toonray::set_limits(saved);
 }
 
-INSTANTIATE_TEST_SUITE_P(
-    Targets, FuzzReplay,
-    ::testing::Values(Target{"obj", toonray_fuzz_obj}, Target{"mtl", toonray_fuzz_mtl},
-                      Target{"camera", toonray_fuzz_camera}, Target{"note_script", toonray_fuzz_note_script},
-                      Target{"midi", toonray_fuzz_midi}, Target{"camera_path", toonray_fuzz_camera_path},
-                      Target{"options", toonray_fuzz_options}, Target{"png", toonray_fuzz_png, toonray_fuzz_init_png},
-                      Target{"render", toonray_fuzz_render}, Target{"shading", toonray_fuzz_shading}),
-    [](const auto& info) { return std::string(info.param.name); });
+INSTANTIATE_TEST_SUITE_P(Targets, FuzzReplay,
+                         ::testing::Values(Target{"obj", toonray_fuzz_obj},
+                                           Target{"mtl", toonray_fuzz_mtl},
+                                           Target{"camera", toonray_fuzz_camera},
+                                           Target{"note_script", toonray_fuzz_note_script},
+                                           Target{"midi", toonray_fuzz_midi},
+                                           Target{"camera_path", toonray_fuzz_camera_path},
+                                           Target{"options", toonray_fuzz_options},
+                                           Target{"png", toonray_fuzz_png, toonray_fuzz_init_png},
+                                           Target{"render", toonray_fuzz_render},
+                                           Target{"shading", toonray_fuzz_shading}),
+                         [](const auto& info) { return std::string(info.param.name); });

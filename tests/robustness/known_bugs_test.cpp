@@ -19,8 +19,9 @@ using namespace toonray;
 // (UBSan: "-nan is outside the range of representable values of type 'int'"; on x86 it gives
 // INT_MIN, an out-of-bounds bin).
 TEST(KnownBugs, BvhBinningWithExtremeCoordinates) {
-    for (const char* name : {"fuzz/render/bvh_binning_nan_huge_span.obj", "fuzz/render/bvh_binning_nan_tiny_span.obj",
-                             "fuzz/render/bvh_binning_inf_found_by_fuzzing.obj"}) {
+    for (const char* name :
+         {"fuzz/render/bvh_binning_nan_huge_span.obj", "fuzz/render/bvh_binning_nan_tiny_span.obj",
+          "fuzz/render/bvh_binning_inf_found_by_fuzzing.obj"}) {
         Scene scene;
         Warnings warnings;
         load_obj(robustness::data(name), scene, warnings);
@@ -30,7 +31,8 @@ TEST(KnownBugs, BvhBinningWithExtremeCoordinates) {
         settings.width = 32;
         settings.height = 24;
         Renderer renderer;
-        const CameraSpec camera = scene.camera ? *scene.camera : auto_camera(scene.positions, 32, 24);
+        const CameraSpec camera =
+            scene.camera ? *scene.camera : auto_camera(scene.positions, 32, 24);
         const ImageRgb8& image = renderer.render(scene, accel, camera, settings);
         EXPECT_EQ(image.width(), 32) << name;
     }

@@ -143,14 +143,17 @@ TEST(ReadFile, RefusesFilesOverTheLimitBeforeReading) {
 
 TEST(ReadFile, RefusesDirectoriesDevicesAndFifosWithoutBlocking) {
     TempDir dir("limits_special");
-    EXPECT_EQ(error_of([&] { read_file(dir.path); }), dir.path.string() + ": is a directory, not a file");
-    EXPECT_EQ(error_of([] { read_file("/dev/zero"); }),
-              "/dev/zero: not a regular file (a device, FIFO or socket); toonray reads inputs from regular files only");
+    EXPECT_EQ(error_of([&] { read_file(dir.path); }),
+              dir.path.string() + ": is a directory, not a file");
+    EXPECT_EQ(
+        error_of([] { read_file("/dev/zero"); }),
+        "/dev/zero: not a regular file (a device, FIFO or socket); toonray reads inputs from regular files only");
     // A FIFO with no writer: opening it for reading would block forever.
     ASSERT_EQ(::mkfifo((dir / "fifo").c_str(), 0600), 0);
-    EXPECT_EQ(error_of([&] { read_file(dir / "fifo"); }),
-              (dir / "fifo").string() +
-                  ": not a regular file (a device, FIFO or socket); toonray reads inputs from regular files only");
+    EXPECT_EQ(
+        error_of([&] { read_file(dir / "fifo"); }),
+        (dir / "fifo").string() +
+            ": not a regular file (a device, FIFO or socket); toonray reads inputs from regular files only");
 }
 
 TEST(ReadFile, ReadsProcFilesThatReportSizeZero) {
@@ -166,9 +169,14 @@ TEST(ObjLimits, LineLength) {
     EXPECT_EQ(parse_with("v 0 0 0\n# " + std::string(62, 'x') + "\n", o).positions.size(), 1u);
     EXPECT_EQ(error_of([&] { parse_with("v 0 0 0\n# " + std::string(63, 'x') + "\n", o); }),
               "limits.obj:2: line longer than the limit of 64 bytes");
-    EXPECT_EQ(limit_of([&] { parse_with("v 0 0 0\n# " + std::string(63, 'x') + "\n", o); }), Limit::LineBytes);
+    EXPECT_EQ(limit_of([&] { parse_with("v 0 0 0\n# " + std::string(63, 'x') + "\n", o); }),
+              Limit::LineBytes);
     // Continuations count as one line.
-    EXPECT_EQ(error_of([&] { parse_with("v 0 0 0\nf 1 \\\n" + std::string(30, ' ') + "\\\n" + std::string(40, ' '), o); }),
+    EXPECT_EQ(error_of([&] {
+                  parse_with(
+                      "v 0 0 0\nf 1 \\\n" + std::string(30, ' ') + "\\\n" + std::string(40, ' '),
+                      o);
+              }),
               "limits.obj:2: line (with its continuations) longer than the limit of 64 bytes");
 }
 
@@ -182,9 +190,13 @@ TEST(ObjLimits, VertexAndTriangleCounts) {
     EXPECT_EQ(error_of([&] { parse_with(quad + "v 2 2 2\n", o); }),
               "limits.obj:5: more than 4 vertices ('v') (the limit)");
     EXPECT_EQ(limit_of([&] { parse_with(quad + "v 2 2 2\n", o); }), Limit::Vertices);
-    EXPECT_EQ(error_of([&] { parse_with(quad + "vn 0 0 1\nvn 0 0 1\nvn 0 0 1\nvn 0 0 1\nvn 0 0 1\n", o); }),
+    EXPECT_EQ(error_of([&] {
+                  parse_with(quad + "vn 0 0 1\nvn 0 0 1\nvn 0 0 1\nvn 0 0 1\nvn 0 0 1\n", o);
+              }),
               "limits.obj:9: more than 4 normals ('vn') (the limit)");
-    EXPECT_EQ(limit_of([&] { parse_with(quad + "vn 0 0 1\nvn 0 0 1\nvn 0 0 1\nvn 0 0 1\nvn 0 0 1\n", o); }),
+    EXPECT_EQ(limit_of([&] {
+                  parse_with(quad + "vn 0 0 1\nvn 0 0 1\nvn 0 0 1\nvn 0 0 1\nvn 0 0 1\n", o);
+              }),
               Limit::Vertices);
     EXPECT_EQ(error_of([&] { parse_with(quad + "f 1 2 3 4\nf 1 2 3\n", o); }),
               "limits.obj:6: more than 2 triangles (the limit)");
@@ -199,7 +211,10 @@ TEST(ObjLimits, MemoryEstimateIsCheckedAsTheSceneGrows) {
     std::string text;
     for (int i = 0; i < 100'000; ++i) text += "v 0 0 0\n";
     const std::string e = error_of([&] { parse_with(text, o); });
-    EXPECT_EQ(e.rfind("limits.obj:65536: the scene so far (65535 vertices, 0 triangles) needs about ", 0), 0u) << e;
+    EXPECT_EQ(
+        e.rfind("limits.obj:65536: the scene so far (65535 vertices, 0 triangles) needs about ", 0),
+        0u)
+        << e;
     EXPECT_TRUE(e.ends_with("more than the limit of 2.0 MiB")) << e;
     EXPECT_EQ(limit_of([&] { parse_with(text, o); }), Limit::Memory);
     // Memory reserved for frame buffers counts too.
@@ -207,7 +222,9 @@ TEST(ObjLimits, MemoryEstimateIsCheckedAsTheSceneGrows) {
         l.max_memory = 64 * kMiB;
         l.reserved_memory = 64 * kMiB;
     });
-    EXPECT_NE(error_of([&] { parse_with("v 0 0 0\n", reserved); }).find("limits.obj: the scene so far"), std::string::npos);
+    EXPECT_NE(
+        error_of([&] { parse_with("v 0 0 0\n", reserved); }).find("limits.obj: the scene so far"),
+        std::string::npos);
 }
 
 TEST(ObjLimits, ManyWarningsAreCappedWithACount) {
@@ -255,9 +272,14 @@ TEST(ObjLimits, RepeatedMaterialLibrariesAreReadOnce) {
 }
 
 TEST(ObjLimits, IndicesPastTwoToTheThirtyOneAreOutOfRange) {
-    for (const char* index : {"2147483648", "4294967296", "4294967297", "-4294967296", "9223372036854775807"}) {
-        const std::string e = error_of([&] { parse_with(std::string("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 ") + index + "\n", ObjOptions{}); });
-        EXPECT_EQ(e, std::string("limits.obj:4: face vertex index ") + index + " out of range (3 vertices defined so far)");
+    for (const char* index :
+         {"2147483648", "4294967296", "4294967297", "-4294967296", "9223372036854775807"}) {
+        const std::string e = error_of([&] {
+            parse_with(std::string("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 ") + index + "\n",
+                       ObjOptions{});
+        });
+        EXPECT_EQ(e, std::string("limits.obj:4: face vertex index ") + index +
+                         " out of range (3 vertices defined so far)");
     }
 }
 
@@ -289,7 +311,8 @@ TEST(ObjLimits, AMillionVertexFaceLoads) {
 TEST(PngLimits, HeaderAnnouncingAHugeImageIsRefusedBeforeAllocating) {
     // A valid 1x1 PNG whose IHDR claims 100000 x 100000 (CRC fixed up): libpng would accept the
     // header, and decoding would allocate 30 GB.
-    std::string png = robustness::slurp(std::filesystem::path(TOONRAY_FUZZ_DIR) / "corpus" / "png" / "rgb.png");
+    std::string png =
+        robustness::slurp(std::filesystem::path(TOONRAY_FUZZ_DIR) / "corpus" / "png" / "rgb.png");
     auto be32 = [&](std::size_t at, std::uint32_t v) {
         for (int i = 0; i < 4; ++i) png[at + i] = static_cast<char>(v >> (24 - 8 * i));
     };
@@ -324,7 +347,10 @@ TEST(FrameLimits, PlanChecksPixelsAndMemoryAndFitsJobsToMemory) {
         const std::uint64_t frame = frame_bytes(o);
         ScopedLimits l([&](Limits& x) { x.max_memory = 2 * frame + frame / 2; });
         EXPECT_EQ(plan_frame_jobs(o, 0, 100).jobs, std::min(2, hardware_threads()));
-        EXPECT_EQ(error_of([&] { plan_frame_jobs(o, 4, 100); }).rfind("4 frames at once (a 1920x1080 frame each) needs about ", 0), 0u);
+        EXPECT_EQ(error_of([&] {
+                      plan_frame_jobs(o, 4, 100);
+                  }).rfind("4 frames at once (a 1920x1080 frame each) needs about ", 0),
+                  0u);
         EXPECT_EQ(limit_of([&] { plan_frame_jobs(o, 4, 100); }), Limit::Memory);
     }
     s.width = 10000;
@@ -340,10 +366,16 @@ TEST(FrameLimits, PlanChecksPixelsAndMemoryAndFitsJobsToMemory) {
 }
 
 TEST(FrameLimits, FrameRangesAreCheckedBeforeAllocating) {
-    EXPECT_EQ(error_of([] { shard_frames(0, 2147483647, {1, 1}); }),
+    EXPECT_EQ(error_of([] {
+                  shard_frames(0, 2147483647, {1, 1});
+              }),
               "frame range 0 2147483647: 2147483648 frames is more than the limit of 10000000");
-    EXPECT_EQ(shard_frames(0, 2147483647, {1, 1000}).size(), 2147484u);  // within the limit once sharded
-    EXPECT_EQ(error_of([] { shard_frames(5, 4, {1, 1}); }), "frame range 5 4: the first frame is after the last");
+    EXPECT_EQ(shard_frames(0, 2147483647, {1, 1000}).size(),
+              2147484u);  // within the limit once sharded
+    EXPECT_EQ(error_of([] {
+                  shard_frames(5, 4, {1, 1});
+              }),
+              "frame range 5 4: the first frame is after the last");
 }
 
 TEST(FrameLimits, FrameCountSaturatesInsteadOfOverflowing) {
@@ -377,6 +409,8 @@ TEST(CameraPathLimits, KeyCount) {
     ScopedLimits l([](Limits& x) { x.max_camera_keys = 2; });
     const std::string two = "key 0 eye 0 1 5 target 0 0 0\nkey 1 eye 5 1 0 target 0 0 0\n";
     EXPECT_EQ(parse_camera_path(two, "p.campath").keys().size(), 2u);
-    EXPECT_EQ(error_of([&] { (void)parse_camera_path(two + "key 2 eye 0 1 -5 target 0 0 0\n", "p.campath"); }),
+    EXPECT_EQ(error_of([&] {
+                  (void)parse_camera_path(two + "key 2 eye 0 1 -5 target 0 0 0\n", "p.campath");
+              }),
               "p.campath:3: more than 2 camera keys (the limit)");
 }

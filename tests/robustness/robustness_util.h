@@ -34,8 +34,8 @@ inline std::vector<std::string> files_under(const fs::path& dir) {
     if (!fs::exists(dir, ec)) return out;
     // Files may come and go while a run is in progress (temporary files being renamed): no
     // call here may touch the filesystem beyond the listing itself.
-    for (auto it = fs::recursive_directory_iterator(dir, ec); !ec && it != fs::recursive_directory_iterator();
-         it.increment(ec))
+    for (auto it = fs::recursive_directory_iterator(dir, ec);
+         !ec && it != fs::recursive_directory_iterator(); it.increment(ec))
         if (it->is_regular_file(ec)) out.push_back(it->path().lexically_relative(dir).string());
     return out;
 }
@@ -61,16 +61,17 @@ struct ScratchMount {
     std::string why;
 
     ScratchMount(const std::string& name, const std::string& options, bool read_only = false) {
-        path = fs::temp_directory_path() / ("toonray_mount_" + name + "_" + std::to_string(::getpid()));
+        path = fs::temp_directory_path() /
+               ("toonray_mount_" + name + "_" + std::to_string(::getpid()));
         fs::create_directories(path);
         if (::geteuid() != 0) {
             why = "not root: cannot mount a tmpfs";
             return;
         }
-        if (::mount("tmpfs", path.c_str(), "tmpfs", read_only ? MS_RDONLY : 0, options.c_str()) != 0) {
+        if (::mount("tmpfs", path.c_str(), "tmpfs", read_only ? MS_RDONLY : 0, options.c_str()) !=
+            0) {
             why = std::string("mount -t tmpfs -o ") + options + (read_only ? ",ro" : "") +
-                  " failed: " + std::strerror(errno) +
-                  " (a container without CAP_SYS_ADMIN?)";
+                  " failed: " + std::strerror(errno) + " (a container without CAP_SYS_ADMIN?)";
             return;
         }
         ok = true;

@@ -53,7 +53,8 @@ TEST(ViewPlane, InvalidCamerasAreErrors) {
 TEST(AutoCamera, EveryPointProjectsInsideTheImage) {
     std::vector<Vec3f> points;
     for (int i = 0; i < 200; ++i)
-        points.push_back({std::sin(i * 0.7f) * 3.0f, std::cos(i * 1.3f) * 0.5f + 10.0f, (i % 17) * 0.2f});
+        points.push_back(
+            {std::sin(i * 0.7f) * 3.0f, std::cos(i * 1.3f) * 0.5f + 10.0f, (i % 17) * 0.2f});
     for (auto [w, h] : {std::pair{1280, 720}, std::pair{400, 800}}) {
         CameraSpec cam = auto_camera(points, w, h);
         ViewPlane v = make_view_plane(cam, w, h);
@@ -99,15 +100,18 @@ std::string camera_error(const CameraSpec& c) {
 
 TEST(ValidateCamera, NamesWhatIsWrong) {
     EXPECT_EQ(camera_error({{0, 0, 0}, {0, 0, -1}, {0, 1, 0}}), "(valid)");
-    EXPECT_EQ(camera_error({{0, 0, NAN}, {0, 0, -1}, {0, 1, 0}}), "invalid camera: eye, gaze and up must be finite");
-    EXPECT_EQ(camera_error({{1, 2, 3}, {1, 2, 3}, {0, 1, 0}}), "invalid camera: eye and gaze point are the same point");
+    EXPECT_EQ(camera_error({{0, 0, NAN}, {0, 0, -1}, {0, 1, 0}}),
+              "invalid camera: eye, gaze and up must be finite");
+    EXPECT_EQ(camera_error({{1, 2, 3}, {1, 2, 3}, {0, 1, 0}}),
+              "invalid camera: eye and gaze point are the same point");
     EXPECT_EQ(camera_error({{0, 0, 0}, {0, 0, -1}, {0, 0, 0}}),
               "invalid camera: up vector is zero or parallel to the view direction");
     EXPECT_EQ(camera_error({{0, 0, 0}, {0, 0, -1}, {0, 0, 1}}),
               "invalid camera: up vector is zero or parallel to the view direction");
-    EXPECT_EQ(camera_error({{0, 0, 0}, {0, 0, -3e7f}, {0, 1, 0}}),
-              "invalid camera: the gaze point is 3e+07 from the eye (at most 1e6; the distance sets the field of "
-              "view, 1 gives 90 degrees)");
+    EXPECT_EQ(
+        camera_error({{0, 0, 0}, {0, 0, -3e7f}, {0, 1, 0}}),
+        "invalid camera: the gaze point is 3e+07 from the eye (at most 1e6; the distance sets the field of "
+        "view, 1 gives 90 degrees)");
     EXPECT_EQ(camera_error({{0, 0, 0}, {0, 0, -1}, {0, 2e6f, 0}}),
               "invalid camera: up vector of length 2e+06 (at most 1e6)");
     // Up 0.05 degrees from the view direction is too close; 0.1 degrees is enough.
@@ -146,7 +150,8 @@ TEST(ParseCameraSpec, MessagesQuoteTheText) {
         }
         return std::string("(no error)");
     };
-    EXPECT_EQ(error_of("1,2,3"), "camera '1,2,3': expected 9 numbers ex,ey,ez,gx,gy,gz,ux,uy,uz, got 3");
+    EXPECT_EQ(error_of("1,2,3"),
+              "camera '1,2,3': expected 9 numbers ex,ey,ez,gx,gy,gz,ux,uy,uz, got 3");
     EXPECT_EQ(error_of("1,2,x"), "camera '1,2,x': malformed number");
     EXPECT_EQ(error_of("1;2"), "camera '1;2': expected ',' between numbers");
 }

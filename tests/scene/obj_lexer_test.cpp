@@ -16,7 +16,8 @@ using namespace toonray::wavefront;
 
 namespace {
 
-std::vector<std::pair<std::size_t, std::string>> lines_of(std::string_view text, std::uint64_t max_line = 1000) {
+std::vector<std::pair<std::size_t, std::string>> lines_of(std::string_view text,
+                                                          std::uint64_t max_line = 1000) {
     LineReader reader(text, "t.obj", max_line);
     std::vector<std::pair<std::size_t, std::string>> out;
     std::string_view line;
@@ -117,7 +118,7 @@ TEST(ParseIndex, SignsAndLength) {
     EXPECT_EQ(v, 12);
     EXPECT_TRUE(index("-3", v));
     EXPECT_EQ(v, -3);
-    EXPECT_TRUE(index("999999999999999999", v));  // 18 digits
+    EXPECT_TRUE(index("999999999999999999", v));    // 18 digits
     EXPECT_FALSE(index("1000000000000000000", v));  // 19: refused
     EXPECT_FALSE(index("-", v));
 }

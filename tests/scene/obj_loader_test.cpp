@@ -18,7 +18,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-Scene parse(std::string_view text, Warnings* warnings_out = nullptr, const fs::path& path = "test.obj") {
+Scene parse(std::string_view text, Warnings* warnings_out = nullptr,
+            const fs::path& path = "test.obj") {
     Scene scene;
     Warnings warnings;
     parse_obj(text, path, scene, warnings);
@@ -36,15 +37,14 @@ std::string error_of(std::string_view text, const fs::path& path = "test.obj") {
 }
 
 fs::path temp_dir(const std::string& name) {
-    fs::path dir = fs::temp_directory_path() / ("toonray_obj_" + name + "_" + std::to_string(::getpid()));
+    fs::path dir =
+        fs::temp_directory_path() / ("toonray_obj_" + name + "_" + std::to_string(::getpid()));
     fs::remove_all(dir);
     fs::create_directories(dir);
     return dir;
 }
 
-void write(const fs::path& p, std::string_view text) {
-    std::ofstream(p, std::ios::binary) << text;
-}
+void write(const fs::path& p, std::string_view text) { std::ofstream(p, std::ios::binary) << text; }
 
 const char* kQuad = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n";
 
@@ -55,7 +55,8 @@ TEST(ObjLoader, ReadsAllFourIndexForms) {
                     "vt 0 0\nvt 1 0\nvt 1 1\nvn 0 0 1\nvn 0 0 -1\n"
                     "f 1 2 3\nf 1/1 2/2 3/3\nf 1//1 2//1 3//2\nf 1/1/1 2/2/1 3/3/1\n");
     ASSERT_EQ(s.triangle_count(), 4u);
-    for (std::size_t i = 0; i < 4; ++i) EXPECT_EQ(s.tri_positions[i], (std::array<std::uint32_t, 3>{0, 1, 2}));
+    for (std::size_t i = 0; i < 4; ++i)
+        EXPECT_EQ(s.tri_positions[i], (std::array<std::uint32_t, 3>{0, 1, 2}));
     EXPECT_EQ(s.tri_normals[0][0], kNoIndex);
     EXPECT_EQ(s.tri_texcoords[1], (std::array<std::uint32_t, 3>{0, 1, 2}));
     EXPECT_EQ(s.tri_normals[1][2], kNoIndex);
@@ -81,8 +82,9 @@ TEST(ObjLoader, PolygonsAreFanTriangulated) {
 }
 
 TEST(ObjLoader, AcceptsWComponentCommentsSmoothingCrlfBomAndContinuations) {
-    Scene s = parse("\xEF\xBB\xBF# comment\r\nv 0 0 0 1\r\nv 1 0 0 1.0 # trailing\r\n"
-                    "v 1 1 \\\r\n 0\r\ns 1\r\ns off\r\nf 1 \\\n 2 3\r\n");
+    Scene s = parse(
+        "\xEF\xBB\xBF# comment\r\nv 0 0 0 1\r\nv 1 0 0 1.0 # trailing\r\n"
+        "v 1 1 \\\r\n 0\r\ns 1\r\ns off\r\nf 1 \\\n 2 3\r\n");
     ASSERT_EQ(s.positions.size(), 3u);
     EXPECT_EQ(s.positions[2], Vec3f(1, 1, 0));
     ASSERT_EQ(s.triangle_count(), 1u);
@@ -104,10 +106,13 @@ TEST(ObjLoader, ObjectsAndGroupsGetIds) {
 TEST(ObjLoader, MaterialsFromSeveralLibrariesRelativeToTheObj) {
     fs::path dir = temp_dir("mtl");
     fs::create_directories(dir / "sub");
-    write(dir / "sub" / "a.mtl", "newmtl red\nKd 1 0 0\nKa 0.1 0.1 0.1\nKs 0.5 0.5 0.5\nNs 20\nd 0.5\nillum 2\nmap_Kd -s 1 1 1 tex.png\n");
+    write(
+        dir / "sub" / "a.mtl",
+        "newmtl red\nKd 1 0 0\nKa 0.1 0.1 0.1\nKs 0.5 0.5 0.5\nNs 20\nd 0.5\nillum 2\nmap_Kd -s 1 1 1 tex.png\n");
     write(dir / "b.mtl", "# b\nnewmtl blue\r\nKd 0 0 1\r\nunknown_statement 1 2 3\r\n");
-    write(dir / "scene.obj", std::string("mtllib sub/a.mtl b.mtl\n") + kQuad +
-                                 "f 1 2 3\nusemtl red\nf 1 2 3\nusemtl blue\nf 1 3 4\nusemtl\nf 2 3 4\n");
+    write(dir / "scene.obj",
+          std::string("mtllib sub/a.mtl b.mtl\n") + kQuad +
+              "f 1 2 3\nusemtl red\nf 1 2 3\nusemtl blue\nf 1 3 4\nusemtl\nf 2 3 4\n");
     Scene s;
     Warnings w;
     load_obj(dir / "scene.obj", s, w);
@@ -132,7 +137,8 @@ TEST(ObjLoader, MaterialsFromSeveralLibrariesRelativeToTheObj) {
 
 TEST(ObjLoader, MissingLibraryAndUnknownMaterialWarnAndUseTheDefault) {
     fs::path dir = temp_dir("missing");
-    write(dir / "scene.obj", std::string("mtllib nothere.mtl\n") + kQuad + "usemtl ghost\nf 1 2 3\n");
+    write(dir / "scene.obj",
+          std::string("mtllib nothere.mtl\n") + kQuad + "usemtl ghost\nf 1 2 3\n");
     Scene s;
     Warnings w;
     load_obj(dir / "scene.obj", s, w);
@@ -180,7 +186,8 @@ TEST(ObjLoader, UnderflowReadsAsZeroOverflowIsAnError) {
     EXPECT_EQ(s.positions[0].x, 0.0f);
     EXPECT_EQ(s.positions[0].y, 0.0f);
     EXPECT_GT(s.positions[0].z, 0.0f);  // a denormal, kept
-    EXPECT_NE(error_of("v 1 1e400 0\n").find("test.obj:1: number '1e400' out of range"), std::string::npos);
+    EXPECT_NE(error_of("v 1 1e400 0\n").find("test.obj:1: number '1e400' out of range"),
+              std::string::npos);
 }
 
 TEST(ObjLoader, CommentsAreNotContinued) {
@@ -210,7 +217,8 @@ TEST(ObjLoader, MtlErrorsNameTheMtlFileAndLine) {
         parse_mtl("newmtl a\nKd 1 x 0\n", "lib.mtl", materials, w);
         FAIL();
     } catch (const Error& e) {
-        EXPECT_NE(std::string(e.what()).find("lib.mtl:2: malformed number 'x'"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("lib.mtl:2: malformed number 'x'"), std::string::npos)
+            << e.what();
     }
     EXPECT_THROW(parse_mtl("Kd 1 1 1\n", "lib.mtl", materials, w), Error);  // before newmtl
 }
@@ -224,12 +232,14 @@ TEST(ObjLoader, MtlSingleValueKdIsGrey) {
 }
 
 TEST(CameraBlock, ReadsTheSeedsBlock) {
-    Scene s = parse("# Camera start\n"
-                    "v 16.270052 26.948549 25.997269\n"
-                    "v 15.863070 26.491430 25.206442\n"
-                    "vn -0.419904 0.862497 -0.282451\n"
-                    "c 1 2 1\n"
-                    "# Camera end\n" + std::string(kQuad) + "f 3 4 5\n");
+    Scene s = parse(
+        "# Camera start\n"
+        "v 16.270052 26.948549 25.997269\n"
+        "v 15.863070 26.491430 25.206442\n"
+        "vn -0.419904 0.862497 -0.282451\n"
+        "c 1 2 1\n"
+        "# Camera end\n" +
+        std::string(kQuad) + "f 3 4 5\n");
     ASSERT_TRUE(s.camera);
     EXPECT_EQ(s.camera->eye, Vec3f(16.270052f, 26.948549f, 25.997269f));
     EXPECT_EQ(s.camera->gaze, Vec3f(15.863070f, 26.491430f, 25.206442f));
@@ -246,11 +256,21 @@ TEST(CameraBlock, RelativeIndices) {
 }
 
 TEST(CameraBlock, InvalidBlocksAreErrors) {
-    EXPECT_NE(error_of("v 0 0 5\nv 0 0 4\nvn 0 1 0\nc 1 2 2\n").find("test.obj:4: camera up index 2 out of range"), std::string::npos);
-    EXPECT_NE(error_of("v 0 0 5\nv 0 0 4\nvn 0 1 0\nc 0 2 1\n").find("test.obj:4: camera eye index 0"), std::string::npos);
-    EXPECT_NE(error_of("v 0 0 5\nv 0 0 5\nvn 0 1 0\nc 1 2 1\n").find("test.obj:4: invalid camera: eye and gaze"), std::string::npos);
-    EXPECT_NE(error_of("v 0 0 5\nv 0 0 4\nvn 0 0 1\nc 1 2 1\n").find("test.obj:4: invalid camera: up vector"), std::string::npos);
-    EXPECT_NE(error_of("v 0 0 5\nv 0 0 4\nvn 0 1 0\nc 1 2\n").find("test.obj:4: camera statement needs three"), std::string::npos);
+    EXPECT_NE(error_of("v 0 0 5\nv 0 0 4\nvn 0 1 0\nc 1 2 2\n")
+                  .find("test.obj:4: camera up index 2 out of range"),
+              std::string::npos);
+    EXPECT_NE(
+        error_of("v 0 0 5\nv 0 0 4\nvn 0 1 0\nc 0 2 1\n").find("test.obj:4: camera eye index 0"),
+        std::string::npos);
+    EXPECT_NE(error_of("v 0 0 5\nv 0 0 5\nvn 0 1 0\nc 1 2 1\n")
+                  .find("test.obj:4: invalid camera: eye and gaze"),
+              std::string::npos);
+    EXPECT_NE(error_of("v 0 0 5\nv 0 0 4\nvn 0 0 1\nc 1 2 1\n")
+                  .find("test.obj:4: invalid camera: up vector"),
+              std::string::npos);
+    EXPECT_NE(error_of("v 0 0 5\nv 0 0 4\nvn 0 1 0\nc 1 2\n")
+                  .find("test.obj:4: camera statement needs three"),
+              std::string::npos);
 }
 
 TEST(ObjLoader, FastNumberPathEqualsFromCharsBitForBit) {
@@ -268,7 +288,8 @@ TEST(ObjLoader, FastNumberPathEqualsFromCharsBitForBit) {
             auto r = std::to_chars(buf, buf + 64, f, std::chars_format::fixed);
             texts[0].assign(buf, r.ptr);
         }
-        int digits = 1 + static_cast<int>(rng() % 16), decimals = static_cast<int>(rng() % (digits + 1));
+        int digits = 1 + static_cast<int>(rng() % 16),
+            decimals = static_cast<int>(rng() % (digits + 1));
         for (int k = 0; k < digits; ++k) texts[1] += static_cast<char>('0' + rng() % 10);
         if (decimals) texts[1].insert(texts[1].size() - decimals, ".");
         if (rng() & 1) texts[1] = "-" + texts[1];
@@ -296,7 +317,8 @@ TEST(ObjLoader, CrOnlyLineEndingsAreRead) {
     Scene s = parse("v 0 0 0\rv 1 0 0\r\nv 0 1 0\nf 1 2 3\r");
     EXPECT_EQ(s.positions.size(), 3u);
     EXPECT_EQ(s.triangle_count(), 1u);
-    EXPECT_NE(error_of("v 0 0 0\rv 1 0 0\r\nv 0 1 0\n\rf 1 2 4\r").find("test.obj:5: face vertex index 4"),
+    EXPECT_NE(error_of("v 0 0 0\rv 1 0 0\r\nv 0 1 0\n\rf 1 2 4\r")
+                  .find("test.obj:5: face vertex index 4"),
               std::string::npos);
 }
 
@@ -324,8 +346,9 @@ TEST(ObjLoader, MaterialDefinedAgainKeepsItsFirstDefinition) {
     fs::path dir = temp_dir("redefined");
     write(dir / "a.mtl", "newmtl A\nKd 1 0 0\nnewmtl A\nKd 0 0 0.5\n");
     write(dir / "b.mtl", "newmtl A\nKd 0 0 1\nnewmtl B\nKd 0 1 0\n");
-    write(dir / "scene.obj", std::string("mtllib a.mtl\n") + kQuad +
-                                 "usemtl A\nf 1 2 3\nmtllib b.mtl\nusemtl A\nf 1 2 3\nusemtl B\nf 1 2 3\n");
+    write(dir / "scene.obj",
+          std::string("mtllib a.mtl\n") + kQuad +
+              "usemtl A\nf 1 2 3\nmtllib b.mtl\nusemtl A\nf 1 2 3\nusemtl B\nf 1 2 3\n");
     Scene s;
     Warnings w;
     load_obj(dir / "scene.obj", s, w);
@@ -345,13 +368,15 @@ TEST(ObjLoader, LongAndShortNumbersReadTheSameInEveryPosition) {
     // (from_chars) reads them, including past the fast paths' 15- and 18-digit limits.
     for (const char* tail : {"", "\n", " \n", "\r\n"}) {
         for (int digits = 1; digits <= 20; ++digits) {
-            std::string index = std::string(static_cast<std::size_t>(digits - 1), '0') + "1";  // vertex 1
+            std::string index =
+                std::string(static_cast<std::size_t>(digits - 1), '0') + "1";  // vertex 1
             std::string text = std::string(kQuad) + "f " + index + " 2 " + index + tail;
             // Past 18 digits the general path reads it (from_chars), still as 1.
             Scene s = parse(text);
             ASSERT_EQ(s.triangle_count(), 1u) << text;
             EXPECT_EQ(s.tri_positions[0], (std::array<std::uint32_t, 3>{0, 1, 0})) << text;
-            std::string number = "0." + std::string(static_cast<std::size_t>(digits - 1), '3') + "7";
+            std::string number =
+                "0." + std::string(static_cast<std::size_t>(digits - 1), '3') + "7";
             float expect;
             std::from_chars(number.data(), number.data() + number.size(), expect);
             Scene v = parse("v " + number + " -" + number + " " + number + tail);
@@ -359,6 +384,9 @@ TEST(ObjLoader, LongAndShortNumbersReadTheSameInEveryPosition) {
             EXPECT_EQ(v.positions[0], Vec3f(expect, -expect, expect)) << number;
         }
     }
-    EXPECT_NE(error_of(std::string(kQuad) + "f 1 2 12345678x\n").find("malformed face corner '12345678x'"), std::string::npos);
-    EXPECT_NE(error_of("v 1 2 12345678.9x\n").find("malformed number '12345678.9x'"), std::string::npos);
+    EXPECT_NE(error_of(std::string(kQuad) + "f 1 2 12345678x\n")
+                  .find("malformed face corner '12345678x'"),
+              std::string::npos);
+    EXPECT_NE(error_of("v 1 2 12345678.9x\n").find("malformed number '12345678.9x'"),
+              std::string::npos);
 }

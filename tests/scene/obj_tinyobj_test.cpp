@@ -410,16 +410,11 @@ struct Rng {
 /// A number in one of the spellings exporters write.
 std::string spell(Rng& rng, double v) {
     switch (rng.below(5)) {
-        case 0:
-            return fmt::format("{:.6f}", v);
-        case 1:
-            return fmt::format("{}", static_cast<float>(v));  // shortest round trip
-        case 2:
-            return fmt::format("{:e}", v);
-        case 3:
-            return fmt::format("{:.3E}", v);
-        default:
-            return fmt::format("{:.9g}", v);
+        case 0: return fmt::format("{:.6f}", v);
+        case 1: return fmt::format("{}", static_cast<float>(v));  // shortest round trip
+        case 2: return fmt::format("{:e}", v);
+        case 3: return fmt::format("{:.3E}", v);
+        default: return fmt::format("{:.9g}", v);
     }
 }
 
@@ -570,8 +565,10 @@ TEST(ObjTinyobjCrossCheck, UnderflowingNumbersReadAsZero) {
 //   in "usemtl red # note", where rc10 keeps "red" too.)
 TEST(ObjTinyobjCrossCheck, RedefinedMaterialsCrOnlyLinesAndHashInNames) {
     const fs::path dir = temp_dir("fixed");
-    write_text(dir / "a.mtl", "newmtl A\nKd 1 0 0\nnewmtl A\nKd 0 0 0.5\nnewmtl Mat#1\nKd 0.2 0.2 0.2\n");
-    write_text(dir / "b.mtl", "newmtl A\nKd 0 0 1\nnewmtl B\nKd 0 1 0\nnewmtl Mat#2\nKd 0.7 0.7 0.7\n");
+    write_text(dir / "a.mtl",
+               "newmtl A\nKd 1 0 0\nnewmtl A\nKd 0 0 0.5\nnewmtl Mat#1\nKd 0.2 0.2 0.2\n");
+    write_text(dir / "b.mtl",
+               "newmtl A\nKd 0 0 1\nnewmtl B\nKd 0 1 0\nnewmtl Mat#2\nKd 0.7 0.7 0.7\n");
     const std::string body =
         "mtllib a.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl A\nf 1 2 3\n"
         "mtllib b.mtl\nusemtl A\nf 1 2 3\nusemtl B\nf 1 2 3\n"

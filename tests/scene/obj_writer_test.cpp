@@ -36,8 +36,17 @@ bool same_bits(const Vec3f& a, const Vec3f& b) {
 /// unused), faces on the default material and object, and a camera.
 Scene tricky_scene() {
     Scene s;
-    const float values[] = {0.1f, -0.0f, 0.0f, 1e-7f, -3.4028235e38f, 1.17549435e-38f,
-                            1.4e-45f /* denormal */, 123456.789f, 1.0f / 3.0f, -2.5f, 16777217.0f,
+    const float values[] = {0.1f,
+                            -0.0f,
+                            0.0f,
+                            1e-7f,
+                            -3.4028235e38f,
+                            1.17549435e-38f,
+                            1.4e-45f /* denormal */,
+                            123456.789f,
+                            1.0f / 3.0f,
+                            -2.5f,
+                            16777217.0f,
                             0.3f};
     const int nv = static_cast<int>(std::size(values));
     for (int i = 0; i < nv; ++i)
@@ -58,9 +67,9 @@ Scene tricky_scene() {
     s.materials.push_back(brass);
     s.objects.push_back("key w1");
     s.objects.push_back("lid");
-    s.objects.push_back("unused");  // no triangles: still must keep its index
-    s.add_triangle({0, 1, 2}, 1, 2);                           // lid first: out of order
-    s.add_triangle({3, 4, 5}, 2, 1, {0, 1, 2});                // smooth
+    s.objects.push_back("unused");               // no triangles: still must keep its index
+    s.add_triangle({0, 1, 2}, 1, 2);             // lid first: out of order
+    s.add_triangle({3, 4, 5}, 2, 1, {0, 1, 2});  // smooth
     s.add_triangle({6, 7, 8}, 0, 1, {kNoIndex, 2, kNoIndex});  // default material, mixed corners
     s.add_triangle({9, 10, 11}, 1, 0, {0, 0, 0}, {0, 1, 2});   // default object, v/vt/vn
     s.add_triangle({0, 5, 9}, 2, 2, {kNoIndex, kNoIndex, kNoIndex}, {2, kNoIndex, 0});
@@ -270,8 +279,7 @@ TEST(ObjWriter, AnotherReaderAgrees) {
     tinyobj::ObjReader reader;
     tinyobj::ObjReaderConfig config;
     config.triangulate = false;
-    ASSERT_TRUE(reader.ParseFromFile((dir.path / "scene.obj").string(), config))
-        << reader.Error();
+    ASSERT_TRUE(reader.ParseFromFile((dir.path / "scene.obj").string(), config)) << reader.Error();
     const auto& attrib = reader.GetAttrib();
     ASSERT_EQ(attrib.vertices.size(), 3 * in.positions.size());
     for (std::size_t i = 0; i < in.positions.size(); ++i) {

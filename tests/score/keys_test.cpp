@@ -22,15 +22,15 @@ int black_by_formula(int n) {
 }
 
 TEST(PianoKeys, SpotChecks) {
-    EXPECT_EQ(white_key(1), 21);   // A0
-    EXPECT_EQ(black_key(1), 22);   // A#0
-    EXPECT_EQ(white_key(2), 23);   // B0
-    EXPECT_EQ(white_key(3), 24);   // C1
-    EXPECT_EQ(black_key(2), 25);   // C#1
-    EXPECT_EQ(white_key(24), 60);  // C4, middle C
-    EXPECT_EQ(black_key(12), 49);  // C#3
-    EXPECT_EQ(black_key(16), 58);  // A#3
-    EXPECT_EQ(black_key(17), 61);  // C#4
+    EXPECT_EQ(white_key(1), 21);    // A0
+    EXPECT_EQ(black_key(1), 22);    // A#0
+    EXPECT_EQ(white_key(2), 23);    // B0
+    EXPECT_EQ(white_key(3), 24);    // C1
+    EXPECT_EQ(black_key(2), 25);    // C#1
+    EXPECT_EQ(white_key(24), 60);   // C4, middle C
+    EXPECT_EQ(black_key(12), 49);   // C#3
+    EXPECT_EQ(black_key(16), 58);   // A#3
+    EXPECT_EQ(black_key(17), 61);   // C#4
     EXPECT_EQ(white_key(52), 108);  // C8
     EXPECT_EQ(black_key(36), 106);  // A#7
     EXPECT_EQ(white_key(0), -1);

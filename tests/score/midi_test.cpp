@@ -19,9 +19,20 @@ namespace {
 using Bytes = std::vector<std::uint8_t>;
 
 Bytes header(unsigned format, unsigned tracks, unsigned division) {
-    return {'M', 'T', 'h', 'd', 0, 0, 0, 6, 0, static_cast<std::uint8_t>(format),
-            static_cast<std::uint8_t>(tracks >> 8), static_cast<std::uint8_t>(tracks),
-            static_cast<std::uint8_t>(division >> 8), static_cast<std::uint8_t>(division)};
+    return {'M',
+            'T',
+            'h',
+            'd',
+            0,
+            0,
+            0,
+            6,
+            0,
+            static_cast<std::uint8_t>(format),
+            static_cast<std::uint8_t>(tracks >> 8),
+            static_cast<std::uint8_t>(tracks),
+            static_cast<std::uint8_t>(division >> 8),
+            static_cast<std::uint8_t>(division)};
 }
 
 Bytes chunk(const char* type, const Bytes& body) {
@@ -143,14 +154,14 @@ TEST(Midi, ThroughNoteScriptAndBack) {
 
 TEST(Midi, RunningStatusAndVelocityZeroNoteOff) {
     // ppq 96, no tempo event: MIDI's 120 bpm.
-    const Bytes file = cat({header(0, 1, 96),
-                            track({0x00, 0x90, 0x3C, 0x40,    // on 60 at 0
-                                   0x10, 0x3E, 0x50,          // running status: on 62 at 16
-                                   0x10, 0x3C, 0x00,          // velocity 0: off 60 at 32
-                                   0x10, 0x3E, 0x00,          // off 62 at 48
-                                   0x00, 0x90, 0x40, 0x64,    // on 64 at 48
-                                   0x60, 0x80, 0x40, 0x7F,    // note-off with release velocity
-                                   0x00, 0xFF, 0x2F, 0x00})});
+    const Bytes file =
+        cat({header(0, 1, 96), track({0x00, 0x90, 0x3C, 0x40,  // on 60 at 0
+                                      0x10, 0x3E, 0x50,        // running status: on 62 at 16
+                                      0x10, 0x3C, 0x00,        // velocity 0: off 60 at 32
+                                      0x10, 0x3E, 0x00,        // off 62 at 48
+                                      0x00, 0x90, 0x40, 0x64,  // on 64 at 48
+                                      0x60, 0x80, 0x40, 0x7F,  // note-off with release velocity
+                                      0x00, 0xFF, 0x2F, 0x00})});
     const TimedScore t = read(file);
     ASSERT_EQ(t.notes.size(), 3u);
     EXPECT_EQ(t.notes[0], (TimedNote{0, 32, 60, 64, 0, 0}));
@@ -165,15 +176,15 @@ TEST(Midi, RunningStatusAndVelocityZeroNoteOff) {
 
 TEST(Midi, TempoChangesMidPiece) {
     // Format 1: the tempo map in track 0, notes in track 1, ppq 96.
-    const Bytes file = cat({header(1, 2, 96),
-                            track({0x00, 0xFF, 0x51, 0x03, 0x07, 0xA1, 0x20,   // 500000 at 0
-                                   0x60, 0xFF, 0x51, 0x03, 0x0F, 0x42, 0x40,   // 1000000 at 96
-                                   0x60, 0xFF, 0x51, 0x03, 0x03, 0xD0, 0x90,   // 250000 at 192
-                                   0x00, 0xFF, 0x2F, 0x00}),
-                            track({0x00, 0x90, 60, 100, 0x60, 60, 0,       // 60: 0..96
-                                   0x00, 62, 100, 0x60, 62, 0,             // 62: 96..192
-                                   0x00, 64, 100, 0x60, 64, 0,             // 64: 192..288
-                                   0x00, 0xFF, 0x2F, 0x00})});
+    const Bytes file =
+        cat({header(1, 2, 96), track({0x00, 0xFF, 0x51, 0x03, 0x07, 0xA1, 0x20,  // 500000 at 0
+                                      0x60, 0xFF, 0x51, 0x03, 0x0F, 0x42, 0x40,  // 1000000 at 96
+                                      0x60, 0xFF, 0x51, 0x03, 0x03, 0xD0, 0x90,  // 250000 at 192
+                                      0x00, 0xFF, 0x2F, 0x00}),
+             track({0x00, 0x90, 60,   100,  0x60, 60, 0,  // 60: 0..96
+                    0x00, 62,   100,  0x60, 62,   0,      // 62: 96..192
+                    0x00, 64,   100,  0x60, 64,   0,      // 64: 192..288
+                    0x00, 0xFF, 0x2F, 0x00})});
     const TimedScore t = read(file);
     ASSERT_EQ(t.tempo.size(), 3u);
     const Score s = to_score(t);
@@ -189,24 +200,24 @@ TEST(Midi, TempoChangesMidPiece) {
 }
 
 TEST(Midi, Format0WithChannelsAndSkippedEvents) {
-    const Bytes file = cat({header(0, 1, 480),
-                            track({0x00, 0xFF, 0x03, 0x04, 'n', 'a', 'm', 'e',        // track name
-                                   0x00, 0xF0, 0x05, 0x7E, 0x7F, 0x09, 0x01, 0xF7,    // sysex
-                                   0x00, 0xC0, 0x05,                                  // program
-                                   0x00, 0x99, 36, 90,                                // channel 10
-                                   0x00, 0xF7, 0x02, 0x12, 0x34,                      // escape
-                                   0x00, 0xFF, 0x7F, 0x03, 0x00, 0x00, 0x41,          // seq. meta
-                                   0x00, 0xE0, 0x00, 0x40,                            // pitch bend
-                                   0x00, 0xD0, 0x30,                                  // pressure
-                                   0x00, 0xA0, 60, 10,                                // aftertouch
-                                   0x00, 0x90, 60, 70,                                // channel 1
-                                   0x00, 62, 71,                                      // running
-                                   0x83, 0x60, 0x89, 36, 0,                           // at 480
-                                   0x00, 0x90, 60, 0,
-                                   0x00, 0xFF, 0x01, 0x02, 'h', 'i',                  // text meta
-                                   0x00, 62, 0,  // running status from before the meta event
-                                   0x00, 0xFF, 0x2F, 0x00,
-                                   0x00, 0x90, 70, 70})});  // after the end of track: ignored
+    const Bytes file = cat(
+        {header(0, 1, 480),
+         track(
+             {0x00, 0xFF, 0x03, 0x04, 'n',  'a',  'm',  'e',             // track name
+              0x00, 0xF0, 0x05, 0x7E, 0x7F, 0x09, 0x01, 0xF7,            // sysex
+              0x00, 0xC0, 0x05,                                          // program
+              0x00, 0x99, 36,   90,                                      // channel 10
+              0x00, 0xF7, 0x02, 0x12, 0x34,                              // escape
+              0x00, 0xFF, 0x7F, 0x03, 0x00, 0x00, 0x41,                  // seq. meta
+              0x00, 0xE0, 0x00, 0x40,                                    // pitch bend
+              0x00, 0xD0, 0x30,                                          // pressure
+              0x00, 0xA0, 60,   10,                                      // aftertouch
+              0x00, 0x90, 60,   70,                                      // channel 1
+              0x00, 62,   71,                                            // running
+              0x83, 0x60, 0x89, 36,   0,                                 // at 480
+              0x00, 0x90, 60,   0,    0x00, 0xFF, 0x01, 0x02, 'h', 'i',  // text meta
+              0x00, 62,   0,  // running status from before the meta event
+              0x00, 0xFF, 0x2F, 0x00, 0x00, 0x90, 70,   70})});  // after the end of track: ignored
     Warnings warnings;
     const TimedScore t = read(file, &warnings);
     EXPECT_TRUE(warnings.empty());
@@ -218,16 +229,15 @@ TEST(Midi, Format0WithChannelsAndSkippedEvents) {
 }
 
 TEST(Midi, SustainPedal) {
-    const Bytes file = cat({header(0, 1, 96),
-                            track({0x00, 0xB0, 0x40, 0x7F,   // down at 0
-                                   0x00, 0x90, 60, 80,
-                                   0x60, 0xB0, 0x07, 0x64,   // volume: ignored
-                                   0x00, 0x40, 0x00,         // running status: up at 96
-                                   0x00, 0x80, 60, 0,
-                                   0x30, 0xB0, 0x40, 0x40,   // 64: down at 144
-                                   0x10, 0x40, 0x70,         // still down: no change
-                                   0x10, 0x40, 0x3F,         // 63: up at 176
-                                   0x00, 0xFF, 0x2F, 0x00})});
+    const Bytes file =
+        cat({header(0, 1, 96),
+             track({0x00, 0xB0, 0x40, 0x7F,                          // down at 0
+                    0x00, 0x90, 60,   80,   0x60, 0xB0, 0x07, 0x64,  // volume: ignored
+                    0x00, 0x40, 0x00,                                // running status: up at 96
+                    0x00, 0x80, 60,   0,    0x30, 0xB0, 0x40, 0x40,  // 64: down at 144
+                    0x10, 0x40, 0x70,                                // still down: no change
+                    0x10, 0x40, 0x3F,                                // 63: up at 176
+                    0x00, 0xFF, 0x2F, 0x00})});
     const TimedScore t = read(file);
     ASSERT_EQ(t.pedal.size(), 5u);
     EXPECT_EQ(t.pedal[0], (PedalChange{0, 127, 0, 0}));
@@ -250,11 +260,11 @@ TEST(Midi, SustainPedal) {
 TEST(Midi, OverlappingSameKeyNotes) {
     // On 60 at 0 and again at 10, offs at 20 and 30: first in, first out pairs them as
     // 0..20 and 10..30; the first is then cut where the second starts.
-    const Bytes file = cat({header(0, 1, 96),
-                            track({0x00, 0x90, 60, 50, 0x0A, 60, 60, 0x0A, 60, 0, 0x0A, 60, 0,
-                                   // on 62 twice at 40, one off at 50: one note survives
-                                   0x0A, 62, 70, 0x00, 62, 71, 0x0A, 62, 0, 0x0A, 62, 0,
-                                   0x00, 0xFF, 0x2F, 0x00})});
+    const Bytes file =
+        cat({header(0, 1, 96), track({0x00, 0x90, 60, 50, 0x0A, 60, 60, 0x0A, 60, 0, 0x0A, 60, 0,
+                                      // on 62 twice at 40, one off at 50: one note survives
+                                      0x0A, 62, 70, 0x00, 62, 71, 0x0A, 62, 0, 0x0A, 62, 0, 0x00,
+                                      0xFF, 0x2F, 0x00})});
     Warnings warnings;
     const TimedScore t = read(file, &warnings);
     ASSERT_EQ(t.notes.size(), 3u);
@@ -267,8 +277,9 @@ TEST(Midi, OverlappingSameKeyNotes) {
 }
 
 TEST(Midi, UnreleasedNotesEndWithTheirTrack) {
-    const Bytes file = cat({header(0, 1, 96), track({0x00, 0x90, 60, 50, 0x81, 0x00, 0x80, 61,
-                                                     0, 0x20, 0xFF, 0x2F, 0x00})});
+    const Bytes file =
+        cat({header(0, 1, 96),
+             track({0x00, 0x90, 60, 50, 0x81, 0x00, 0x80, 61, 0, 0x20, 0xFF, 0x2F, 0x00})});
     Warnings warnings;
     const TimedScore t = read(file, &warnings);
     ASSERT_EQ(t.notes.size(), 1u);
@@ -280,17 +291,17 @@ TEST(Midi, UnreleasedNotesEndWithTheirTrack) {
 
 TEST(Midi, SmpteTiming) {
     // 25 frames per second, 40 ticks per frame: 1000 ticks a second; tempo events don't apply.
-    const Bytes file = cat({header(0, 1, 0xE728),
-                            track({0x00, 0xFF, 0x51, 0x03, 0x07, 0xA1, 0x20, 0x00, 0x90, 60, 80,
-                                   0x87, 0x68, 60, 0, 0x00, 0xFF, 0x2F, 0x00})});
+    const Bytes file =
+        cat({header(0, 1, 0xE728), track({0x00, 0xFF, 0x51, 0x03, 0x07, 0xA1, 0x20, 0x00, 0x90, 60,
+                                          80, 0x87, 0x68, 60, 0, 0x00, 0xFF, 0x2F, 0x00})});
     const TimedScore t = read(file);
     EXPECT_EQ(t.ppq, 1000);
     const Score s = to_score(t);
     ASSERT_EQ(s.notes.size(), 1u);
     EXPECT_DOUBLE_EQ(s.notes[0].end, 1.0);
     // 29.97 fps drop-frame: 30 frames take 1.001 s.
-    const Bytes df = cat({header(0, 1, 0xE302),
-                          track({0x00, 0x90, 60, 80, 0x3C, 60, 0, 0x00, 0xFF, 0x2F, 0x00})});
+    const Bytes df = cat(
+        {header(0, 1, 0xE302), track({0x00, 0x90, 60, 80, 0x3C, 60, 0, 0x00, 0xFF, 0x2F, 0x00})});
     EXPECT_DOUBLE_EQ(to_score(read(df)).notes[0].end, 1.001);
 }
 
@@ -334,8 +345,9 @@ TEST(Midi, ErrorCatalogue) {
               "t.mid: byte 14: bad chunk: type bytes 00 01 02 03 where \"MTrk\" was expected");
     Bytes past_end = cat({header(1, 1, 96), track(cat({note, kEnd}))});
     past_end[21] = 100;  // claims 100 bytes; 11 follow
-    EXPECT_EQ(midi_error(past_end), "t.mid: byte 18: truncated track chunk: length 100 but only "
-                                    "11 bytes left");
+    EXPECT_EQ(midi_error(past_end),
+              "t.mid: byte 18: truncated track chunk: length 100 but only "
+              "11 bytes left");
     EXPECT_EQ(midi_error(cat({header(1, 1, 96), chunk("JUNK", Bytes(3)), Bytes{'M', 'T', 'r'}})),
               "t.mid: byte 25: truncated file: the header announces 1 tracks but the file ends "
               "after 0");
@@ -344,9 +356,9 @@ TEST(Midi, ErrorCatalogue) {
     EXPECT_EQ(midi_error(cat({header(1, 2, 96), track(kEnd)})),
               "t.mid: byte 26: truncated file: the header announces 2 tracks but the file ends "
               "after 1");
-    EXPECT_EQ(midi_error(cat({header(1, 1, 96),
-                              track({0xFF, 0xFF, 0xFF, 0xFF, 0x00, 0x90, 60, 80})})),
-              "t.mid: byte 22: bad variable-length quantity (longer than 4 bytes)");
+    EXPECT_EQ(
+        midi_error(cat({header(1, 1, 96), track({0xFF, 0xFF, 0xFF, 0xFF, 0x00, 0x90, 60, 80})})),
+        "t.mid: byte 22: bad variable-length quantity (longer than 4 bytes)");
     EXPECT_EQ(midi_error(cat({header(1, 1, 96), track({0x00, 0x90, 60})})),
               "t.mid: byte 22: truncated track chunk: an event runs past its end");
     EXPECT_EQ(midi_error(cat({header(1, 1, 96), track({0x00, 0x90, 60, 80, 0x81})})),
@@ -360,17 +372,17 @@ TEST(Midi, ErrorCatalogue) {
               "t.mid: byte 23: unexpected status byte 0xF8 in a track");
     EXPECT_EQ(midi_error(cat({header(1, 1, 96), track({0x00, 0xFF, 0x01, 0x10, 'a', 'b'})})),
               "t.mid: byte 22: truncated track chunk: meta event of 16 bytes runs past its end");
-    EXPECT_EQ(midi_error(cat({header(1, 1, 96),
-                              track({0x00, 0xFF, 0x01, 0xFF, 0xFF, 0xFF, 0x7F, 'a'})})),
-              "t.mid: byte 22: truncated track chunk: meta event of 268435455 bytes runs past "
-              "its end");
+    EXPECT_EQ(
+        midi_error(cat({header(1, 1, 96), track({0x00, 0xFF, 0x01, 0xFF, 0xFF, 0xFF, 0x7F, 'a'})})),
+        "t.mid: byte 22: truncated track chunk: meta event of 268435455 bytes runs past "
+        "its end");
     EXPECT_EQ(midi_error(cat({header(1, 1, 96), track({0x00, 0xF0, 0x85, 0x00, 0x01})})),
               "t.mid: byte 22: truncated track chunk: sysex event of 640 bytes runs past its end");
     EXPECT_EQ(midi_error(cat({header(1, 1, 96), track({0x00, 0xFF, 0x01})})),
               "t.mid: byte 25: truncated track chunk: an event runs past its end");
-    EXPECT_EQ(midi_error(cat({header(1, 2, 96), track(cat({note, kEnd})),
-                              track(cat({note, note, kEnd}))}),
-                         MidiLimits{16, 5}),
+    EXPECT_EQ(midi_error(
+                  cat({header(1, 2, 96), track(cat({note, kEnd})), track(cat({note, note, kEnd}))}),
+                  MidiLimits{16, 5}),
               "t.mid: byte 48: more than 5 events (the limit)");
 }
 
@@ -381,11 +393,12 @@ TEST(Midi, DefaultEventLimit) {
 
 // Every prefix of a file is an error, never a crash or a hang.
 TEST(Midi, TruncatedAtEveryCutPoint) {
-    for (const Bytes& file : {entertainer_bytes(),
-                              cat({header(1, 2, 96), track({0x00, 0xFF, 0x51, 0x03, 7, 0xA1, 0x20,
-                                                            0x00, 0xFF, 0x2F, 0x00}),
-                                   track({0x00, 0x90, 60, 80, 0x83, 0x00, 60, 0, 0x00, 0xF0, 0x01,
-                                          0xF7, 0x00, 0xFF, 0x2F, 0x00})})}) {
+    for (const Bytes& file :
+         {entertainer_bytes(),
+          cat({header(1, 2, 96),
+               track({0x00, 0xFF, 0x51, 0x03, 7, 0xA1, 0x20, 0x00, 0xFF, 0x2F, 0x00}),
+               track({0x00, 0x90, 60, 80, 0x83, 0x00, 60, 0, 0x00, 0xF0, 0x01, 0xF7, 0x00, 0xFF,
+                      0x2F, 0x00})})}) {
         ASSERT_NO_THROW((void)read(file));
         for (std::size_t cut = 0; cut < file.size(); ++cut) {
             const Bytes prefix(file.begin(), file.begin() + static_cast<std::ptrdiff_t>(cut));
@@ -434,14 +447,12 @@ TEST(Midi, WriterBytes) {
     t.end_tick = 192;
     const Bytes expected = cat({
         header(1, 2, 96),
-        track({0x00, 0xFF, 0x51, 0x03, 0x07, 0xA1, 0x20,           // tempo
-               0x00, 0xFF, 0x58, 0x04, 0x02, 0x02, 0x18, 0x08,     // 2/4
-               0x81, 0x40, 0xFF, 0x2F, 0x00}),                     // end at 192
-        track({0x00, 0x90, 60, 100,
-               0x30, 64, 90,      // running status
-               0x30, 60, 0,       // note-offs as velocity 0
-               0x00, 64, 0,
-               0x60, 0xFF, 0x2F, 0x00}),
+        track({0x00, 0xFF, 0x51, 0x03, 0x07, 0xA1, 0x20,        // tempo
+               0x00, 0xFF, 0x58, 0x04, 0x02, 0x02, 0x18, 0x08,  // 2/4
+               0x81, 0x40, 0xFF, 0x2F, 0x00}),                  // end at 192
+        track({0x00, 0x90, 60, 100, 0x30, 64, 90,               // running status
+               0x30, 60, 0,                                     // note-offs as velocity 0
+               0x00, 64, 0, 0x60, 0xFF, 0x2F, 0x00}),
     });
     EXPECT_EQ(write_midi(t), expected);
 }
@@ -461,14 +472,16 @@ TEST(Midi, WriterRefusesWhatMidiCannotHold) {
     t.notes = {{0, 10, 128, 80, 0, 0}};
     EXPECT_EQ(error(t), "cannot write MIDI: key 128 outside 0..127");
     t.notes = {{0, 0x10000000, 60, 80, 0, 0}};
-    EXPECT_EQ(error(t), "cannot write MIDI: 268435456 ticks between two events of track 0 exceed "
-                        "the limit of 268435455");
+    EXPECT_EQ(error(t),
+              "cannot write MIDI: 268435456 ticks between two events of track 0 exceed "
+              "the limit of 268435455");
     t.notes = {{10, 10, 60, 80, 0, 0}};
     EXPECT_EQ(error(t), "cannot write MIDI: note 60 at tick 10 ends at tick 10");
     t.notes.clear();
     t.time_signatures = {{0, 3, 6}};
-    EXPECT_EQ(error(t), "cannot write MIDI: time signature denominator 6 is not a power of two "
-                        "from 1 to 128");
+    EXPECT_EQ(error(t),
+              "cannot write MIDI: time signature denominator 6 is not a power of two "
+              "from 1 to 128");
 }
 
 TEST(Midi, IsMidi) {

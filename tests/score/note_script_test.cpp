@@ -24,25 +24,24 @@ std::string parse_error(std::string_view text) {
 }
 
 struct Expected {
-    int line;    // seed line the note starts on
-    int lines;   // its length in lines
+    int line;   // seed line the note starts on
+    int lines;  // its length in lines
     int key;
 };
 
 TEST(NoteScript, SeedLinesParseToExactNotes) {
     Warnings warnings;
-    const Score score =
-        load_score(TOONRAY_TEST_DATA_DIR "/score/seed.notes", &warnings);
+    const Score score = load_score(TOONRAY_TEST_DATA_DIR "/score/seed.notes", &warnings);
     // Keys worked out by hand: w26 = E4 = 64, w14 = G2 = 43, b12 = C#3 = 49, ...
     // The half note on w16 (line 3) would last to line 7, but w16 is struck again on line 6,
     // so it ends there (the overlap rule of `normalize`), with a warning.
     const Expected expected[] = {
-        {0, 1, 64}, {0, 1, 67}, {0, 1, 71},               // E:w26,w28,w30
-        {1, 2, 43}, {1, 2, 49}, {1, 2, 53},               // Q:w14,b12,w20
-        {2, 1, 76},                                       // E:w33
-        {3, 3, 47}, {3, 4, 52}, {3, 4, 55}, {3, 4, 59},   // H:w16,w19,w21,w23
-        {3, 1, 71}, {3, 1, 83},                           // E:w30,w37
-        {5, 1, 48}, {5, 1, 50}, {5, 2, 88},               // E:w17,w18 | Q:w40
+        {0, 1, 64}, {0, 1, 67}, {0, 1, 71},                          // E:w26,w28,w30
+        {1, 2, 43}, {1, 2, 49}, {1, 2, 53},                          // Q:w14,b12,w20
+        {2, 1, 76},                                                  // E:w33
+        {3, 3, 47}, {3, 4, 52}, {3, 4, 55}, {3, 4, 59},              // H:w16,w19,w21,w23
+        {3, 1, 71}, {3, 1, 83},                                      // E:w30,w37
+        {5, 1, 48}, {5, 1, 50}, {5, 2, 88},                          // E:w17,w18 | Q:w40
         {6, 1, 26}, {6, 1, 47}, {6, 1, 50}, {6, 1, 53}, {6, 1, 77},  // E:w16,w18,w20,w34,w4
     };
     ASSERT_EQ(score.notes.size(), std::size(expected));
@@ -75,9 +74,8 @@ TEST(NoteScript, SeedTicksAndDefaults) {
 }
 
 TEST(NoteScript, BlankLinesAndCommentsTakeNoTime) {
-    const TimedScore t =
-        parse_note_script("\xEF\xBB\xBF# title\r\nE:w1\r\n\r\n   \n# note\nE:w2 # a comment\n",
-                          "x.notes");
+    const TimedScore t = parse_note_script(
+        "\xEF\xBB\xBF# title\r\nE:w1\r\n\r\n   \n# note\nE:w2 # a comment\n", "x.notes");
     ASSERT_EQ(t.notes.size(), 2u);
     EXPECT_EQ(t.notes[1].start, 192);
     EXPECT_EQ(t.notes[1].key, 23);
@@ -103,12 +101,12 @@ TEST(NoteScript, Extension) {
     EXPECT_EQ(t.pedal[0], (PedalChange{768, 127, 0, 0}));
     EXPECT_EQ(t.pedal[1], (PedalChange{960, 0, 0, 0}));
     const TimedNote expected[] = {
-        {0, 192, 36, 90, 2, 0},     {0, 192, 48, 90, 2, 0},    // track 2: E:w10,w17 at 0
-        {0, 96, 74, 90, 0, 0},      {0, 96, 86, 90, 0, 0},     // S:w32,w39
-        {96, 192, 76, 90, 0, 0},    {96, 192, 88, 90, 0, 0},   // S:w33,w40
-        {192, 288, 72, 90, 0, 0},   {192, 288, 84, 90, 0, 0},  // S:w31,w38
-        {288, 960, 69, 90, 0, 0},   {288, 960, 81, 127, 0, 0}, // Q.+S:w29,w36@127
-        {768, 864, 62, 90, 0, 0},   {768, 1056, 63, 90, 0, 0}, // E.:b18|S:w25 after wait Q
+        {0, 192, 36, 90, 2, 0},   {0, 192, 48, 90, 2, 0},     // track 2: E:w10,w17 at 0
+        {0, 96, 74, 90, 0, 0},    {0, 96, 86, 90, 0, 0},      // S:w32,w39
+        {96, 192, 76, 90, 0, 0},  {96, 192, 88, 90, 0, 0},    // S:w33,w40
+        {192, 288, 72, 90, 0, 0}, {192, 288, 84, 90, 0, 0},   // S:w31,w38
+        {288, 960, 69, 90, 0, 0}, {288, 960, 81, 127, 0, 0},  // Q.+S:w29,w36@127
+        {768, 864, 62, 90, 0, 0}, {768, 1056, 63, 90, 0, 0},  // E.:b18|S:w25 after wait Q
     };
     ASSERT_EQ(t.notes.size(), std::size(expected));
     for (std::size_t i = 0; i < t.notes.size(); ++i) EXPECT_EQ(t.notes[i], expected[i]) << i;
@@ -172,9 +170,11 @@ TEST(NoteScript, WriteParsesBackExactly) {
     t.tempo = {{0, 500000}, {1000, 612345}, {5000, 833333}};
     t.time_signatures = {{0, 3, 4}, {2880, 6, 8}};
     t.notes = {
-        {0, 160, 60, 80, 0, 0},  {160, 320, 62, 81, 0, 0},  {320, 480, 64, 127, 0, 0},  // 3 in 2
-        {7, 1000, 0, 1, 3, 9},      {7, 20, 127, 64, 3, 9},    {480, 3360, 21, 100, 0, 0},
-        {9000, 9001, 108, 5, 1, 15}, {100000, 200000, 61, 80, 0, 0},
+        {0, 160, 60, 80, 0, 0},         {160, 320, 62, 81, 0, 0},
+        {320, 480, 64, 127, 0, 0},  // 3 in 2
+        {7, 1000, 0, 1, 3, 9},          {7, 20, 127, 64, 3, 9},
+        {480, 3360, 21, 100, 0, 0},     {9000, 9001, 108, 5, 1, 15},
+        {100000, 200000, 61, 80, 0, 0},
     };
     t.pedal = {{0, 127, 3, 9}, {500, 70, 3, 9}, {900, 0, 3, 9}, {900, 127, 3, 9}};
     t.end_tick = 250000;
@@ -206,8 +206,9 @@ TEST(NoteScript, ErrorCatalogue) {
     EXPECT_EQ(parse_error("E:m128"), "bad.notes:1: unknown key 'm128': MIDI keys are m0..m127");
     EXPECT_EQ(parse_error("E:w99999999999"),
               "bad.notes:1: unknown key 'w99999999999': white keys are w1..w52");
-    EXPECT_EQ(parse_error("E;w3"), "bad.notes:1: malformed note group 'E;w3': expected "
-                                   "DURATION:KEYS such as 'E:w26,w28,w30'");
+    EXPECT_EQ(parse_error("E;w3"),
+              "bad.notes:1: malformed note group 'E;w3': expected "
+              "DURATION:KEYS such as 'E:w26,w28,w30'");
     EXPECT_EQ(parse_error("E:w1\n\n# c\nE:w1|Q;w2"),
               "bad.notes:4: malformed note group 'Q;w2': expected DURATION:KEYS such as "
               "'E:w26,w28,w30'");
@@ -262,8 +263,9 @@ TEST(NoteScript, ErrorCatalogue) {
 TEST(NoteScript, ErrorsNameTheFileFromLoadScore) {
     const std::string what =
         error_of([] { (void)load_score(TOONRAY_TEST_DATA_DIR "/score/bad_key.notes"); });
-    EXPECT_EQ(what, TOONRAY_TEST_DATA_DIR "/score/bad_key.notes:3: unknown key 'w53': white keys "
-                                          "are w1..w52");
+    EXPECT_EQ(what, TOONRAY_TEST_DATA_DIR
+              "/score/bad_key.notes:3: unknown key 'w53': white keys "
+              "are w1..w52");
 }
 
 TEST(NoteScript, BinaryGarbageIsAnError) {

@@ -27,8 +27,8 @@ protected:
     void TearDown() override { fs::remove_all(dir_); }
 
     void write(const fs::path& path, std::string_view text) {
-        write_file_atomic(path, std::span(reinterpret_cast<const std::uint8_t*>(text.data()),
-                                          text.size()));
+        write_file_atomic(
+            path, std::span(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()));
     }
 
     fs::path dir_;
@@ -86,8 +86,9 @@ TEST_F(ScoreIo, Errors) {
     const fs::path cut = dir_ / "cut.mid";
     write(cut, std::string_view(bytes).substr(0, 5000));
     EXPECT_EQ(error_of([&] { (void)load_score(cut); }),
-              cut.string() + ": byte 123: truncated track chunk: length 11431 but only 4873 "
-                             "bytes left");
+              cut.string() +
+                  ": byte 123: truncated track chunk: length 11431 but only 4873 "
+                  "bytes left");
 
     // Nothing is written when the input is bad.
     const fs::path bad = dir_ / "bad.notes";

@@ -21,7 +21,9 @@ struct TempDir {
     std::filesystem::path path;
 
     explicit TempDir(std::string_view name = "test") {
-        std::string tmpl = (std::filesystem::temp_directory_path() / ("toonray_" + std::string(name) + "_XXXXXX")).string();
+        std::string tmpl =
+            (std::filesystem::temp_directory_path() / ("toonray_" + std::string(name) + "_XXXXXX"))
+                .string();
         if (!::mkdtemp(tmpl.data())) throw std::runtime_error("mkdtemp failed for " + tmpl);
         path = tmpl;
     }
@@ -36,7 +38,8 @@ struct TempDir {
 
     /// Writes `text` to `<path>/<name>` as bytes, and returns that file's path.
     std::filesystem::path write(const std::string& name, std::string_view text) const {
-        std::ofstream(path / name, std::ios::binary).write(text.data(), static_cast<std::streamsize>(text.size()));
+        std::ofstream(path / name, std::ios::binary)
+            .write(text.data(), static_cast<std::streamsize>(text.size()));
         return path / name;
     }
 };

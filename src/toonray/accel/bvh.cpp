@@ -61,8 +61,8 @@ struct Box4 {
 };
 
 struct Bins {
-    Box4 box[3][kMaxBins];              // [axis][bin]: 32 bytes each
-    std::uint32_t count[3][kMaxBins];   // at a byte offset 1/8 of its box's
+    Box4 box[3][kMaxBins];             // [axis][bin]: 32 bytes each
+    std::uint32_t count[3][kMaxBins];  // at a byte offset 1/8 of its box's
     void clear(int n) {
         for (int a = 0; a < 3; ++a)
             for (int b = 0; b < n; ++b) {
@@ -86,7 +86,8 @@ static_assert(sizeof(Box4) == 32 && offsetof(Bins, count) == 3 * kMaxBins * 32);
 
 // Half areas of three boxes at once (lanes 0-2).
 inline __m128 half_areas(const Box4& a, const Box4& b, const Box4& c) {
-    __m128 x = _mm_sub_ps(a.hi, a.lo), y = _mm_sub_ps(b.hi, b.lo), z = _mm_sub_ps(c.hi, c.lo), w = _mm_setzero_ps();
+    __m128 x = _mm_sub_ps(a.hi, a.lo), y = _mm_sub_ps(b.hi, b.lo), z = _mm_sub_ps(c.hi, c.lo),
+           w = _mm_setzero_ps();
     _MM_TRANSPOSE4_PS(x, y, z, w);  // now x = extents along x of the three boxes, etc.
     return _mm_add_ps(_mm_add_ps(_mm_mul_ps(x, y), _mm_mul_ps(y, z)), _mm_mul_ps(z, x));
 }
@@ -134,16 +135,19 @@ inline void bin_add(Bins& bins, const PrimRef& r, __m128i off) {
     }
 }
 
-void bin_range(const PrimRef* refs, std::size_t begin, std::size_t end, const Binner& binner, Bins& bins) {
+void bin_range(const PrimRef* refs, std::size_t begin, std::size_t end, const Binner& binner,
+               Bins& bins) {
     const __m128i axis_off = _mm_setr_epi32(0, kMaxBins * 32, 2 * kMaxBins * 32, 0);
     std::size_t i = begin;
-    for (; i < end; ++i) bin_add(bins, refs[i], _mm_add_epi32(_mm_slli_epi32(binner.bin(refs[i]), 5), axis_off));
+    for (; i < end; ++i)
+        bin_add(bins, refs[i], _mm_add_epi32(_mm_slli_epi32(binner.bin(refs[i]), 5), axis_off));
 }
 
 // The same into two bin sets, even and odd primitives apart: neighbours in memory are
 // neighbours in space and usually share bins, and one set would chain every update on the
 // previous one through memory.
-void bin_range2(const PrimRef* refs, std::size_t begin, std::size_t end, const Binner& binner, Bins& a, Bins& b) {
+void bin_range2(const PrimRef* refs, std::size_t begin, std::size_t end, const Binner& binner,
+                Bins& a, Bins& b) {
     const __m128i axis_off = _mm_setr_epi32(0, kMaxBins * 32, 2 * kMaxBins * 32, 0);
     std::size_t i = begin;
     for (; i + 1 < end; i += 2) {
@@ -154,11 +158,12 @@ void bin_range2(const PrimRef* refs, std::size_t begin, std::size_t end, const B
         bin_add(a, r0, o0);
         bin_add(b, r1, o1);
     }
-    if (i < end) bin_add(a, refs[i], _mm_add_epi32(_mm_slli_epi32(binner.bin(refs[i]), 5), axis_off));
+    if (i < end)
+        bin_add(a, refs[i], _mm_add_epi32(_mm_slli_epi32(binner.bin(refs[i]), 5), axis_off));
 }
 
 struct Task {
-    std::uint32_t node;  // index in the temporary node array
+    std::uint32_t node;    // index in the temporary node array
     std::uint32_t buffer;  // which of the two PrimRef arrays holds the range
     std::size_t begin, end;
     Box4 bounds, centres;
@@ -187,7 +192,7 @@ struct Builder {
     const Bvh::Config& config;
     int bins;
     int max_leaf;
-    int block_shift;  // log2 of the block size
+    int block_shift;      // log2 of the block size
     PrimRef* buffers[2];  // the primitives, and scratch space for parallel partitions (ping-pong)
     // Nodes in allocation order (which depends on scheduling). Plain data, left uninitialised:
     // room for 2n - 1 nodes is reserved but far fewer are used, and untouched pages cost nothing.
@@ -250,7 +255,8 @@ struct Builder {
     }
 
     [[nodiscard]] __m128 blocks4(__m128i n) const {
-        return _mm_cvtepi32_ps(_mm_srli_epi32(_mm_add_epi32(n, _mm_set1_epi32((1 << block_shift) - 1)), block_shift));
+        return _mm_cvtepi32_ps(
+            _mm_srli_epi32(_mm_add_epi32(n, _mm_set1_epi32((1 << block_shift) - 1)), block_shift));
     }
 
     // Binned SAH on all three axes at once (lanes 0-2).
@@ -276,13 +282,14 @@ struct Builder {
             __m128 cost = _mm_add_ps(_mm_mul_ps(half_areas(acc[0], acc[1], acc[2]), blocks4(cnt)),
                                      _mm_mul_ps(right_area[i + 1], blocks4(right_count[i + 1])));
             // Both sides must be non-empty.
-            __m128 valid = _mm_castsi128_ps(_mm_andnot_si128(
-                _mm_or_si128(_mm_cmpeq_epi32(cnt, _mm_setzero_si128()), _mm_cmpeq_epi32(cnt, total)),
-                _mm_set1_epi32(-1)));
+            __m128 valid = _mm_castsi128_ps(
+                _mm_andnot_si128(_mm_or_si128(_mm_cmpeq_epi32(cnt, _mm_setzero_si128()),
+                                              _mm_cmpeq_epi32(cnt, total)),
+                                 _mm_set1_epi32(-1)));
             __m128 better = _mm_and_ps(valid, _mm_cmplt_ps(cost, best_cost));
             best_cost = _mm_blendv_ps(best_cost, cost, better);
-            best_bin = _mm_castps_si128(
-                _mm_blendv_ps(_mm_castsi128_ps(best_bin), _mm_castsi128_ps(_mm_set1_epi32(i + 1)), better));
+            best_bin = _mm_castps_si128(_mm_blendv_ps(
+                _mm_castsi128_ps(best_bin), _mm_castsi128_ps(_mm_set1_epi32(i + 1)), better));
         }
         alignas(16) float costs[4];
         alignas(16) int bin_of[4];
@@ -296,14 +303,15 @@ struct Builder {
                 best.bin = bin_of[axis];
             }
         if (best.axis >= 0)
-            for (int i = 0; i < bins; ++i) (i < best.bin ? best.left : best.right).extend(b.box[best.axis][i]);
+            for (int i = 0; i < bins; ++i)
+                (i < best.bin ? best.left : best.right).extend(b.box[best.axis][i]);
         return best;
     }
 
     // In place: [begin, mid) go left. Returns mid.
     template <int A>
-    static std::size_t partition_serial(PrimRef* refs, std::size_t begin, std::size_t end, GoesLeft<A> left,
-                                        Box4& lc, Box4& rc) {
+    static std::size_t partition_serial(PrimRef* refs, std::size_t begin, std::size_t end,
+                                        GoesLeft<A> left, Box4& lc, Box4& rc) {
         std::size_t i = begin, j = end;
         while (true) {
             while (i < j) {
@@ -326,8 +334,8 @@ struct Builder {
 
     // Stable, several tasks: from `src` into `dst`, left side first. Returns mid.
     template <int A>
-    static std::size_t partition_parallel(const PrimRef* src, PrimRef* dst, std::size_t begin, std::size_t end,
-                                          GoesLeft<A> left, Box4& lc, Box4& rc) {
+    static std::size_t partition_parallel(const PrimRef* src, PrimRef* dst, std::size_t begin,
+                                          std::size_t end, GoesLeft<A> left, Box4& lc, Box4& rc) {
         const std::size_t n = end - begin;
         const std::size_t chunks = (n + kChunk - 1) / kChunk;
         std::vector<std::size_t> left_count(chunks);
@@ -386,8 +394,8 @@ struct Builder {
             return partition_serial(buffers[t.buffer], t.begin, t.end, left, l.centres, r.centres);
         }
         l.buffer = r.buffer = 1 - t.buffer;
-        return partition_parallel(buffers[t.buffer], buffers[1 - t.buffer], t.begin, t.end, left, l.centres,
-                                  r.centres);
+        return partition_parallel(buffers[t.buffer], buffers[1 - t.buffer], t.begin, t.end, left,
+                                  l.centres, r.centres);
     }
 
     std::size_t partition(const Task& t, const Binner& binner, const Split& s, Task& l, Task& r) {
@@ -398,7 +406,8 @@ struct Builder {
         }
     }
 
-    void range_bounds(const PrimRef* refs, std::size_t begin, std::size_t end, Box4& bounds, Box4& centres) const {
+    void range_bounds(const PrimRef* refs, std::size_t begin, std::size_t end, Box4& bounds,
+                      Box4& centres) const {
         for (std::size_t i = begin; i < end; ++i) {
             bounds.extend(refs[i].lo, refs[i].hi);
             centres.extend_point(_mm_add_ps(refs[i].lo, refs[i].hi));
@@ -406,8 +415,10 @@ struct Builder {
     }
 
     void make_leaf(const Task& t) {
-        if (t.buffer != 0) std::copy(buffers[1] + t.begin, buffers[1] + t.end, buffers[0] + t.begin);
-        set_node(t.node, t.bounds, static_cast<std::uint32_t>(t.begin), static_cast<std::uint32_t>(t.end - t.begin));
+        if (t.buffer != 0)
+            std::copy(buffers[1] + t.begin, buffers[1] + t.end, buffers[0] + t.begin);
+        set_node(t.node, t.bounds, static_cast<std::uint32_t>(t.begin),
+                 static_cast<std::uint32_t>(t.end - t.begin));
     }
 
     // Builds the subtree of `root` with an explicit stack (a degenerate mesh could otherwise
@@ -422,7 +433,8 @@ struct Builder {
             // A small node, or one that fits one block (cheaper as a leaf than any split when a
             // traversal step costs at least a block test), is a leaf.
             if (n <= 1 || (n <= static_cast<std::uint32_t>(max_leaf) &&
-                           (n <= kSmallLeaf || config.intersection_cost * blocks(n) <= config.traversal_cost))) {
+                           (n <= kSmallLeaf ||
+                            config.intersection_cost * blocks(n) <= config.traversal_cost))) {
                 make_leaf(t);
                 continue;
             }
@@ -436,8 +448,8 @@ struct Builder {
             std::size_t mid;
             Task left{0, t.buffer, t.begin, 0, {}, {}}, right{0, t.buffer, 0, t.end, {}, {}};
             if (s.axis >= 0) {
-                float split_cost =
-                    config.traversal_cost + config.intersection_cost * s.cost / t.bounds.half_area();
+                float split_cost = config.traversal_cost +
+                                   config.intersection_cost * s.cost / t.bounds.half_area();
                 if (!(split_cost < leaf_cost) && n <= static_cast<std::uint32_t>(max_leaf)) {
                     make_leaf(t);
                     continue;
@@ -493,7 +505,8 @@ Bvh Bvh::build(std::span<const BBox> boxes, const Config& config) {
                 __m128 hi = _mm_setr_ps(box.hi.x, box.hi.y, box.hi.z, 0.0f);
                 bb.extend(lo, hi);
                 cc.extend_point(_mm_add_ps(lo, hi));
-                refs[i].lo = _mm_castsi128_ps(_mm_insert_epi32(_mm_castps_si128(lo), static_cast<int>(i), 3));
+                refs[i].lo = _mm_castsi128_ps(
+                    _mm_insert_epi32(_mm_castps_si128(lo), static_cast<int>(i), 3));
                 refs[i].hi = hi;
             }
             b[chunk] = bb;
@@ -528,7 +541,8 @@ Bvh Bvh::build(std::span<const BBox> boxes, const Config& config) {
         auto [from, to] = stack.back();
         stack.pop_back();
         const Builder::TmpNode& t = tmp[from];
-        BvhNode node{BBox{Vec3f(t.lo[0], t.lo[1], t.lo[2]), Vec3f(t.hi[0], t.hi[1], t.hi[2])}, t.first, t.count};
+        BvhNode node{BBox{Vec3f(t.lo[0], t.lo[1], t.lo[2]), Vec3f(t.hi[0], t.hi[1], t.hi[2])},
+                     t.first, t.count};
         if (!node.is_leaf()) {
             std::uint32_t pair = next;
             next += 2;
@@ -540,7 +554,8 @@ Bvh Bvh::build(std::span<const BBox> boxes, const Config& config) {
     }
     bvh.prim_indices.resize(n);
     for (std::size_t i = 0; i < n; ++i)
-        bvh.prim_indices[i] = static_cast<std::uint32_t>(_mm_extract_epi32(_mm_castps_si128(refs[i].lo), 3));
+        bvh.prim_indices[i] =
+            static_cast<std::uint32_t>(_mm_extract_epi32(_mm_castps_si128(refs[i].lo), 3));
     return bvh;
 }
 

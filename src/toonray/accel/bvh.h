@@ -24,16 +24,18 @@ struct BvhNode {
 struct Bvh {
     /// Build settings; defaults suit triangle meshes traced with SIMD leaf tests.
     struct Config {
-        int max_leaf_size = 8;      ///< leaves never hold more (clamped to [1, 128])
-        int bin_count = 16;         ///< SAH bins per axis (clamped to [2, 64])
-        float traversal_cost = 1.0f;  ///< cost of visiting a node, relative to...
+        int max_leaf_size = 8;           ///< leaves never hold more (clamped to [1, 128])
+        int bin_count = 16;              ///< SAH bins per axis (clamped to [2, 64])
+        float traversal_cost = 1.0f;     ///< cost of visiting a node, relative to...
         float intersection_cost = 1.0f;  ///< ...testing one block of `block_size` primitives
-        int block_size = 2;  ///< primitives tested together (the leaf test's SIMD width; a power of two)
+        int block_size =
+            2;  ///< primitives tested together (the leaf test's SIMD width; a power of two)
 
         bool operator==(const Config&) const = default;
     };
 
-    std::vector<BvhNode> nodes;  ///< nodes[0] is the root; children follow parents; empty if no primitives
+    std::vector<BvhNode>
+        nodes;  ///< nodes[0] is the root; children follow parents; empty if no primitives
     std::vector<std::uint32_t> prim_indices;  ///< primitive ids in leaf order
 
     /// Builds with binned SAH on the boxes' centres: all three axes binned in one pass over the

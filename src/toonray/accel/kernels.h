@@ -25,8 +25,9 @@ struct KernelTable {
     /// Whether one ray hits any triangle with 0 < t < ray.tmax; `stack` as for intersect1.
     bool (*occluded1)(const WideBvh& w, const Ray& ray, std::uint64_t* stack);
     /// Closest hits of a width x height (<= 16 x 16) row-major tile of rays from one origin.
-    void (*intersect_tile)(const WideBvh& w, const Vec3f& origin, const Vec3f* dirs, int width, int height,
-                           float tmax, Hit* hits, bool* found, TileEntry* stack, std::uint64_t* stack1);
+    void (*intersect_tile)(const WideBvh& w, const Vec3f& origin, const Vec3f* dirs, int width,
+                           int height, float tmax, Hit* hits, bool* found, TileEntry* stack,
+                           std::uint64_t* stack1);
 };
 
 const KernelTable& kernels_sse();

@@ -15,7 +15,7 @@
 // with its rounding error folded into the constants; interval (frustum) tests bound the per-ray
 // slab distances exactly (float multiplication is monotonic); and NaN distances never cull.
 
-constexpr int kNearLo[3] = {0, 8, 16};   // offsets of lo[axis] in a WideNode, in floats
+constexpr int kNearLo[3] = {0, 8, 16};    // offsets of lo[axis] in a WideNode, in floats
 constexpr int kNearHi[3] = {24, 32, 40};  // offsets of hi[axis]
 
 template <class V, class M>
@@ -38,7 +38,8 @@ struct EdgesT {
 using Edges = EdgesT<vf8, vm8>;
 
 template <class V, class M>
-TR_INLINE EdgesT<V, M> edges(V akx, V aky, V akz, V bkx, V bky, V bkz, V ckx, V cky, V ckz, V sx, V sy) {
+TR_INLINE EdgesT<V, M> edges(V akx, V aky, V akz, V bkx, V bky, V bkz, V ckx, V cky, V ckz, V sx,
+                             V sy) {
     const V zero = splat<V>(0.0f);
     const V ax = akx - sx * akz, ay = aky - sy * akz;
     const V bx = bkx - sx * bkz, by = bky - sy * bkz;
@@ -55,8 +56,8 @@ TR_INLINE EdgesT<V, M> edges(V akx, V aky, V akz, V bkx, V bky, V bkz, V ckx, V 
     e.live = (s0 & s1 & s2) | not_mask(s0 | s1 | s2) | e.zero;
     return e;
 }
-TR_INLINE Edges edges8(vf8 akx, vf8 aky, vf8 akz, vf8 bkx, vf8 bky, vf8 bkz, vf8 ckx, vf8 cky, vf8 ckz, vf8 sx,
-                       vf8 sy) {
+TR_INLINE Edges edges8(vf8 akx, vf8 aky, vf8 akz, vf8 bkx, vf8 bky, vf8 bkz, vf8 ckx, vf8 cky,
+                       vf8 ckz, vf8 sx, vf8 sy) {
     return edges<vf8, vm8>(akx, aky, akz, bkx, bky, bkz, ckx, cky, ckz, sx, sy);
 }
 
@@ -106,8 +107,8 @@ struct LeafRay {
 constexpr std::uint32_t kPrimMask = ~kLeafEnd;
 
 // The scalar test for lanes with an exact zero edge function.
-TR_INLINE void leaf_zero_lanes(int zero, const TriBlock& b0, const TriBlock& b1, const ShearedRay& sr,
-                               BestHit& best) {
+TR_INLINE void leaf_zero_lanes(int zero, const TriBlock& b0, const TriBlock& b1,
+                               const ShearedRay& sr, BestHit& best) {
     while (zero) {
         int i = __builtin_ctz(static_cast<unsigned>(zero));
         zero &= zero - 1;
@@ -124,8 +125,8 @@ TR_INLINE void leaf_zero_lanes(int zero, const TriBlock& b0, const TriBlock& b1,
 }
 
 template <class V, class M>
-TR_INLINE void take_lanes(int ok, const LaneResultT<V, M>& r, const TriBlock& b0, const TriBlock& b1,
-                          BestHit& best) {
+TR_INLINE void take_lanes(int ok, const LaneResultT<V, M>& r, const TriBlock& b0,
+                          const TriBlock& b1, BestHit& best) {
     alignas(32) float ts[8], us[8], vs[8];
     if constexpr (sizeof(V) == sizeof(vf8)) {
         store8(ts, r.t);
@@ -154,8 +155,8 @@ TR_INLINE int leaf_ends(const TriBlock& b0, const TriBlock& b1) {
 // with the current `tmax` (read again for every window). `visit(r, valid, b0, b1)` gets each
 // window's lane results, `valid` the lanes that are the leaf's, and returns true to stop.
 template <class Visit>
-TR_INLINE void leaf_windows(const WideBvh& w, std::uint32_t ref, const LeafRay& lr, const float& tmax,
-                            Visit&& visit) {
+TR_INLINE void leaf_windows(const WideBvh& w, std::uint32_t ref, const LeafRay& lr,
+                            const float& tmax, Visit&& visit) {
     const std::uint32_t first = leaf_first(ref);
     const TriBlock* blk = &w.blocks[first / 4];
     int start = static_cast<int>(first % 4);
@@ -184,24 +185,30 @@ TR_INLINE void leaf_windows(const WideBvh& w, std::uint32_t ref, const LeafRay& 
             const float* v1 = b0.v[1][0];
             const float* v2 = b0.v[2][0];
             const vf4 okx = set1_4(lr.o[0]), oky = set1_4(lr.o[1]), okz = set1_4(lr.o[2]);
-            const vf4 akz = load4(v0 + kz) - okz, bkz = load4(v1 + kz) - okz, ckz = load4(v2 + kz) - okz;
-            const EdgesT<vf4, vm4> e =
-                edges<vf4, vm4>(load4(v0 + kx) - okx, load4(v0 + ky) - oky, akz, load4(v1 + kx) - okx,
-                                load4(v1 + ky) - oky, bkz, load4(v2 + kx) - okx, load4(v2 + ky) - oky, ckz,
-                                set1_4(lr.sr.sx), set1_4(lr.sr.sy));
+            const vf4 akz = load4(v0 + kz) - okz, bkz = load4(v1 + kz) - okz,
+                      ckz = load4(v2 + kz) - okz;
+            const EdgesT<vf4, vm4> e = edges<vf4, vm4>(
+                load4(v0 + kx) - okx, load4(v0 + ky) - oky, akz, load4(v1 + kx) - okx,
+                load4(v1 + ky) - oky, bkz, load4(v2 + kx) - okx, load4(v2 + ky) - oky, ckz,
+                set1_4(lr.sr.sx), set1_4(lr.sr.sy));
             if (movemask(e.live) & valid &&
-                visit(finish<vf4, vm4>(e, akz, bkz, ckz, set1_4(lr.sr.sz), set1_4(tmax)), valid, b0, b0))
+                visit(finish<vf4, vm4>(e, akz, bkz, ckz, set1_4(lr.sr.sz), set1_4(tmax)), valid, b0,
+                      b0))
                 return;
         } else {
             const float* p0 = &b0.v[0][0][0];
             const float* p1 = &b1.v[0][0][0];
-            auto ld = [&](int corner, int row) { return load4x2(p0 + corner * 12 + row, p1 + corner * 12 + row); };
+            auto ld = [&](int corner, int row) {
+                return load4x2(p0 + corner * 12 + row, p1 + corner * 12 + row);
+            };
             const vf8 o8[3] = {bcast(&lr.o[0]), bcast(&lr.o[1]), bcast(&lr.o[2])};
             const vf8 s8[3] = {bcast(&lr.sr.sx), bcast(&lr.sr.sy), bcast(&lr.sr.sz)};
             const vf8 akz = ld(0, kz) - o8[2], bkz = ld(1, kz) - o8[2], ckz = ld(2, kz) - o8[2];
-            const Edges e = edges8(ld(0, kx) - o8[0], ld(0, ky) - o8[1], akz, ld(1, kx) - o8[0], ld(1, ky) - o8[1],
-                                   bkz, ld(2, kx) - o8[0], ld(2, ky) - o8[1], ckz, s8[0], s8[1]);
-            if (movemask(e.live) & valid && visit(finish8(e, akz, bkz, ckz, s8[2], set1(tmax)), valid, b0, b1))
+            const Edges e = edges8(ld(0, kx) - o8[0], ld(0, ky) - o8[1], akz, ld(1, kx) - o8[0],
+                                   ld(1, ky) - o8[1], bkz, ld(2, kx) - o8[0], ld(2, ky) - o8[1],
+                                   ckz, s8[0], s8[1]);
+            if (movemask(e.live) & valid &&
+                visit(finish8(e, akz, bkz, ckz, s8[2], set1(tmax)), valid, b0, b1))
                 return;
         }
         if (done) return;
@@ -211,37 +218,43 @@ TR_INLINE void leaf_windows(const WideBvh& w, std::uint32_t ref, const LeafRay& 
 }
 
 // Not inlined: the traversal loop keeps its registers for the node tests.
-__attribute__((noinline)) void leaf1(const WideBvh& w, std::uint32_t ref, const LeafRay& lr, BestHit& best) {
-    leaf_windows(w, ref, lr, best.t, [&](const auto& r, int valid, const TriBlock& b0, const TriBlock& b1) {
-        const int ok = movemask(r.ok) & valid;
-        const int zero = movemask(r.zero) & valid;
-        if (ok) take_lanes(ok, r, b0, b1, best);
-        if (zero) leaf_zero_lanes(zero, b0, b1, lr.sr, best);
-        return false;
-    });
+__attribute__((noinline)) void leaf1(const WideBvh& w, std::uint32_t ref, const LeafRay& lr,
+                                     BestHit& best) {
+    leaf_windows(w, ref, lr, best.t,
+                 [&](const auto& r, int valid, const TriBlock& b0, const TriBlock& b1) {
+                     const int ok = movemask(r.ok) & valid;
+                     const int zero = movemask(r.zero) & valid;
+                     if (ok) take_lanes(ok, r, b0, b1, best);
+                     if (zero) leaf_zero_lanes(zero, b0, b1, lr.sr, best);
+                     return false;
+                 });
 }
 
 // Whether a leaf holds a triangle hit with 0 < t < tmax: the lanes that leaf1 would take as a
 // first hit (a lane passes the test with t <= tmax, and a first hit must be below tmax).
-__attribute__((noinline)) bool leaf_occluded(const WideBvh& w, std::uint32_t ref, const LeafRay& lr, float tmax) {
+__attribute__((noinline)) bool leaf_occluded(const WideBvh& w, std::uint32_t ref, const LeafRay& lr,
+                                             float tmax) {
     bool hit = false;
-    leaf_windows(w, ref, lr, tmax, [&](const auto& r, int valid, const TriBlock& b0, const TriBlock& b1) {
-        if (movemask(r.ok & (r.t < splat<decltype(r.t)>(tmax))) & valid) return hit = true;
-        int zero = movemask(r.zero) & valid;
-        while (zero) {
-            const int i = __builtin_ctz(static_cast<unsigned>(zero));
-            zero &= zero - 1;
-            const TriBlock& b = i < 4 ? b0 : b1;
-            const int l = i & 3;
-            float t, u, v;
-            if (watertight_test(lr.sr, Vec3f(b.v[0][0][l], b.v[0][1][l], b.v[0][2][l]),
-                                Vec3f(b.v[1][0][l], b.v[1][1][l], b.v[1][2][l]),
-                                Vec3f(b.v[2][0][l], b.v[2][1][l], b.v[2][2][l]), tmax, t, u, v) &&
-                t < tmax)
-                return hit = true;
-        }
-        return false;
-    });
+    leaf_windows(w, ref, lr, tmax,
+                 [&](const auto& r, int valid, const TriBlock& b0, const TriBlock& b1) {
+                     if (movemask(r.ok & (r.t < splat<decltype(r.t)>(tmax))) & valid)
+                         return hit = true;
+                     int zero = movemask(r.zero) & valid;
+                     while (zero) {
+                         const int i = __builtin_ctz(static_cast<unsigned>(zero));
+                         zero &= zero - 1;
+                         const TriBlock& b = i < 4 ? b0 : b1;
+                         const int l = i & 3;
+                         float t, u, v;
+                         if (watertight_test(lr.sr, Vec3f(b.v[0][0][l], b.v[0][1][l], b.v[0][2][l]),
+                                             Vec3f(b.v[1][0][l], b.v[1][1][l], b.v[1][2][l]),
+                                             Vec3f(b.v[2][0][l], b.v[2][1][l], b.v[2][2][l]), tmax,
+                                             t, u, v) &&
+                             t < tmax)
+                             return hit = true;
+                     }
+                     return false;
+                 });
     return hit;
 }
 
@@ -280,7 +293,8 @@ struct RayBoxes {
 
     TR_INLINE explicit RayBoxes(const Ray& ray) {
         const float inv[3] = {1.0f / ray.dir.x, 1.0f / ray.dir.y, 1.0f / ray.dir.z};
-        const std::size_t nx = as_bits(inv[0]) >> 31, ny = as_bits(inv[1]) >> 31, nz = as_bits(inv[2]) >> 31;
+        const std::size_t nx = as_bits(inv[0]) >> 31, ny = as_bits(inv[1]) >> 31,
+                          nz = as_bits(inv[2]) >> 31;
         nr[0] = 0 + 24 * nx;
         nr[1] = 8 + 24 * ny;
         nr[2] = 16 + 24 * nz;
@@ -327,7 +341,8 @@ struct RayBoxes {
 };
 
 TR_INLINE std::uint64_t stack_key(float tnear, std::uint32_t ref) {
-    return (static_cast<std::uint64_t>(as_bits(tnear)) << 32) | ref;  // tnear >= +0: bits order like floats
+    return (static_cast<std::uint64_t>(as_bits(tnear)) << 32) |
+           ref;  // tnear >= +0: bits order like floats
 }
 
 bool intersect1(const WideBvh& w, const Ray& ray, Hit& hit, std::uint64_t* stack) {
@@ -435,7 +450,8 @@ bool occluded1(const WideBvh& w, const Ray& ray, std::uint64_t* stack) {
             unsigned mask = boxes.test(node, tmax8, tn);
             if (mask == 0) goto pop;
             ref = node.child[__builtin_ctz(mask)];
-            for (mask &= mask - 1; mask; mask &= mask - 1) stack[sp++] = node.child[__builtin_ctz(mask)];
+            for (mask &= mask - 1; mask; mask &= mask - 1)
+                stack[sp++] = node.child[__builtin_ctz(mask)];
         }
         if (!have_lr) {
             lr = leaf_ray(ray);
@@ -471,8 +487,8 @@ struct alignas(32) TileState {
 };
 
 // Lanes with an exact zero edge function go through the scalar test.
-TR_INLINE void group_zero_lanes(int zero, TileState& s, int g, const Vec3f& origin, const TriBlock& b, int j,
-                                std::uint32_t p) {
+TR_INLINE void group_zero_lanes(int zero, TileState& s, int g, const Vec3f& origin,
+                                const TriBlock& b, int j, std::uint32_t p) {
     const Vec3f v0(b.v[0][0][j], b.v[0][1][j], b.v[0][2][j]);
     const Vec3f v1(b.v[1][0][j], b.v[1][1][j], b.v[1][2][j]);
     const Vec3f v2(b.v[2][0][j], b.v[2][1][j], b.v[2][2][j]);
@@ -515,7 +531,8 @@ TR_INLINE void leaf_groups(const WideBvh& w, std::uint32_t ref, TileState& s, st
         auto prepare = [&](int g) {
             cls = s.cls[g];
             for (int c = 0; c < 3; ++c)
-                for (int r = 0; r < 3; ++r) a[c][r] = set1(b.v[c][s.k[g][r]][j] - origin[s.k[g][r]]);
+                for (int r = 0; r < 3; ++r)
+                    a[c][r] = set1(b.v[c][s.k[g][r]][j] - origin[s.k[g][r]]);
         };
         prepare(__builtin_ctz(groups));
         std::uint32_t gm = groups;
@@ -523,8 +540,8 @@ TR_INLINE void leaf_groups(const WideBvh& w, std::uint32_t ref, TileState& s, st
             const int g = __builtin_ctz(gm);
             gm &= gm - 1;
             if (s.cls[g] != cls) prepare(g);
-            const Edges e = edges8(a[0][0], a[0][1], a[0][2], a[1][0], a[1][1], a[1][2], a[2][0], a[2][1], a[2][2],
-                                   load8(s.sx[g]), load8(s.sy[g]));
+            const Edges e = edges8(a[0][0], a[0][1], a[0][2], a[1][0], a[1][1], a[1][2], a[2][0],
+                                   a[2][1], a[2][2], load8(s.sx[g]), load8(s.sy[g]));
             if (!movemask(e.live)) continue;
             const vf8 tmax = load8(s.tmax[g]);
             const LaneResult r = finish8(e, a[0][2], a[1][2], a[2][2], load8(s.sz[g]), tmax);
@@ -551,8 +568,9 @@ TR_INLINE void leaf_groups(const WideBvh& w, std::uint32_t ref, TileState& s, st
     }
 }
 
-void intersect_tile(const WideBvh& w, const Vec3f& origin, const Vec3f* dirs, int width, int height, float tmax_in,
-                    Hit* hits, bool* found, TileEntry* stack, std::uint64_t* stack1) {
+void intersect_tile(const WideBvh& w, const Vec3f& origin, const Vec3f* dirs, int width, int height,
+                    float tmax_in, Hit* hits, bool* found, TileEntry* stack,
+                    std::uint64_t* stack1) {
     const int gw = (width + 3) / 4, gh = (height + 1) / 2, ng = gw * gh;
     TileState s;
     std::uint32_t regular = 0, irregular = 0;
@@ -693,7 +711,9 @@ void intersect_tile(const WideBvh& w, const Vec3f& origin, const Vec3f* dirs, in
                                 gtf = vmin(vmax(ff * il, ff * ih), gtf);
                             }
                         }
-                        gm |= static_cast<std::uint32_t>(movemask(gtn <= gtf * slack) & static_cast<int>(qm)) << (8 * q);
+                        gm |= static_cast<std::uint32_t>(movemask(gtn <= gtf * slack) &
+                                                         static_cast<int>(qm))
+                              << (8 * q);
                     }
                     if (!gm) continue;
                     TileEntry e{n.child[c], gm, tns[c]};

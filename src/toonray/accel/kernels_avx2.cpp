@@ -41,7 +41,8 @@ namespace toonray::accel {
 
 const KernelTable* kernels_avx2() {
 #ifdef TOONRAY_ACCEL_HAVE_AVX2
-    static const KernelTable table{"avx2", &avx2::intersect1, &avx2::occluded1, &avx2::intersect_tile};
+    static const KernelTable table{"avx2", &avx2::intersect1, &avx2::occluded1,
+                                   &avx2::intersect_tile};
     return &table;
 #else
     return nullptr;

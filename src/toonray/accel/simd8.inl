@@ -50,7 +50,9 @@ TR_INLINE vm8 operator|(vm8 a, vm8 b) { return {_mm256_or_ps(a.m, b.m)}; }
 TR_INLINE vm8 andnot(vm8 a, vm8 b) { return {_mm256_andnot_ps(a.m, b.m)}; }  // ~a & b
 TR_INLINE int movemask(vm8 a) { return _mm256_movemask_ps(a.m); }
 TR_INLINE vm8 as_mask(vf8 a) { return {a.m}; }  // the sign bits are the mask
-TR_INLINE vm8 not_mask(vm8 a) { return {_mm256_xor_ps(a.m, _mm256_castsi256_ps(_mm256_set1_epi32(-1)))}; }
+TR_INLINE vm8 not_mask(vm8 a) {
+    return {_mm256_xor_ps(a.m, _mm256_castsi256_ps(_mm256_set1_epi32(-1)))};
+}
 TR_INLINE vf8 sign_bits(vf8 a) { return {_mm256_and_ps(a.m, _mm256_set1_ps(-0.0f))}; }
 TR_INLINE vf8 flip_sign(vf8 a, vf8 sign) { return {_mm256_xor_ps(a.m, sign.m)}; }
 TR_INLINE vm8 mask_from_bits(int bits) {
@@ -58,14 +60,23 @@ TR_INLINE vm8 mask_from_bits(int bits) {
     return {_mm256_castsi256_ps(
         _mm256_cmpeq_epi32(_mm256_and_si256(_mm256_set1_epi32(bits), lane), lane))};
 }
-TR_INLINE vf8 select(vm8 m, vf8 a, vf8 b) { return {_mm256_blendv_ps(b.m, a.m, m.m)}; }  // m ? a : b
-TR_INLINE vi8 loadi8(const std::uint32_t* p) { return {_mm256_load_si256(reinterpret_cast<const __m256i*>(p))}; }
-TR_INLINE void storei8(std::uint32_t* p, vi8 a) { _mm256_store_si256(reinterpret_cast<__m256i*>(p), a.m); }
+TR_INLINE vf8 select(vm8 m, vf8 a, vf8 b) {
+    return {_mm256_blendv_ps(b.m, a.m, m.m)};
+}  // m ? a : b
+TR_INLINE vi8 loadi8(const std::uint32_t* p) {
+    return {_mm256_load_si256(reinterpret_cast<const __m256i*>(p))};
+}
+TR_INLINE void storei8(std::uint32_t* p, vi8 a) {
+    _mm256_store_si256(reinterpret_cast<__m256i*>(p), a.m);
+}
 TR_INLINE vi8 seti1(std::uint32_t v) { return {_mm256_set1_epi32(static_cast<int>(v))}; }
-TR_INLINE vm8 lt_signed(vi8 a, vi8 b) { return {_mm256_castsi256_ps(_mm256_cmpgt_epi32(b.m, a.m))}; }
+TR_INLINE vm8 lt_signed(vi8 a, vi8 b) {
+    return {_mm256_castsi256_ps(_mm256_cmpgt_epi32(b.m, a.m))};
+}
 TR_INLINE vm8 eqi(vi8 a, vi8 b) { return {_mm256_castsi256_ps(_mm256_cmpeq_epi32(a.m, b.m))}; }
 TR_INLINE vi8 selecti(vm8 m, vi8 a, vi8 b) {
-    return {_mm256_castps_si256(_mm256_blendv_ps(_mm256_castsi256_ps(b.m), _mm256_castsi256_ps(a.m), m.m))};
+    return {_mm256_castps_si256(
+        _mm256_blendv_ps(_mm256_castsi256_ps(b.m), _mm256_castsi256_ps(a.m), m.m))};
 }
 TR_INLINE float hmin(vf8 a) {
     __m128 m = _mm_min_ps(_mm256_castps256_ps128(a.m), _mm256_extractf128_ps(a.m, 1));
@@ -94,7 +105,9 @@ struct vi8 {
 
 TR_INLINE vf8 load8(const float* p) { return {_mm_load_ps(p), _mm_load_ps(p + 4)}; }
 TR_INLINE vf8 loadu8(const float* p) { return {_mm_loadu_ps(p), _mm_loadu_ps(p + 4)}; }
-TR_INLINE vf8 load4x2(const float* lo, const float* hi) { return {_mm_load_ps(lo), _mm_load_ps(hi)}; }
+TR_INLINE vf8 load4x2(const float* lo, const float* hi) {
+    return {_mm_load_ps(lo), _mm_load_ps(hi)};
+}
 TR_INLINE void store8(float* p, vf8 a) {
     _mm_store_ps(p, a.l);
     _mm_store_ps(p + 4, a.h);
@@ -135,27 +148,36 @@ TR_INLINE vf8 sign_bits(vf8 a) {
     const __m128 s = _mm_set1_ps(-0.0f);
     return {_mm_and_ps(a.l, s), _mm_and_ps(a.h, s)};
 }
-TR_INLINE vf8 flip_sign(vf8 a, vf8 sign) { return {_mm_xor_ps(a.l, sign.l), _mm_xor_ps(a.h, sign.h)}; }
+TR_INLINE vf8 flip_sign(vf8 a, vf8 sign) {
+    return {_mm_xor_ps(a.l, sign.l), _mm_xor_ps(a.h, sign.h)};
+}
 TR_INLINE vm8 mask_from_bits(int bits) {
     const __m128i lo = _mm_setr_epi32(1, 2, 4, 8), hi = _mm_setr_epi32(16, 32, 64, 128);
     const __m128i b = _mm_set1_epi32(bits);
     return {_mm_castsi128_ps(_mm_cmpeq_epi32(_mm_and_si128(b, lo), lo)),
             _mm_castsi128_ps(_mm_cmpeq_epi32(_mm_and_si128(b, hi), hi))};
 }
-TR_INLINE vf8 select(vm8 m, vf8 a, vf8 b) { return {_mm_blendv_ps(b.l, a.l, m.l), _mm_blendv_ps(b.h, a.h, m.h)}; }
+TR_INLINE vf8 select(vm8 m, vf8 a, vf8 b) {
+    return {_mm_blendv_ps(b.l, a.l, m.l), _mm_blendv_ps(b.h, a.h, m.h)};
+}
 TR_INLINE vi8 loadi8(const std::uint32_t* p) {
-    return {_mm_load_si128(reinterpret_cast<const __m128i*>(p)), _mm_load_si128(reinterpret_cast<const __m128i*>(p + 4))};
+    return {_mm_load_si128(reinterpret_cast<const __m128i*>(p)),
+            _mm_load_si128(reinterpret_cast<const __m128i*>(p + 4))};
 }
 TR_INLINE void storei8(std::uint32_t* p, vi8 a) {
     _mm_store_si128(reinterpret_cast<__m128i*>(p), a.l);
     _mm_store_si128(reinterpret_cast<__m128i*>(p + 4), a.h);
 }
-TR_INLINE vi8 seti1(std::uint32_t v) { return {_mm_set1_epi32(static_cast<int>(v)), _mm_set1_epi32(static_cast<int>(v))}; }
+TR_INLINE vi8 seti1(std::uint32_t v) {
+    return {_mm_set1_epi32(static_cast<int>(v)), _mm_set1_epi32(static_cast<int>(v))};
+}
 TR_INLINE vm8 lt_signed(vi8 a, vi8 b) {
-    return {_mm_castsi128_ps(_mm_cmplt_epi32(a.l, b.l)), _mm_castsi128_ps(_mm_cmplt_epi32(a.h, b.h))};
+    return {_mm_castsi128_ps(_mm_cmplt_epi32(a.l, b.l)),
+            _mm_castsi128_ps(_mm_cmplt_epi32(a.h, b.h))};
 }
 TR_INLINE vm8 eqi(vi8 a, vi8 b) {
-    return {_mm_castsi128_ps(_mm_cmpeq_epi32(a.l, b.l)), _mm_castsi128_ps(_mm_cmpeq_epi32(a.h, b.h))};
+    return {_mm_castsi128_ps(_mm_cmpeq_epi32(a.l, b.l)),
+            _mm_castsi128_ps(_mm_cmpeq_epi32(a.h, b.h))};
 }
 TR_INLINE vi8 selecti(vm8 m, vi8 a, vi8 b) {
     return {_mm_castps_si128(_mm_blendv_ps(_mm_castsi128_ps(b.l), _mm_castsi128_ps(a.l), m.l)),
@@ -207,6 +229,10 @@ TR_INLINE vf4 flip_sign(vf4 a, vf4 sign) { return {_mm_xor_ps(a.m, sign.m)}; }
 template <class V>
 TR_INLINE V splat(float f);
 template <>
-TR_INLINE vf8 splat<vf8>(float f) { return set1(f); }
+TR_INLINE vf8 splat<vf8>(float f) {
+    return set1(f);
+}
 template <>
-TR_INLINE vf4 splat<vf4>(float f) { return set1_4(f); }
+TR_INLINE vf4 splat<vf4>(float f) {
+    return set1_4(f);
+}

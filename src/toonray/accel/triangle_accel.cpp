@@ -14,8 +14,8 @@ namespace {
 
 bool cpu_has_avx2() {
 #if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
-    return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") && __builtin_cpu_supports("bmi") &&
-           __builtin_cpu_supports("bmi2");
+    return __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma") &&
+           __builtin_cpu_supports("bmi") && __builtin_cpu_supports("bmi2");
 #else
     return false;
 #endif
@@ -23,8 +23,9 @@ bool cpu_has_avx2() {
 
 bool cpu_has_avx512() {
 #if defined(__GNUC__) && (defined(__x86_64__) || defined(__i386__))
-    return cpu_has_avx2() && __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
-           __builtin_cpu_supports("avx512bw") && __builtin_cpu_supports("avx512dq");
+    return cpu_has_avx2() && __builtin_cpu_supports("avx512f") &&
+           __builtin_cpu_supports("avx512vl") && __builtin_cpu_supports("avx512bw") &&
+           __builtin_cpu_supports("avx512dq");
 #else
     return false;
 #endif
@@ -76,13 +77,15 @@ bool set_accel_isa(std::string_view isa) {
     return true;
 }
 
-bool intersect_triangle(const Ray& ray, const Vec3f& v0, const Vec3f& v1, const Vec3f& v2,
-                        float& t, float& u, float& v) {
-    return accel::watertight_test(accel::ShearedRay(ray), v0, v1, v2, ray.tmax, t, u, v) && t < ray.tmax;
+bool intersect_triangle(const Ray& ray, const Vec3f& v0, const Vec3f& v1, const Vec3f& v2, float& t,
+                        float& u, float& v) {
+    return accel::watertight_test(accel::ShearedRay(ray), v0, v1, v2, ray.tmax, t, u, v) &&
+           t < ray.tmax;
 }
 
 void TriangleAccel::build(std::span<const Vec3f> positions,
-                          std::span<const std::array<std::uint32_t, 3>> tris, const Bvh::Config& config) {
+                          std::span<const std::array<std::uint32_t, 3>> tris,
+                          const Bvh::Config& config) {
     std::vector<BBox> boxes;
     boxes_of(positions, tris, boxes);
     bvh_ = Bvh::build(boxes, config);
@@ -100,8 +103,10 @@ void TriangleAccel::refit(std::span<const Vec3f> positions,
 }
 
 std::size_t TriangleAccel::memory_bytes() const {
-    return bvh_.nodes.capacity() * sizeof(BvhNode) + bvh_.prim_indices.capacity() * sizeof(std::uint32_t) +
-           wide_.nodes.capacity() * sizeof(accel::WideNode) + wide_.blocks.capacity() * sizeof(accel::TriBlock);
+    return bvh_.nodes.capacity() * sizeof(BvhNode) +
+           bvh_.prim_indices.capacity() * sizeof(std::uint32_t) +
+           wide_.nodes.capacity() * sizeof(accel::WideNode) +
+           wide_.blocks.capacity() * sizeof(accel::TriBlock);
 }
 
 bool TriangleAccel::intersect(const Ray& ray, Hit& hit) const {
@@ -122,8 +127,8 @@ bool TriangleAccel::occluded(const Ray& ray) const {
     return kernels().occluded1(wide_, ray, stack.data());
 }
 
-void TriangleAccel::intersect_tile(const Vec3f& origin, const Vec3f* dirs, int width, int height, Hit* hits,
-                                   bool* found, float tmax) const {
+void TriangleAccel::intersect_tile(const Vec3f& origin, const Vec3f* dirs, int width, int height,
+                                   Hit* hits, bool* found, float tmax) const {
     if (width <= 0 || height <= 0) return;
     if (width > kTileSize || height > kTileSize) {
         // Larger grids: tile them.
@@ -147,12 +152,14 @@ void TriangleAccel::intersect_tile(const Vec3f& origin, const Vec3f* dirs, int w
     if (wide_.max_stack <= kFixedStack) {
         accel::TileEntry stack[kFixedStack];
         std::uint64_t stack1[kFixedStack];
-        kernels().intersect_tile(wide_, origin, dirs, width, height, tmax, hits, found, stack, stack1);
+        kernels().intersect_tile(wide_, origin, dirs, width, height, tmax, hits, found, stack,
+                                 stack1);
         return;
     }
     std::vector<accel::TileEntry> stack(wide_.max_stack);
     std::vector<std::uint64_t> stack1(wide_.max_stack);
-    kernels().intersect_tile(wide_, origin, dirs, width, height, tmax, hits, found, stack.data(), stack1.data());
+    kernels().intersect_tile(wide_, origin, dirs, width, height, tmax, hits, found, stack.data(),
+                             stack1.data());
 }
 
 }  // namespace toonray

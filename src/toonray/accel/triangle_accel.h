@@ -27,7 +27,8 @@ public:
     void build(std::span<const Vec3f> positions, std::span<const std::array<std::uint32_t, 3>> tris,
                const Bvh::Config& config = {});
     /// Updates for moved vertices with the same triangles (topology kept).
-    void refit(std::span<const Vec3f> positions, std::span<const std::array<std::uint32_t, 3>> tris);
+    void refit(std::span<const Vec3f> positions,
+               std::span<const std::array<std::uint32_t, 3>> tris);
 
     /// Closest hit with 0 < t < ray.tmax. Returns true and fills `hit` when there is one.
     /// Among hits at the same distance the lowest triangle index wins, whatever the tree.
@@ -43,8 +44,8 @@ public:
     /// intersect(Ray{origin, dir, tmax}, hit) gives (misses get Hit{} and false). Neighbouring
     /// rays should be coherent (a pinhole camera's): each kTileSize x kTileSize tile is
     /// traversed once, as a frustum of 4 x 2 ray packets (larger grids are cut into tiles).
-    void intersect_tile(const Vec3f& origin, const Vec3f* dirs, int width, int height, Hit* hits, bool* found,
-                        float tmax = std::numeric_limits<float>::infinity()) const;
+    void intersect_tile(const Vec3f& origin, const Vec3f* dirs, int width, int height, Hit* hits,
+                        bool* found, float tmax = std::numeric_limits<float>::infinity()) const;
 
     [[nodiscard]] const Bvh& bvh() const { return bvh_; }
     [[nodiscard]] std::size_t triangle_count() const { return triangle_count_; }
@@ -60,8 +61,8 @@ private:
 
 /// The watertight ray/triangle test the traversal uses (Woop et al. 2013): 0 < t < ray.tmax.
 /// Exposed for brute-force reference checks in tests.
-bool intersect_triangle(const Ray& ray, const Vec3f& v0, const Vec3f& v1, const Vec3f& v2,
-                        float& t, float& u, float& v);
+bool intersect_triangle(const Ray& ray, const Vec3f& v0, const Vec3f& v1, const Vec3f& v2, float& t,
+                        float& u, float& v);
 
 /// The instruction set the traversal kernels use: "avx2" or "sse4.2". By default the best the
 /// CPU supports; the environment variable TOONRAY_ACCEL_ISA=sse4.2 forces the portable one.

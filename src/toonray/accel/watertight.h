@@ -56,7 +56,8 @@ inline bool watertight_test(const ShearedRay& r, const Vec3f& v0, const Vec3f& v
         e1 = static_cast<float>(static_cast<double>(ax) * cy - static_cast<double>(ay) * cx);
         e2 = static_cast<float>(static_cast<double>(bx) * ay - static_cast<double>(by) * ax);
     }
-    if ((e0 < 0.0f || e1 < 0.0f || e2 < 0.0f) && (e0 > 0.0f || e1 > 0.0f || e2 > 0.0f)) return false;
+    if ((e0 < 0.0f || e1 < 0.0f || e2 < 0.0f) && (e0 > 0.0f || e1 > 0.0f || e2 > 0.0f))
+        return false;
     const float det = e0 + e1 + e2;
     if (det == 0.0f) return false;
     const float az = r.sz * a[r.kz], bz = r.sz * b[r.kz], cz = r.sz * c[r.kz];
@@ -64,7 +65,8 @@ inline bool watertight_test(const ShearedRay& r, const Vec3f& v0, const Vec3f& v
     // Reject most misses before the division, on scaled values with some slack; the exact
     // test is on t below.
     const float bound = tmax * det * kTmaxSlack;
-    if (det > 0.0f ? (scaled_t <= 0.0f || scaled_t > bound) : (scaled_t >= 0.0f || scaled_t < bound))
+    if (det > 0.0f ? (scaled_t <= 0.0f || scaled_t > bound)
+                   : (scaled_t >= 0.0f || scaled_t < bound))
         return false;
     const float inv = 1.0f / det;
     t = scaled_t * inv;

@@ -9,7 +9,8 @@
 namespace toonray::accel {
 
 void WideBvh::build(const Bvh& bvh, std::span<const BBox> boxes, std::span<const Vec3f> positions,
-                    std::span<const std::array<std::uint32_t, 3>> tris, const CollapseCosts& costs) {
+                    std::span<const std::array<std::uint32_t, 3>> tris,
+                    const CollapseCosts& costs) {
     nodes.clear();
     blocks.clear();
     root = kEmptyChild;
@@ -73,7 +74,9 @@ void WideBvh::build(const Bvh& bvh, std::span<const BBox> boxes, std::span<const
     auto prim_count = std::make_unique_for_overwrite<std::uint32_t[]>(count);
     auto flags = std::make_unique_for_overwrite<std::uint8_t[]>(count);  // kAsLeaf, kSpread
     constexpr std::uint8_t kAsLeaf = 1, kSpread = 2;
-    auto range = [&](std::uint32_t n) { return BvhNode{bvh.nodes[n].bounds, first_prim[n], prim_count[n]}; };
+    auto range = [&](std::uint32_t n) {
+        return BvhNode{bvh.nodes[n].bounds, first_prim[n], prim_count[n]};
+    };
     auto tri_box = [&](std::uint32_t p) { return boxes[p]; };
     for (std::size_t n = count; n-- > 0;) {
         const BvhNode& b = bvh.nodes[n];
@@ -82,7 +85,8 @@ void WideBvh::build(const Bvh& bvh, std::span<const BBox> boxes, std::span<const
             first_prim[n] = b.first;
             prim_count[n] = b.count;
             flags[n] = kAsLeaf;
-            cost[n].fill(costs.block * area * static_cast<float>((b.count + costs.leaf_width - 1) / costs.leaf_width));
+            cost[n].fill(costs.block * area *
+                         static_cast<float>((b.count + costs.leaf_width - 1) / costs.leaf_width));
             // With as many slots as it has triangles, a small leaf may rather spread them
             // over the slots, one leaf each, so that boxes cull them one by one.
             if (b.count >= 2 && b.count <= 8) {
@@ -113,7 +117,9 @@ void WideBvh::build(const Bvh& bvh, std::span<const BBox> boxes, std::span<const
         cost[n][0] = costs.node * area + best;
         split[n][0] = static_cast<std::int8_t>(best_k);
         if (prim_count[n] <= costs.merge_leaf) {
-            float leaf = costs.block * area * static_cast<float>((prim_count[n] + costs.leaf_width - 1) / costs.leaf_width);
+            float leaf =
+                costs.block * area *
+                static_cast<float>((prim_count[n] + costs.leaf_width - 1) / costs.leaf_width);
             if (leaf <= cost[n][0]) {
                 cost[n][0] = leaf;
                 flags[n] |= kAsLeaf;
@@ -144,7 +150,8 @@ void WideBvh::build(const Bvh& bvh, std::span<const BBox> boxes, std::span<const
         if (b.is_leaf()) {
             if ((flags[n] & kSpread) && static_cast<std::uint32_t>(i) >= b.count) {
                 for (std::uint32_t k = 0; k < b.count; ++k)
-                    out[len++] = {BvhNode{tri_box(bvh.prim_indices[b.first + k]), b.first + k, 1}, kNoIndex};
+                    out[len++] = {BvhNode{tri_box(bvh.prim_indices[b.first + k]), b.first + k, 1},
+                                  kNoIndex};
             } else {
                 out[len++] = {b, kNoIndex};
             }
@@ -185,8 +192,10 @@ void WideBvh::build(const Bvh& bvh, std::span<const BBox> boxes, std::span<const
         gather(gather, first + 1, 8 - k, ch, n);
         WideNode w;
         for (int a = 0; a < 3; ++a) {
-            std::fill(std::begin(w.lo[a]), std::end(w.lo[a]), std::numeric_limits<float>::infinity());
-            std::fill(std::begin(w.hi[a]), std::end(w.hi[a]), -std::numeric_limits<float>::infinity());
+            std::fill(std::begin(w.lo[a]), std::end(w.lo[a]),
+                      std::numeric_limits<float>::infinity());
+            std::fill(std::begin(w.hi[a]), std::end(w.hi[a]),
+                      -std::numeric_limits<float>::infinity());
         }
         std::fill(std::begin(w.child), std::end(w.child), kEmptyChild);
         std::fill(std::begin(w.pad), std::end(w.pad), 0u);

@@ -21,12 +21,15 @@ namespace toonray::accel {
 inline constexpr std::uint32_t kLeafBit = 0x80000000u;
 inline constexpr std::uint32_t kLeafCountShift = 27;
 inline constexpr std::uint32_t kMaxSlots = 1u << kLeafCountShift;  ///< 134 million triangles
-inline constexpr std::uint32_t kLeafEnd = 0x80000000u;  ///< in TriBlock::prim: last triangle of its leaf
+inline constexpr std::uint32_t kLeafEnd =
+    0x80000000u;  ///< in TriBlock::prim: last triangle of its leaf
 inline constexpr std::uint32_t kEmptyChild = 0xffffffffu;
 
 [[nodiscard]] inline bool is_leaf(std::uint32_t ref) { return (ref & kLeafBit) != 0; }
 [[nodiscard]] inline std::uint32_t leaf_first(std::uint32_t ref) { return ref & (kMaxSlots - 1); }
-[[nodiscard]] inline std::uint32_t leaf_count(std::uint32_t ref) { return (ref >> kLeafCountShift) & 15u; }
+[[nodiscard]] inline std::uint32_t leaf_count(std::uint32_t ref) {
+    return (ref >> kLeafCountShift) & 15u;
+}
 
 /// 256 bytes, cache-line aligned. Unused slots have empty boxes (lo = +inf, hi = -inf), which
 /// no ray enters.
@@ -42,8 +45,8 @@ static_assert(sizeof(WideNode) == 256);
 /// the slots after the last leaf (and two whole blocks after it, which 8-wide loads may touch)
 /// have NaN corners, which fail every test, and prim == kNoIndex.
 struct alignas(16) TriBlock {
-    float v[3][3][4];         ///< [corner][axis][lane]
-    std::uint32_t prim[4];    ///< triangle index in the input order, | kLeafEnd on a leaf's last
+    float v[3][3][4];       ///< [corner][axis][lane]
+    std::uint32_t prim[4];  ///< triangle index in the input order, | kLeafEnd on a leaf's last
 };
 static_assert(sizeof(TriBlock) == 160);
 
@@ -59,7 +62,8 @@ struct WideBvh {
     struct CollapseCosts {
         float node = 1.0f;
         float block = 1.0f;
-        std::uint32_t merge_leaf = 8;  ///< subtrees of at most this many triangles may become one leaf
+        std::uint32_t merge_leaf =
+            8;  ///< subtrees of at most this many triangles may become one leaf
         std::uint32_t leaf_width = 4;  ///< triangles a leaf test takes at once
     };
 

@@ -63,9 +63,10 @@ public:
         auto input = find_frame_file(options_.input_dir, input_patterns_, frame);
         if (!input) {
             std::string tried;
-            for (const auto& p : input_patterns_) tried += (tried.empty() ? "" : ", ") + p.format(frame);
-            throw Error(fmt::format("{}: no input file for frame {} (tried {})", options_.input_dir.string(), frame,
-                                    tried));
+            for (const auto& p : input_patterns_)
+                tried += (tried.empty() ? "" : ", ") + p.format(frame);
+            throw Error(fmt::format("{}: no input file for frame {} (tried {})",
+                                    options_.input_dir.string(), frame, tried));
         }
         try {
             load_obj(*input, scene, warnings, obj_);
@@ -88,7 +89,8 @@ private:
 // A batch job: two scenes, so that the next frame's OBJ loads while this one renders.
 class ObjFrameJob : public FrameJob {
 public:
-    ObjFrameJob(const ObjFrames& source, int jobs) : source_(source), render_(source.options().render) {
+    ObjFrameJob(const ObjFrames& source, int jobs)
+        : source_(source), render_(source.options().render) {
         render_.settings.threads = threads_per_frame(render_.settings.threads, jobs);
     }
 
@@ -100,13 +102,15 @@ public:
             Scene& target = scenes_[1 - slot_];
             const int n = *next;
             pending_frame_ = n;
-            pending_ = std::async(std::launch::async, [this, n, &target] { return load_into(n, target); });
+            pending_ =
+                std::async(std::launch::async, [this, n, &target] { return load_into(n, target); });
         }
         const Scene& scene = scenes_[slot_];
         slot_ = 1 - slot_;
         warnings.insert(warnings.end(), current.warnings.begin(), current.warnings.end());
         if (current.error) std::rethrow_exception(current.error);
-        renderer_.render(scene, choose_camera(scene, render_), source_.output(frame), render_, warnings);
+        renderer_.render(scene, choose_camera(scene, render_), source_.output(frame), render_,
+                         warnings);
     }
 
 private:
@@ -136,7 +140,9 @@ private:
     int pending_frame_ = -1;
 };
 
-std::unique_ptr<FrameJob> ObjFrames::make_job(int jobs) { return std::make_unique<ObjFrameJob>(*this, jobs); }
+std::unique_ptr<FrameJob> ObjFrames::make_job(int jobs) {
+    return std::make_unique<ObjFrameJob>(*this, jobs);
+}
 
 }  // namespace
 
@@ -144,7 +150,8 @@ Shard parse_shard(const std::string& text) {
     auto slash = text.find('/');
     Shard s;
     if (slash == std::string::npos || !parse_int(text.substr(0, slash), s.index) ||
-        !parse_int(text.substr(slash + 1), s.count) || s.count < 1 || s.index < 1 || s.index > s.count)
+        !parse_int(text.substr(slash + 1), s.count) || s.count < 1 || s.index < 1 ||
+        s.index > s.count)
         throw Error(fmt::format("shard '{}': expected K/N with 1 <= K <= N", text));
     return s;
 }
@@ -156,40 +163,50 @@ std::optional<Shard> shard_from_environment() {
     const char* min = std::getenv("SLURM_ARRAY_TASK_MIN");
     int task = 0, n = 0, first = 1;
     if (!parse_int(id, task) || !parse_int(count, n) || (min && !parse_int(min, first)))
-        throw Error(fmt::format("Slurm array variables are not numbers: SLURM_ARRAY_TASK_ID={} "
-                                "SLURM_ARRAY_TASK_COUNT={} SLURM_ARRAY_TASK_MIN={}",
-                                id, count, min ? min : "(unset)"));
+        throw Error(
+            fmt::format("Slurm array variables are not numbers: SLURM_ARRAY_TASK_ID={} "
+                        "SLURM_ARRAY_TASK_COUNT={} SLURM_ARRAY_TASK_MIN={}",
+                        id, count, min ? min : "(unset)"));
     Shard s{task - first + 1, n};
     if (s.count < 1 || s.index < 1 || s.index > s.count)
-        throw Error(fmt::format("Slurm array task {} (min {}) is outside a {}-task array; submit "
-                                "with --array=1-N for N tasks",
-                                task, first, n));
+        throw Error(
+            fmt::format("Slurm array task {} (min {}) is outside a {}-task array; submit "
+                        "with --array=1-N for N tasks",
+                        task, first, n));
     return s;
 }
 
 std::vector<int> shard_frames(int first, int last, const Shard& shard) {
     if (first > last)
-        throw Error(fmt::format("frame range {} {}: the first frame is after the last", first, last));
+        throw Error(
+            fmt::format("frame range {} {}: the first frame is after the last", first, last));
     if (shard.count < 1 || shard.index < 1 || shard.index > shard.count)
-        throw Error(fmt::format("shard {}/{}: expected K/N with 1 <= K <= N", shard.index, shard.count));
+        throw Error(
+            fmt::format("shard {}/{}: expected K/N with 1 <= K <= N", shard.index, shard.count));
     const long long span = static_cast<long long>(last) - first;  // >= 0
-    const long long count = span < shard.index - 1 ? 0 : (span - (shard.index - 1)) / shard.count + 1;
+    const long long count =
+        span < shard.index - 1 ? 0 : (span - (shard.index - 1)) / shard.count + 1;
     if (static_cast<unsigned long long>(count) > limits().max_frames)
-        throw LimitError(Limit::Frames, fmt::format("frame range {} {}: {} frames is more than the limit of {}", first, last,
-                                count, limits().max_frames));
+        throw LimitError(Limit::Frames,
+                         fmt::format("frame range {} {}: {} frames is more than the limit of {}",
+                                     first, last, count, limits().max_frames));
     std::vector<int> frames;
     frames.reserve(static_cast<std::size_t>(count));
-    for (long long f = static_cast<long long>(first) + (shard.index - 1); f <= last; f += shard.count)
+    for (long long f = static_cast<long long>(first) + (shard.index - 1); f <= last;
+         f += shard.count)
         frames.push_back(static_cast<int>(f));
     return frames;
 }
 
 BatchReport run_batch(const BatchOptions& options, BatchObserver* observer) {
     if (options.first < 0 || options.last < 0)
-        throw Error(fmt::format("frame range {} {}: frame numbers must not be negative", options.first, options.last));
+        throw Error(fmt::format("frame range {} {}: frame numbers must not be negative",
+                                options.first, options.last));
     if (options.first > options.last)
-        throw Error(fmt::format("frame range {} {}: the first frame is after the last", options.first, options.last));
-    if (options.name.empty() && !options.input_pattern) throw Error("batch: the animation name is empty");
+        throw Error(fmt::format("frame range {} {}: the first frame is after the last",
+                                options.first, options.last));
+    if (options.name.empty() && !options.input_pattern)
+        throw Error("batch: the animation name is empty");
     std::error_code ec;
     std::filesystem::create_directories(options.output_dir, ec);
     if (ec || ::access(options.output_dir.c_str(), W_OK) != 0)

@@ -38,10 +38,10 @@ struct BatchOptions {
     int first = 1, last = 1;
     std::filesystem::path input_dir = ".";
     std::filesystem::path output_dir = ".";
-    std::optional<std::string> input_pattern;  ///< default: see default_input_patterns()
-    std::optional<std::string> output_pattern; ///< default: NAME_%06d.png
+    std::optional<std::string> input_pattern;   ///< default: see default_input_patterns()
+    std::optional<std::string> output_pattern;  ///< default: NAME_%06d.png
     FrameOptions render;
-    int jobs = 0;  ///< frames rendered at once; 0 = one per hardware thread
+    int jobs = 0;            ///< frames rendered at once; 0 = one per hardware thread
     bool resume = false;     ///< skip frames whose PNG exists and is valid
     bool fail_fast = false;  ///< stop at the first failed frame
     Shard shard;

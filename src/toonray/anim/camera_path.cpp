@@ -19,9 +19,9 @@ namespace {
 constexpr double kDegrees = std::numbers::pi / 180.0;
 
 /// Ranges that keep the spline's double arithmetic and the float camera finite.
-constexpr double kMaxKeyTime = 1e9;   // seconds, about 32 years
-constexpr double kMinKeyGap = 1e-6;   // seconds between keys
-constexpr double kMaxKeyValue = 1e15; // eye, target and up coordinates
+constexpr double kMaxKeyTime = 1e9;    // seconds, about 32 years
+constexpr double kMinKeyGap = 1e-6;    // seconds between keys
+constexpr double kMaxKeyValue = 1e15;  // eye, target and up coordinates
 
 struct Vec3d {
     double x = 0, y = 0, z = 0;
@@ -50,8 +50,8 @@ double steffen_slope(double d0, double d1, double h0, double h1) {
 }
 
 struct Frame {
-    Vec3d dir;   ///< unit view direction
-    Vec3d up;    ///< unit, orthogonal to dir
+    Vec3d dir;  ///< unit view direction
+    Vec3d up;   ///< unit, orthogonal to dir
     double view_length = 0;
     double up_sine = 0;  ///< |cross(dir, unit up)| before orthogonalisation
     double up_length = 0;
@@ -101,12 +101,13 @@ CameraPath::CameraPath(std::vector<CameraKey> keys, std::optional<double> loop_p
         if (!(std::abs(k.time) <= kMaxKeyTime))
             fail(fmt::format("key time {} s is outside -1e9..1e9 s", k.time));
         if (i > 0 && !(k.time > keys_[i - 1].time))
-            fail(fmt::format("key times must increase: {} s comes after {} s{}", k.time,
-                             keys_[i - 1].time,
-                             keys_[i - 1].line ? fmt::format(" (line {})", keys_[i - 1].line) : ""));
+            fail(fmt::format(
+                "key times must increase: {} s comes after {} s{}", k.time, keys_[i - 1].time,
+                keys_[i - 1].line ? fmt::format(" (line {})", keys_[i - 1].line) : ""));
         if (i > 0 && !(k.time - keys_[i - 1].time >= kMinKeyGap))
-            fail(fmt::format("key times must be at least 1 microsecond apart: {} s comes {} s after {} s",
-                             k.time, k.time - keys_[i - 1].time, keys_[i - 1].time));
+            fail(fmt::format(
+                "key times must be at least 1 microsecond apart: {} s comes {} s after {} s",
+                k.time, k.time - keys_[i - 1].time, keys_[i - 1].time));
         if (!is_finite(k.eye) || !is_finite(k.target) || !is_finite(k.up) || !std::isfinite(k.fov))
             fail("key has a value that is not finite");
         for (const Vec3f* v : {&k.eye, &k.target, &k.up})
@@ -129,10 +130,11 @@ CameraPath::CameraPath(std::vector<CameraKey> keys, std::optional<double> loop_p
                                             "first (leave out a closing key equal to the first)",
                                             *period_, span)));
         if (!(*period_ - span >= kMinKeyGap) || !(*period_ <= 2 * kMaxKeyTime))
-            throw Error(located(source_, 0,
-                                fmt::format("loop period {} s must exceed the keys' span {} s by at "
-                                            "least 1 microsecond and be at most 2e9 s",
-                                            *period_, span)));
+            throw Error(
+                located(source_, 0,
+                        fmt::format("loop period {} s must exceed the keys' span {} s by at "
+                                    "least 1 microsecond and be at most 2e9 s",
+                                    *period_, span)));
     }
 
     values_.resize(n);
@@ -141,8 +143,8 @@ CameraPath::CameraPath(std::vector<CameraKey> keys, std::optional<double> loop_p
         // Up is interpolated as a unit vector (then renormalised), so keys written as "0 2 0"
         // and "0 1 0" weigh the same.
         const Vec3d up = to_d(k.up) * (1.0 / length(to_d(k.up)));
-        values_[i] = {k.eye.x, k.eye.y, k.eye.z, k.target.x, k.target.y, k.target.z,
-                      up.x, up.y, up.z, k.fov};
+        values_[i] = {k.eye.x,    k.eye.y, k.eye.z, k.target.x, k.target.y,
+                      k.target.z, up.x,    up.y,    up.z,       k.fov};
     }
 
     // Tangents. The neighbours of a key and the time to them; around the wrap of a loop, the
@@ -154,8 +156,8 @@ CameraPath::CameraPath(std::vector<CameraKey> keys, std::optional<double> loop_p
         if (!has_prev || !has_next) continue;  // ends of an open path start and stop at rest
         const std::size_t prev = i > 0 ? i - 1 : n - 1;
         const std::size_t next = i + 1 < n ? i + 1 : 0;
-        const double h0 = i > 0 ? keys_[i].time - keys_[prev].time
-                                : keys_[i].time + *period_ - keys_[prev].time;
+        const double h0 =
+            i > 0 ? keys_[i].time - keys_[prev].time : keys_[i].time + *period_ - keys_[prev].time;
         const double h1 = i + 1 < n ? keys_[next].time - keys_[i].time
                                     : keys_[next].time + *period_ - keys_[i].time;
         for (int c = 0; c < kChannels; ++c) {
@@ -242,12 +244,13 @@ void CameraPath::validate_between_keys() const {
                 problem = "up turns parallel to the view direction";
             }
             if (!problem.empty())
-                throw_at(source_, keys_[i].line,
-                         fmt::format("between this key ({} s) and the next ({} s{}) {} near {:.3f} s; "
-                                     "add a key in between or change up",
-                                     ta, keys_[j].time,
-                                     keys_[j].line ? fmt::format(", line {}", keys_[j].line) : "",
-                                     problem, t));
+                throw_at(
+                    source_, keys_[i].line,
+                    fmt::format("between this key ({} s) and the next ({} s{}) {} near {:.3f} s; "
+                                "add a key in between or change up",
+                                ta, keys_[j].time,
+                                keys_[j].line ? fmt::format(", line {}", keys_[j].line) : "",
+                                problem, t));
         }
     }
 }
@@ -276,7 +279,8 @@ public:
 
     double number(Tokens& t, std::string_view after, int count) const {
         if (t.done())
-            fail(fmt::format("expected {} number{} after '{}'", count, count > 1 ? "s" : "", after));
+            fail(
+                fmt::format("expected {} number{} after '{}'", count, count > 1 ? "s" : "", after));
         const std::string_view w = t.next();
         double v = 0;
         const char* end = w.data() + w.size();
@@ -306,7 +310,8 @@ private:
 
 CameraPath parse_camera_path(std::string_view text, std::string_view source) {
     if (const std::size_t nul = text.find('\0'); nul != std::string_view::npos)
-        throw_at(source, 1 + static_cast<std::size_t>(std::count(text.begin(), text.begin() + nul, '\n')),
+        throw_at(source,
+                 1 + static_cast<std::size_t>(std::count(text.begin(), text.begin() + nul, '\n')),
                  "binary data (NUL byte): not a camera path file");
     std::vector<CameraKey> keys;
     std::optional<double> period;
@@ -365,34 +370,41 @@ CameraPath parse_camera_path(std::string_view text, std::string_view source) {
                     once(have_fov);
                     key.fov = static_cast<float>(p.number(t, w, 1));
                 } else {
-                    p.fail(fmt::format("unknown word '{}' in a key (expected eye, target, up or fov)", w));
+                    p.fail(fmt::format(
+                        "unknown word '{}' in a key (expected eye, target, up or fov)", w));
                 }
             }
             if (!have_eye || !have_target)
                 p.fail(fmt::format("key at {} s needs {}", key.time,
-                                   !have_eye && !have_target ? "an eye and a target"
-                                                             : (!have_eye ? "an eye" : "a target")));
+                                   !have_eye && !have_target
+                                       ? "an eye and a target"
+                                       : (!have_eye ? "an eye" : "a target")));
             up = key.up;
             fov = key.fov;
             if (keys.size() >= limits().max_camera_keys)
-                p.fail(fmt::format("more than {} camera keys (the limit)", limits().max_camera_keys));
+                p.fail(
+                    fmt::format("more than {} camera keys (the limit)", limits().max_camera_keys));
             keys.push_back(key);
         } else {
-            p.fail(fmt::format("unknown word '{}' (a line is 'key ...' or 'loop PERIOD')", directive));
+            p.fail(
+                fmt::format("unknown word '{}' (a line is 'key ...' or 'loop PERIOD')", directive));
         }
         if (!t.done()) p.fail(fmt::format("unexpected '{}' at the end of the line", t.peek()));
     }
-    if (keys.empty()) throw Error(located(source, 0, "no camera keys (lines 'key TIME eye ... target ...')"));
+    if (keys.empty())
+        throw Error(located(source, 0, "no camera keys (lines 'key TIME eye ... target ...')"));
     // Checked here too (CameraPath checks it again) to point at the loop line; unordered times
     // are left to CameraPath, which names the key.
-    const bool increasing = std::adjacent_find(keys.begin(), keys.end(), [](const auto& a, const auto& b) {
-                                return !(b.time > a.time);
-                            }) == keys.end();
+    const bool increasing =
+        std::adjacent_find(keys.begin(), keys.end(), [](const auto& a, const auto& b) {
+            return !(b.time > a.time);
+        }) == keys.end();
     if (period && increasing && !(*period > keys.back().time - keys.front().time))
         throw_at(source, loop_line,
                  fmt::format("loop period {} s must be longer than the keys' span {} s: after the "
                              "last key the path returns to the first (leave out a closing key "
-                             "equal to the first)", *period, keys.back().time - keys.front().time));
+                             "equal to the first)",
+                             *period, keys.back().time - keys.front().time));
     return CameraPath(std::move(keys), period, std::string(source));
 }
 

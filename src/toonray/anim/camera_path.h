@@ -24,12 +24,12 @@ namespace toonray {
 
 /// One keyframe.
 struct CameraKey {
-    double time = 0.0;       ///< seconds
-    Vec3f eye;               ///< camera position
-    Vec3f target;            ///< point looked at
-    Vec3f up{0, 1, 0};       ///< roughly up in the image; need not be unit or orthogonal
-    float fov = 45.0f;       ///< horizontal field of view, degrees, in (1, 179)
-    std::size_t line = 0;    ///< line in the source file, for messages (0 when built in code)
+    double time = 0.0;     ///< seconds
+    Vec3f eye;             ///< camera position
+    Vec3f target;          ///< point looked at
+    Vec3f up{0, 1, 0};     ///< roughly up in the image; need not be unit or orthogonal
+    float fov = 45.0f;     ///< horizontal field of view, degrees, in (1, 179)
+    std::size_t line = 0;  ///< line in the source file, for messages (0 when built in code)
 };
 
 /// The camera at one time, in look-at form.

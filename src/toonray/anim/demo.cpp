@@ -13,7 +13,8 @@ DemoReport run_demo(const Score& score, const CameraPath& camera_path, const Dem
     movie.output_dir = options.output_dir / "frames";
     movie.export_obj_dir.reset();
     movie.seconds = options.seconds;
-    const double seconds = options.seconds ? *options.seconds : std::max(0.0, score.duration() - movie.start);
+    const double seconds =
+        options.seconds ? *options.seconds : std::max(0.0, score.duration() - movie.start);
     const int frames = frame_count(seconds, movie.fps);
 
     // Frames from a longer earlier run would join the movie: remove them.

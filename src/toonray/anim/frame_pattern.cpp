@@ -27,14 +27,17 @@ FramePattern::FramePattern(std::string pattern) : text_(std::move(pattern)) {
         while (j < text_.size() && text_[j] >= '0' && text_[j] <= '9' && width < 100)
             width = width * 10 + (text_[j++] - '0');
         if (j >= text_.size() || text_[j] != 'd' || width > 9 || (width > 0 && !zero))
-            throw Error(fmt::format("frame pattern '{}': only %d and %0Nd (N <= 9) are supported", text_));
+            throw Error(
+                fmt::format("frame pattern '{}': only %d and %0Nd (N <= 9) are supported", text_));
         if (found) throw Error(fmt::format("frame pattern '{}': more than one %d", text_));
         found = true;
         width_ = width;
         out = &suffix_;
         i = j;
     }
-    if (!found) throw Error(fmt::format("frame pattern '{}': needs a %d or %0Nd for the frame number", text_));
+    if (!found)
+        throw Error(
+            fmt::format("frame pattern '{}': needs a %d or %0Nd for the frame number", text_));
     if (text_.find('/') != std::string::npos)
         throw Error(fmt::format("frame pattern '{}': must be a file name, not a path", text_));
 }

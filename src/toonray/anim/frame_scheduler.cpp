@@ -114,37 +114,47 @@ FramePlan plan_frame_jobs(const FrameOptions& options, int requested, std::size_
     const Limits& lim = limits();
     const RenderSettings& settings = options.settings;
     if (settings.width < 1 || settings.height < 1)
-        throw Error(fmt::format("image size {}x{}: both must be at least 1", settings.width, settings.height));
-    const std::uint64_t pixels = static_cast<std::uint64_t>(settings.width) * static_cast<std::uint64_t>(settings.height);
+        throw Error(fmt::format("image size {}x{}: both must be at least 1", settings.width,
+                                settings.height));
+    const std::uint64_t pixels =
+        static_cast<std::uint64_t>(settings.width) * static_cast<std::uint64_t>(settings.height);
     if (pixels > lim.max_image_pixels)
-        throw LimitError(Limit::ImagePixels, fmt::format("image size {}x{}: {} pixels, more than the limit of {}",
-                                                         settings.width, settings.height, pixels,
-                                                         lim.max_image_pixels));
+        throw LimitError(
+            Limit::ImagePixels,
+            fmt::format("image size {}x{}: {} pixels, more than the limit of {}", settings.width,
+                        settings.height, pixels, lim.max_image_pixels));
     FramePlan plan;
     plan.frame_bytes = frame_bytes(options);
     const std::string size = fmt::format("a {}x{} frame", settings.width, settings.height);
     check_memory(plan.frame_bytes, size);
     const int wanted = requested > 0 ? requested : hardware_threads();
-    const int most = static_cast<int>(std::max<std::size_t>(1, std::min<std::size_t>(frames, 1 << 16)));
+    const int most =
+        static_cast<int>(std::max<std::size_t>(1, std::min<std::size_t>(frames, 1 << 16)));
     plan.jobs = std::max(1, std::min(wanted, most));
     if (requested > 0) {
-        check_memory(plan.jobs * plan.frame_bytes, fmt::format("{} frames at once ({} each)", plan.jobs, size));
+        check_memory(plan.jobs * plan.frame_bytes,
+                     fmt::format("{} frames at once ({} each)", plan.jobs, size));
     } else {
         // One per core, as many as fit.
-        const std::uint64_t fit = std::max<std::uint64_t>(1, lim.max_memory / std::max<std::uint64_t>(plan.frame_bytes, 1));
-        plan.jobs = static_cast<int>(std::min<std::uint64_t>(static_cast<std::uint64_t>(plan.jobs), fit));
+        const std::uint64_t fit = std::max<std::uint64_t>(
+            1, lim.max_memory / std::max<std::uint64_t>(plan.frame_bytes, 1));
+        plan.jobs =
+            static_cast<int>(std::min<std::uint64_t>(static_cast<std::uint64_t>(plan.jobs), fit));
     }
     return plan;
 }
 
-int threads_per_frame(int requested, int jobs) { return jobs > 1 && requested == 0 ? 1 : requested; }
+int threads_per_frame(int requested, int jobs) {
+    return jobs > 1 && requested == 0 ? 1 : requested;
+}
 
-BatchReport run_frames(FrameSource& source, const std::vector<int>& frames, const ScheduleOptions& options,
-                       BatchObserver* observer) {
+BatchReport run_frames(FrameSource& source, const std::vector<int>& frames,
+                       const ScheduleOptions& options, BatchObserver* observer) {
     const auto start = std::chrono::steady_clock::now();
     Scheduler scheduler(source, frames, options, observer);
     BatchReport report = scheduler.run();
-    report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    report.seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return report;
 }
 

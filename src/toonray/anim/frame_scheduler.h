@@ -27,7 +27,7 @@ struct FrameFailure {
 struct BatchReport {
     int total = 0;  ///< frames to produce
     int rendered = 0, skipped = 0, failed = 0;
-    bool cancelled = false;  ///< stopped early: by the cancel flag or by fail-fast
+    bool cancelled = false;              ///< stopped early: by the cancel flag or by fail-fast
     std::vector<FrameFailure> failures;  ///< sorted by frame
     double seconds = 0.0;
 };
@@ -42,8 +42,8 @@ public:
 
 /// Frames rendered at once within the limits (docs/robustness.md).
 struct FramePlan {
-    int jobs = 1;                  ///< frames in flight
-    std::uint64_t frame_bytes = 0; ///< estimated memory of one frame (frame_bytes)
+    int jobs = 1;                   ///< frames in flight
+    std::uint64_t frame_bytes = 0;  ///< estimated memory of one frame (frame_bytes)
 };
 
 /// Checks the image size against limits().max_image_pixels (LimitError) and the memory of the
@@ -78,16 +78,16 @@ public:
 };
 
 struct ScheduleOptions {
-    int jobs = 1;            ///< frames produced at once
-    bool resume = false;     ///< skip frames whose output is a valid PNG
-    bool fail_fast = false;  ///< stop claiming frames after the first failure
+    int jobs = 1;                               ///< frames produced at once
+    bool resume = false;                        ///< skip frames whose output is a valid PNG
+    bool fail_fast = false;                     ///< stop claiming frames after the first failure
     const std::atomic<bool>* cancel = nullptr;  ///< set (e.g. by SIGINT) to stop cleanly
 };
 
 /// Produces `frames` from `source`. Frames that fail are reported and the rest go on (unless
 /// fail_fast); frames already claimed when the run stops are finished. Never throws for a
 /// frame's failure.
-BatchReport run_frames(FrameSource& source, const std::vector<int>& frames, const ScheduleOptions& options,
-                       BatchObserver* observer = nullptr);
+BatchReport run_frames(FrameSource& source, const std::vector<int>& frames,
+                       const ScheduleOptions& options, BatchObserver* observer = nullptr);
 
 }  // namespace toonray

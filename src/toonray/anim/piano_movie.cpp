@@ -26,8 +26,9 @@ Score load_demo_score() {
 
 CameraPath load_demo_camera_path() {
     auto bytes = demo_camera_path();
-    return parse_camera_path(std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()),
-                             "entertainer.campath (built in)");
+    return parse_camera_path(
+        std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()),
+        "entertainer.campath (built in)");
 }
 
 int frame_count(double seconds, double fps) {
@@ -43,8 +44,10 @@ int frame_count(double seconds, double fps) {
 int checked_frame_count(double seconds, double fps) {
     const int frames = frame_count(seconds, fps);
     if (static_cast<std::uint64_t>(frames) > limits().max_frames)
-        throw LimitError(Limit::Frames, fmt::format("{:.0f} s at {} fps: {}{} frames is more than the limit of {}", seconds, fps,
-                                frames == 2147483647 ? "over " : "", frames, limits().max_frames));
+        throw LimitError(
+            Limit::Frames,
+            fmt::format("{:.0f} s at {} fps: {}{} frames is more than the limit of {}", seconds,
+                        fps, frames == 2147483647 ? "over " : "", frames, limits().max_frames));
     return frames;
 }
 
@@ -54,7 +57,8 @@ void check_directory(const std::filesystem::path& dir, const char* what) {
     std::error_code ec;
     std::filesystem::create_directories(dir, ec);
     if (ec || ::access(dir.c_str(), W_OK) != 0)
-        throw Error(fmt::format("{}: {} directory cannot be created or is not writable", dir.string(), what));
+        throw Error(fmt::format("{}: {} directory cannot be created or is not writable",
+                                dir.string(), what));
 }
 
 // The piano's frames: each job poses its own copy of the piano at the frame's time and renders
@@ -62,16 +66,19 @@ void check_directory(const std::filesystem::path& dir, const char* what) {
 class PianoFrames : public FrameSource {
 public:
     PianoFrames(const Score& score, const CameraPath& path, const PianoMovieOptions& options)
-        : playback_(score), path_(path), options_(options),
+        : playback_(score),
+          path_(path),
+          options_(options),
           output_pattern_(options.name + "_%06d" + (options.export_obj_dir ? ".obj" : ".png")) {
         // The roll's hole pool holds the most slots visible at once; a score can ask for
         // millions (two triangles each). Check before building.
         const std::uint64_t holes = playback_.hole_capacity();
         if (2 * holes > limits().max_triangles)
-            throw LimitError(Limit::Triangles,
-                             fmt::format("the score puts up to {} notes on the roll's window at once: {} "
-                                         "triangles, more than the limit of {}",
-                                         holes, 2 * holes, limits().max_triangles));
+            throw LimitError(
+                Limit::Triangles,
+                fmt::format("the score puts up to {} notes on the roll's window at once: {} "
+                            "triangles, more than the limit of {}",
+                            holes, 2 * holes, limits().max_triangles));
         PianoOptions piano;
         piano.hole_capacity = std::max<std::uint32_t>(playback_.hole_capacity(), 1);
         model_ = build_piano(piano);
@@ -108,7 +115,8 @@ private:
 
 class PianoFrameJob : public FrameJob {
 public:
-    PianoFrameJob(PianoFrames& source, int jobs) : source_(source), scene_(source.scene()), render_(source.options().render) {
+    PianoFrameJob(PianoFrames& source, int jobs)
+        : source_(source), scene_(source.scene()), render_(source.options().render) {
         render_.settings.threads = threads_per_frame(render_.settings.threads, jobs);
     }
 
@@ -130,7 +138,9 @@ private:
     ObjWriter writer_;
 };
 
-std::unique_ptr<FrameJob> PianoFrames::make_job(int jobs) { return std::make_unique<PianoFrameJob>(*this, jobs); }
+std::unique_ptr<FrameJob> PianoFrames::make_job(int jobs) {
+    return std::make_unique<PianoFrameJob>(*this, jobs);
+}
 
 }  // namespace
 
@@ -138,13 +148,17 @@ PianoMovieReport render_piano_movie(const Score& score, const CameraPath& camera
                                     const PianoMovieOptions& options, BatchObserver* observer) {
     if (!(options.fps > 0.0 && options.fps <= 1000.0))
         throw Error(fmt::format("frame rate {} fps: must be in (0, 1000]", options.fps));
-    if (!(options.start >= 0.0)) throw Error(fmt::format("start time {} s: must not be negative", options.start));
+    if (!(options.start >= 0.0))
+        throw Error(fmt::format("start time {} s: must not be negative", options.start));
     if (options.name.empty() || options.name.find('/') != std::string::npos)
         throw Error(fmt::format("frame name '{}': must be a plain file name", options.name));
-    if (camera_path.empty()) throw Error(fmt::format("{}: camera path has no keys", camera_path.source()));
+    if (camera_path.empty())
+        throw Error(fmt::format("{}: camera path has no keys", camera_path.source()));
     double music_end = score.notes.empty() ? 0.0 : score.duration();
     double seconds = options.seconds ? *options.seconds : std::max(0.0, music_end - options.start);
-    if (!(seconds > 0.0)) throw Error("nothing to render: the length is zero (an empty score, or a start time past its end)");
+    if (!(seconds > 0.0))
+        throw Error(
+            "nothing to render: the length is zero (an empty score, or a start time past its end)");
     const int frames = checked_frame_count(seconds, options.fps);
     if (options.export_obj_dir) {
         check_directory(*options.export_obj_dir, "OBJ export");
@@ -159,16 +173,18 @@ PianoMovieReport render_piano_movie(const Score& score, const CameraPath& camera
     const bool exporting = options.export_obj_dir.has_value();
     FramePlan plan;
     if (exporting) {
-        plan.jobs = std::max(1, std::min(options.jobs > 0 ? options.jobs : hardware_threads(), frames));
+        plan.jobs =
+            std::max(1, std::min(options.jobs > 0 ? options.jobs : hardware_threads(), frames));
     } else {
         plan = plan_frame_jobs(options.render, options.jobs, static_cast<std::size_t>(frames));
     }
     const std::uint64_t scene = scene_bytes(piano.positions.size(), piano.triangle_count());
     if (options.jobs <= 0)  // one per core, as many as fit
-        while (plan.jobs > 1 && plan.jobs * (plan.frame_bytes + scene) > limits().max_memory) --plan.jobs;
+        while (plan.jobs > 1 && plan.jobs * (plan.frame_bytes + scene) > limits().max_memory)
+            --plan.jobs;
     check_memory(plan.jobs * (plan.frame_bytes + scene),
-                 fmt::format("{} frame{} at once of the piano ({} triangles)", plan.jobs, plan.jobs == 1 ? "" : "s",
-                             piano.triangle_count()));
+                 fmt::format("{} frame{} at once of the piano ({} triangles)", plan.jobs,
+                             plan.jobs == 1 ? "" : "s", piano.triangle_count()));
     std::vector<int> numbers(static_cast<std::size_t>(frames));
     for (int i = 0; i < frames; ++i) numbers[static_cast<std::size_t>(i)] = i + 1;
     ScheduleOptions schedule;

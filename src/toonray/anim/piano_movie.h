@@ -28,23 +28,23 @@ Score load_demo_score();
 CameraPath load_demo_camera_path();
 
 struct PianoMovieOptions {
-    double start = 0.0;               ///< score time of frame 1, seconds
-    std::optional<double> seconds;    ///< length; default: to the end of the music
+    double start = 0.0;             ///< score time of frame 1, seconds
+    std::optional<double> seconds;  ///< length; default: to the end of the music
     double fps = 24.0;
-    std::string name = "keys";        ///< frames are NAME_NNNNNN.png (or .obj)
-    std::filesystem::path output_dir; ///< PNG frames go here
+    std::string name = "keys";         ///< frames are NAME_NNNNNN.png (or .obj)
+    std::filesystem::path output_dir;  ///< PNG frames go here
     /// Write OBJ + MTL frames here instead of rendering PNGs.
     std::optional<std::filesystem::path> export_obj_dir;
-    FrameOptions render;              ///< size, lines, AOVs, PNG level; camera comes from the path
-    int jobs = 0;                     ///< frames at once; 0 = one per core
-    bool resume = false;              ///< skip frames whose PNG is already valid
+    FrameOptions render;  ///< size, lines, AOVs, PNG level; camera comes from the path
+    int jobs = 0;         ///< frames at once; 0 = one per core
+    bool resume = false;  ///< skip frames whose PNG is already valid
     const std::atomic<bool>* cancel = nullptr;
 };
 
 struct PianoMovieReport {
-    BatchReport batch;         ///< frames rendered / skipped / failed, time
+    BatchReport batch;  ///< frames rendered / skipped / failed, time
     int frame_count = 0;
-    std::size_t triangles = 0; ///< of the posed scene (piano and floor)
+    std::size_t triangles = 0;        ///< of the posed scene (piano and floor)
     std::uint32_t dropped_holes = 0;  ///< roll slots left out because the hole pool was full
 };
 
@@ -59,6 +59,7 @@ int checked_frame_count(double seconds, double fps);
 /// Renders (or exports) the frames. Throws Error for whole-run problems (bad options, an
 /// unwritable directory); per-frame failures are counted in the report.
 PianoMovieReport render_piano_movie(const Score& score, const CameraPath& camera_path,
-                                    const PianoMovieOptions& options, BatchObserver* observer = nullptr);
+                                    const PianoMovieOptions& options,
+                                    BatchObserver* observer = nullptr);
 
 }  // namespace toonray

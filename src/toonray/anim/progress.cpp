@@ -7,9 +7,12 @@
 namespace toonray {
 
 ProgressReporter::ProgressReporter(int total, std::FILE* out, bool quiet, int interactive)
-    : total_(total), out_(out), quiet_(quiet),
+    : total_(total),
+      out_(out),
+      quiet_(quiet),
       interactive_(interactive >= 0 ? interactive != 0 : ::isatty(::fileno(out)) != 0),
-      start_(std::chrono::steady_clock::now()), last_draw_(start_) {}
+      start_(std::chrono::steady_clock::now()),
+      last_draw_(start_) {}
 
 std::string ProgressReporter::format_duration(double seconds) {
     if (!(seconds >= 0) || seconds > 1e7) return "?";
@@ -69,14 +72,16 @@ void ProgressReporter::finish(const BatchReport& report) {
     clear_bar();
     double fps = report.seconds > 0 ? (report.rendered) / report.seconds : 0.0;
     if (!quiet_ || report.failed > 0 || report.cancelled)
-        fmt::print(out_, "toonray: {} rendered, {} skipped, {} failed of {} frames in {} ({:.1f} fps){}\n",
-                   report.rendered, report.skipped, report.failed, report.total,
-                   format_duration(report.seconds), fps, report.cancelled ? "; stopped early" : "");
+        fmt::print(
+            out_, "toonray: {} rendered, {} skipped, {} failed of {} frames in {} ({:.1f} fps){}\n",
+            report.rendered, report.skipped, report.failed, report.total,
+            format_duration(report.seconds), fps, report.cancelled ? "; stopped early" : "");
     if (report.failed > 0) {
         std::string list;
         for (std::size_t i = 0; i < report.failures.size() && i < 20; ++i)
             list += fmt::format("{}{}", i ? " " : "", report.failures[i].frame);
-        fmt::print(out_, "toonray: failed frames: {}{}\n", list, report.failures.size() > 20 ? " ..." : "");
+        fmt::print(out_, "toonray: failed frames: {}{}\n", list,
+                   report.failures.size() > 20 ? " ..." : "");
     }
     std::fflush(out_);
 }

@@ -11,8 +11,14 @@ struct BBox {
     Vec3f lo{std::numeric_limits<float>::infinity()};
     Vec3f hi{-std::numeric_limits<float>::infinity()};
 
-    void extend(const Vec3f& p) { lo = min(lo, p); hi = max(hi, p); }
-    void extend(const BBox& b) { lo = min(lo, b.lo); hi = max(hi, b.hi); }
+    void extend(const Vec3f& p) {
+        lo = min(lo, p);
+        hi = max(hi, p);
+    }
+    void extend(const BBox& b) {
+        lo = min(lo, b.lo);
+        hi = max(hi, b.hi);
+    }
     [[nodiscard]] bool empty() const { return lo.x > hi.x || lo.y > hi.y || lo.z > hi.z; }
     [[nodiscard]] Vec3f extent() const { return hi - lo; }
     [[nodiscard]] Vec3f center() const { return (lo + hi) * 0.5f; }

@@ -18,7 +18,17 @@ public:
 
 /// The limits of core/limits.h that an input can exceed. Each front end has its own way to raise
 /// one (the CLI's --max-* options), so the library names the limit and the front end adds how.
-enum class Limit { InputBytes, LineBytes, Vertices, Triangles, ImagePixels, Memory, Frames, CameraKeys, Notes };
+enum class Limit {
+    InputBytes,
+    LineBytes,
+    Vertices,
+    Triangles,
+    ImagePixels,
+    Memory,
+    Frames,
+    CameraKeys,
+    Notes
+};
 
 /// An input asked for more than a limit allows. The message says what and by how much, never
 /// how to raise the limit: that is the front end's to say (see Limit).

@@ -23,29 +23,31 @@ Limits& process_limits() {
 std::uint64_t parse_scaled(std::string_view text, double base, bool bytes) {
     const std::string_view original = text;
     auto bad = [&]() -> std::uint64_t {
-        throw Error(fmt::format("expected a positive {} such as {}, got '{}'", bytes ? "size" : "number",
-                                bytes ? "512M or 8G" : "50000000 or 50M", original));
+        throw Error(fmt::format("expected a positive {} such as {}, got '{}'",
+                                bytes ? "size" : "number", bytes ? "512M or 8G" : "50000000 or 50M",
+                                original));
     };
     double value = 0;
     auto [p, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
     if (ec != std::errc() || !std::isfinite(value) || value <= 0) return bad();
     std::string_view suffix(p, static_cast<std::size_t>(text.data() + text.size() - p));
     if (bytes) {
-        if (suffix.ends_with("iB"))
-            suffix.remove_suffix(2);
-        else if (suffix.ends_with("B") && suffix.size() > 1)
-            suffix.remove_suffix(1);
-        else if (suffix == "B")
-            suffix = {};
+        if (suffix.ends_with("iB")) suffix.remove_suffix(2);
+        else if (suffix.ends_with("B") && suffix.size() > 1) suffix.remove_suffix(1);
+        else if (suffix == "B") suffix = {};
     }
     double scale = 1;
     if (suffix.size() > 1) return bad();
     if (suffix.size() == 1) {
         switch (suffix[0]) {
-            case 'k': case 'K': scale = base; break;
-            case 'm': case 'M': scale = base * base; break;
-            case 'g': case 'G': scale = base * base * base; break;
-            case 't': case 'T': scale = base * base * base * base; break;
+            case 'k':
+            case 'K': scale = base; break;
+            case 'm':
+            case 'M': scale = base * base; break;
+            case 'g':
+            case 'G': scale = base * base * base; break;
+            case 't':
+            case 'T': scale = base * base * base * base; break;
             default: return bad();
         }
     }
@@ -61,7 +63,8 @@ std::uint64_t Limits::default_max_memory() {
     const long pages = ::sysconf(_SC_PHYS_PAGES);
     const long page_size = ::sysconf(_SC_PAGE_SIZE);
     if (pages <= 0 || page_size <= 0) return 8 * kGiB;
-    return mul_saturated(static_cast<std::uint64_t>(pages), static_cast<std::uint64_t>(page_size)) / 4 * 3;
+    return mul_saturated(static_cast<std::uint64_t>(pages), static_cast<std::uint64_t>(page_size)) /
+           4 * 3;
 }
 
 const Limits& limits() { return process_limits(); }
@@ -71,8 +74,9 @@ void set_limits(const Limits& limits) { process_limits() = limits; }
 void check_memory(std::uint64_t bytes, std::string_view what) {
     const std::uint64_t limit = limits().max_memory;
     if (bytes <= limit) return;
-    throw LimitError(Limit::Memory, fmt::format("{} needs about {} of memory, more than the limit of {}", what,
-                                                format_bytes(bytes), format_bytes(limit)));
+    throw LimitError(Limit::Memory,
+                     fmt::format("{} needs about {} of memory, more than the limit of {}", what,
+                                 format_bytes(bytes), format_bytes(limit)));
 }
 
 std::string format_bytes(std::uint64_t bytes) {

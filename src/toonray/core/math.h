@@ -21,9 +21,24 @@ struct Vec3f {
     constexpr float operator[](int i) const { return i == 0 ? x : (i == 1 ? y : z); }
     constexpr float& operator[](int i) { return i == 0 ? x : (i == 1 ? y : z); }
     constexpr Vec3f operator-() const { return {-x, -y, -z}; }
-    constexpr Vec3f& operator+=(const Vec3f& o) { x += o.x; y += o.y; z += o.z; return *this; }
-    constexpr Vec3f& operator-=(const Vec3f& o) { x -= o.x; y -= o.y; z -= o.z; return *this; }
-    constexpr Vec3f& operator*=(float s) { x *= s; y *= s; z *= s; return *this; }
+    constexpr Vec3f& operator+=(const Vec3f& o) {
+        x += o.x;
+        y += o.y;
+        z += o.z;
+        return *this;
+    }
+    constexpr Vec3f& operator-=(const Vec3f& o) {
+        x -= o.x;
+        y -= o.y;
+        z -= o.z;
+        return *this;
+    }
+    constexpr Vec3f& operator*=(float s) {
+        x *= s;
+        y *= s;
+        z *= s;
+        return *this;
+    }
     constexpr bool operator==(const Vec3f&) const = default;
 };
 
@@ -31,7 +46,9 @@ constexpr Vec3f operator+(Vec3f a, const Vec3f& b) { return a += b; }
 constexpr Vec3f operator-(Vec3f a, const Vec3f& b) { return a -= b; }
 constexpr Vec3f operator*(Vec3f a, float s) { return a *= s; }
 constexpr Vec3f operator*(float s, Vec3f a) { return a *= s; }
-constexpr Vec3f operator*(const Vec3f& a, const Vec3f& b) { return {a.x * b.x, a.y * b.y, a.z * b.z}; }
+constexpr Vec3f operator*(const Vec3f& a, const Vec3f& b) {
+    return {a.x * b.x, a.y * b.y, a.z * b.z};
+}
 constexpr Vec3f operator/(const Vec3f& a, float s) { return {a.x / s, a.y / s, a.z / s}; }
 
 constexpr float dot(const Vec3f& a, const Vec3f& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }

@@ -42,7 +42,8 @@ ImageSize parse_image_size(std::string_view text, std::string_view option) {
     if (ec2 != std::errc() || last != end)
         throw Error(fmt::format("{}: expected WIDTHxHEIGHT, got '{}'", option, text));
     if (size.width < 1 || size.height < 1 || size.width > 32768 || size.height > 32768)
-        throw Error(fmt::format("{}: {}x{} is outside 1x1 to 32768x32768", option, size.width, size.height));
+        throw Error(fmt::format("{}: {}x{} is outside 1x1 to 32768x32768", option, size.width,
+                                size.height));
     return size;
 }
 
@@ -58,12 +59,14 @@ Vec3f parse_colour(std::string_view text, std::string_view option) {
         auto [p, ec] = std::from_chars(text.data() + 1, text.data() + text.size(), value, 16);
         if (text.size() != 7 || ec != std::errc() || p != text.data() + text.size())
             throw Error(fmt::format("{}: expected #rrggbb, got '{}'", option, text));
-        return {((value >> 16) & 255) / 255.0f, ((value >> 8) & 255) / 255.0f, (value & 255) / 255.0f};
+        return {((value >> 16) & 255) / 255.0f, ((value >> 8) & 255) / 255.0f,
+                (value & 255) / 255.0f};
     }
     Vec3f c = parse_vec3(text, option);
     for (int i = 0; i < 3; ++i)
         if (c[i] < 0.0f || c[i] > 1.0f)
-            throw Error(fmt::format("{}: colour components must be in [0, 1], got '{}'", option, text));
+            throw Error(
+                fmt::format("{}: colour components must be in [0, 1], got '{}'", option, text));
     return c;
 }
 

@@ -109,9 +109,9 @@ double exp(double x) {
     const double ax = std::fabs(x);
     if (ax > 0.5 * 0.6931471805599453) {
         if (ax >= 1.5 * 0.6931471805599453)
-            k = static_cast<int>(inv_ln2 * x + (x < 0 ? -0.5 : 0.5));  // truncation: round half away
-        else
-            k = x < 0 ? -1 : 1;
+            k = static_cast<int>(inv_ln2 * x +
+                                 (x < 0 ? -0.5 : 0.5));  // truncation: round half away
+        else k = x < 0 ? -1 : 1;
         hi = x - k * ln2_hi;  // exact: k ln2_hi has few bits
         lo = k * ln2_lo;
         x = hi - lo;

@@ -20,7 +20,8 @@
 namespace toonray {
 
 struct FrameOptions {
-    RenderSettings settings;  ///< settings.feature_images is set from aov_dir, hidden_lines from svg
+    RenderSettings
+        settings;  ///< settings.feature_images is set from aov_dir, hidden_lines from svg
     std::optional<CameraSpec> camera;              ///< overrides the scene's camera block
     std::optional<std::filesystem::path> aov_dir;  ///< write the feature images here
     /// Ink lines only: also write the strokes as SVG here (ink/svg.h), with hidden lines in a
@@ -38,8 +39,8 @@ struct FrameOptions {
 CameraSpec choose_camera(const Scene& scene, const FrameOptions& options);
 
 /// The feature image file for an output and a feature name: `<dir>/<stem>_<name>.png`.
-std::filesystem::path aov_path(const std::filesystem::path& dir, const std::filesystem::path& output,
-                               std::string_view name);
+std::filesystem::path aov_path(const std::filesystem::path& dir,
+                               const std::filesystem::path& output, std::string_view name);
 
 /// Memory of one frame in flight: the renderer's buffers (frame_buffer_bytes), the PNG encoding
 /// of the largest image written (filtered rows, the compressed bound and the file's bytes, and

@@ -23,7 +23,8 @@ const TextureSet& TextureCache::load(const Scene& scene, Warnings& warnings) {
             textures_[m] = image;
         } catch (const Error& e) {
             failed_[path] = true;
-            warnings.push_back(fmt::format("material '{}': texture not used: {}", scene.materials[m].name, e.what()));
+            warnings.push_back(fmt::format("material '{}': texture not used: {}",
+                                           scene.materials[m].name, e.what()));
         }
     }
     return textures_;

@@ -16,13 +16,15 @@ std::vector<T> gather_chunks(int count, int chunk, int threads, const Body& body
     const int chunks = count <= 0 ? 0 : (count + chunk - 1) / chunk;
     std::vector<std::vector<T>> parts(static_cast<std::size_t>(chunks));
     parallel_for(chunks, 1, threads, [&](int c0, int c1) {
-        for (int c = c0; c < c1; ++c) body(c * chunk, std::min(count, (c + 1) * chunk), parts[static_cast<std::size_t>(c)]);
+        for (int c = c0; c < c1; ++c)
+            body(c * chunk, std::min(count, (c + 1) * chunk), parts[static_cast<std::size_t>(c)]);
     });
     std::size_t total = 0;
     for (const auto& p : parts) total += p.size();
     std::vector<T> out;
     out.reserve(total);
-    for (auto& p : parts) out.insert(out.end(), std::make_move_iterator(p.begin()), std::make_move_iterator(p.end()));
+    for (auto& p : parts)
+        out.insert(out.end(), std::make_move_iterator(p.begin()), std::make_move_iterator(p.end()));
     return out;
 }
 

@@ -16,11 +16,15 @@ struct Segment2 {
     int x0, x1, y0, y1;  // pixels whose centres may be covered, inclusive, clamped to the image
 };
 
-std::uint8_t to_byte(float v) { return static_cast<std::uint8_t>(std::min(std::max(v, 0.0f), 1.0f) * 255.0f + 0.5f); }
+std::uint8_t to_byte(float v) {
+    return static_cast<std::uint8_t>(std::min(std::max(v, 0.0f), 1.0f) * 255.0f + 0.5f);
+}
 
 }  // namespace
 
-float stroke_thickness(float width, int height) { return width * static_cast<float>(height) / 720.0f; }
+float stroke_thickness(float width, int height) {
+    return width * static_cast<float>(height) / 720.0f;
+}
 
 void draw_strokes(std::span<const Stroke> strokes, float thickness, ImageF& coverage, int threads) {
     const int w = coverage.width(), h = coverage.height();
@@ -34,8 +38,11 @@ void draw_strokes(std::span<const Stroke> strokes, float thickness, ImageF& cove
             // Pixel x has its centre at x + 0.5; it can be covered if within reach of the box.
             const float lx = std::min(a.x, b.x) - reach, hx = std::max(a.x, b.x) + reach;
             const float ly = std::min(a.y, b.y) - reach, hy = std::max(a.y, b.y) + reach;
-            if (!(hx >= 0.5f && lx <= w - 0.5f && hy >= 0.5f && ly <= h - 0.5f)) continue;  // also NaN
-            Segment2 seg{a, b, std::max(0, static_cast<int>(std::ceil(lx - 0.5f))),
+            if (!(hx >= 0.5f && lx <= w - 0.5f && hy >= 0.5f && ly <= h - 0.5f))
+                continue;  // also NaN
+            Segment2 seg{a,
+                         b,
+                         std::max(0, static_cast<int>(std::ceil(lx - 0.5f))),
                          std::min(w - 1, static_cast<int>(std::floor(hx - 0.5f))),
                          std::max(0, static_cast<int>(std::ceil(ly - 0.5f))),
                          std::min(h - 1, static_cast<int>(std::floor(hy - 0.5f)))};
@@ -79,14 +86,16 @@ void composite_lines(const ImageF& coverage, const Vec3f& colour, ImageRgb8& ima
             const float a = cov[x];
             if (!(a > 0.0f)) continue;
             for (int c = 0; c < 3; ++c)
-                px[x][c] = to_byte(static_cast<float>(px[x][c]) * (1.0f / 255.0f) * (1.0f - a) + colour[c] * a);
+                px[x][c] = to_byte(static_cast<float>(px[x][c]) * (1.0f / 255.0f) * (1.0f - a) +
+                                   colour[c] * a);
         }
     }
 }
 
 void coverage_to_gray(const ImageF& coverage, ImageGray8& out) {
     out.reshape(coverage.width(), coverage.height());
-    for (std::size_t i = 0; i < coverage.size(); ++i) out.data()[i] = to_byte(1.0f - coverage.data()[i]);
+    for (std::size_t i = 0; i < coverage.size(); ++i)
+        out.data()[i] = to_byte(1.0f - coverage.data()[i]);
 }
 
 }  // namespace toonray::ink

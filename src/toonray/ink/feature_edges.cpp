@@ -36,7 +36,8 @@ bool position_less(const Vec3f& a, const Vec3f& b) {
 // Unit geometric normal (p1 - p0) x (p2 - p0), or zero for a degenerate triangle.
 Vec3f face_normal(const Scene& scene, std::size_t t) {
     const auto& v = scene.tri_positions[t];
-    const Vec3f n = cross(scene.positions[v[1]] - scene.positions[v[0]], scene.positions[v[2]] - scene.positions[v[0]]);
+    const Vec3f n = cross(scene.positions[v[1]] - scene.positions[v[0]],
+                          scene.positions[v[2]] - scene.positions[v[0]]);
     const float len = length(n);
     if (!(len > 0.0f) || !std::isfinite(len)) return Vec3f(0.0f);
     return n / len;
@@ -69,12 +70,14 @@ WeldedMesh weld_vertices(const Scene& scene) {
         return std::tuple_cat(bits(a), std::tuple(a)) < std::tuple_cat(bits(b), std::tuple(b));
     });
     for (std::size_t i = 0; i < order.size(); ++i)
-        canonical[order[i]] = i > 0 && bits(order[i]) == bits(order[i - 1]) ? canonical[order[i - 1]] : order[i];
+        canonical[order[i]] =
+            i > 0 && bits(order[i]) == bits(order[i - 1]) ? canonical[order[i - 1]] : order[i];
     // Welded ids in order of first use by the triangles: one per (object, canonical position).
     // Most positions belong to one object; the few shared by several look the rest up.
     WeldedMesh mesh;
     mesh.tri_vertices.resize(n);
-    std::vector<std::uint32_t> id_of(scene.positions.size(), kNoIndex), object_of(scene.positions.size());
+    std::vector<std::uint32_t> id_of(scene.positions.size(), kNoIndex),
+        object_of(scene.positions.size());
     std::map<std::pair<std::uint32_t, std::uint32_t>, std::uint32_t> shared;
     auto new_id = [&](std::uint32_t c) {
         mesh.vertex_position.push_back(c);
@@ -82,7 +85,8 @@ WeldedMesh weld_vertices(const Scene& scene) {
     };
     for (std::size_t t = 0; t < n; ++t)
         for (int k = 0; k < 3; ++k) {
-            const std::uint32_t c = canonical[scene.tri_positions[t][k]], object = scene.tri_object[t];
+            const std::uint32_t c = canonical[scene.tri_positions[t][k]],
+                                object = scene.tri_object[t];
             std::uint32_t& id = mesh.tri_vertices[t][k];
             if (id_of[c] == kNoIndex) {
                 id = id_of[c] = new_id(c);
@@ -107,16 +111,20 @@ WeldedMesh weld_vertices(const Scene& scene) {
     for (std::size_t t = 0; t < n; ++t)
         for (int k = 0; k < 3; ++k)
             if (distinct(t, k)) ++mesh.ring_offsets[mesh.tri_vertices[t][k] + 1];
-    for (std::size_t v = 0; v < mesh.vertex_count(); ++v) mesh.ring_offsets[v + 1] += mesh.ring_offsets[v];
+    for (std::size_t v = 0; v < mesh.vertex_count(); ++v)
+        mesh.ring_offsets[v + 1] += mesh.ring_offsets[v];
     mesh.ring_triangles.resize(mesh.ring_offsets.back());
     std::vector<std::uint32_t> fill(mesh.ring_offsets.begin(), mesh.ring_offsets.end() - 1);
     for (std::size_t t = 0; t < n; ++t)
         for (int k = 0; k < 3; ++k)
-            if (distinct(t, k)) mesh.ring_triangles[fill[mesh.tri_vertices[t][k]]++] = static_cast<std::uint32_t>(t);
+            if (distinct(t, k))
+                mesh.ring_triangles[fill[mesh.tri_vertices[t][k]]++] =
+                    static_cast<std::uint32_t>(t);
     return mesh;
 }
 
-bool intersect_triangles(const std::array<Vec3f, 3>& a, const std::array<Vec3f, 3>& b, TriangleCrossing& out) {
+bool intersect_triangles(const std::array<Vec3f, 3>& a, const std::array<Vec3f, 3>& b,
+                         TriangleCrossing& out) {
     const Vec3f na = cross(a[1] - a[0], a[2] - a[0]);
     const Vec3f nb = cross(b[1] - b[0], b[2] - b[0]);
     float da[3], db[3];
@@ -169,8 +177,9 @@ bool intersect_triangles(const std::array<Vec3f, 3>& a, const std::array<Vec3f, 
     return true;
 }
 
-std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedMesh& mesh, const Bvh& bvh,
-                                               const Vec3f& eye, const FeatureEdgeSettings& settings, int threads) {
+std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedMesh& mesh,
+                                               const Bvh& bvh, const Vec3f& eye,
+                                               const FeatureEdgeSettings& settings, int threads) {
     const std::size_t n = scene.triangle_count();
     std::vector<Vec3f> normal(n);
     for (std::size_t t = 0; t < n; ++t) normal[t] = face_normal(scene, t);
@@ -192,12 +201,15 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
         for (int k = 0; k < 3; ++k) {
             const std::uint32_t u = w[k], v = w[(k + 1) % 3];
             if (u == v) continue;
-            sides.push_back({std::min(u, v), std::max(u, v), static_cast<std::uint32_t>(t), u < v, k});
+            sides.push_back(
+                {std::min(u, v), std::max(u, v), static_cast<std::uint32_t>(t), u < v, k});
         }
     }
-    std::sort(sides.begin(), sides.end(),
-              [](const Side& a, const Side& b) { return std::tie(a.lo, a.hi, a.tri) < std::tie(b.lo, b.hi, b.tri); });
-    const float cos_crease = portable::cos(settings.crease_angle * std::numbers::pi_v<float> / 180.0f);
+    std::sort(sides.begin(), sides.end(), [](const Side& a, const Side& b) {
+        return std::tie(a.lo, a.hi, a.tri) < std::tie(b.lo, b.hi, b.tri);
+    });
+    const float cos_crease =
+        portable::cos(settings.crease_angle * std::numbers::pi_v<float> / 180.0f);
     // Shading is smooth across a side shared by two triangles when both have a normal at every
     // corner and the same normals at the side's two ends.
     auto corner_normal = [&](std::uint32_t t, std::uint32_t welded) {
@@ -215,7 +227,8 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
     // volume, and not around the eye. A line of sight from such a line into the eye starts
     // inside the solid, so it must leave it through the surface on the way.
     std::size_t objects = scene.objects.size();
-    for (std::size_t t = 0; t < n; ++t) objects = std::max<std::size_t>(objects, scene.tri_object[t] + std::size_t{1});
+    for (std::size_t t = 0; t < n; ++t)
+        objects = std::max<std::size_t>(objects, scene.tri_object[t] + std::size_t{1});
     std::vector<std::uint8_t> closed(objects, 1);
     std::vector<double> volume(objects, 0.0);
     std::vector<BBox> object_box(objects);
@@ -235,12 +248,14 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
         i = j;
     }
     auto eye_outside = [&](const BBox& b) {
-        return eye.x < b.lo.x || eye.y < b.lo.y || eye.z < b.lo.z || eye.x > b.hi.x || eye.y > b.hi.y || eye.z > b.hi.z;
+        return eye.x < b.lo.x || eye.y < b.lo.y || eye.z < b.lo.z || eye.x > b.hi.x ||
+               eye.y > b.hi.y || eye.z > b.hi.z;
     };
     // +1: outward normals are the geometric ones; -1: the object is wound inside out; 0: unknown.
     std::vector<int> outward(objects, 0);
     for (std::size_t o = 0; o < objects; ++o)
-        if (closed[o] && volume[o] != 0.0 && eye_outside(object_box[o])) outward[o] = volume[o] > 0.0 ? 1 : -1;
+        if (closed[o] && volume[o] != 0.0 && eye_outside(object_box[o]))
+            outward[o] = volume[o] > 0.0 ? 1 : -1;
 
     for (std::size_t i = 0; i < sides.size();) {
         std::size_t j = i + 1;
@@ -272,7 +287,8 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
             } else if (settings.creases && dot(n0, n1) < cos_crease) {
                 seg.type = EdgeType::Crease;
                 emit = true;
-            } else if (settings.materials && scene.tri_material[s0.tri] != scene.tri_material[s1.tri]) {
+            } else if (settings.materials &&
+                       scene.tri_material[s0.tri] != scene.tri_material[s1.tri]) {
                 seg.type = EdgeType::Material;
                 emit = true;
             }
@@ -323,10 +339,11 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
         // Each corner's canonical position (equal for equal coordinates, across objects).
         std::vector<std::array<std::uint32_t, 3>> tri_position(n);
         for (std::size_t t = 0; t < n; ++t)
-            for (int k = 0; k < 3; ++k) tri_position[t][k] = mesh.vertex_position[mesh.tri_vertices[t][k]];
+            for (int k = 0; k < 3; ++k)
+                tri_position[t][k] = mesh.vertex_position[mesh.tri_vertices[t][k]];
         auto overlap = [](const BBox& a, const BBox& b) {
-            return !(a.lo.x > b.hi.x || a.hi.x < b.lo.x || a.lo.y > b.hi.y || a.hi.y < b.lo.y || a.lo.z > b.hi.z ||
-                     a.hi.z < b.lo.z);
+            return !(a.lo.x > b.hi.x || a.hi.x < b.lo.x || a.lo.y > b.hi.y || a.hi.y < b.lo.y ||
+                     a.lo.z > b.hi.z || a.hi.z < b.lo.z);
         };
         // One BVH query per leaf, with the leaf's box: its triangles are near each other, so
         // they share most candidates. Each pair is tested once, from its lower triangle, and
@@ -334,60 +351,66 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
         std::vector<std::uint32_t> leaves;
         for (std::size_t i = 0; i < bvh.nodes.size(); ++i)
             if (bvh.nodes[i].is_leaf()) leaves.push_back(static_cast<std::uint32_t>(i));
-        auto found = gather_chunks<FeatureSegment>(static_cast<int>(leaves.size()), 16, threads,
-                                                   [&](int l0, int l1, std::vector<FeatureSegment>& out) {
-            std::vector<std::uint32_t> stack, near;
-            for (int l = l0; l < l1; ++l) {
-                const BvhNode& leaf = bvh.nodes[leaves[static_cast<std::size_t>(l)]];
-                near.clear();
-                stack.assign(1, 0);
-                while (!stack.empty()) {
-                    const BvhNode& node = bvh.nodes[stack.back()];
-                    stack.pop_back();
-                    if (!overlap(node.bounds, leaf.bounds)) continue;
-                    if (node.is_leaf()) {
-                        near.insert(near.end(), bvh.prim_indices.begin() + node.first,
-                                    bvh.prim_indices.begin() + node.first + node.count);
-                    } else {
-                        stack.push_back(node.first);
-                        stack.push_back(node.first + 1);
-                    }
-                }
-                for (std::uint32_t i = leaf.first; i < leaf.first + leaf.count; ++i) {
-                    const std::uint32_t t = bvh.prim_indices[i];
-                    if (!usable(t)) continue;
-                    const auto a = corners(scene, t);
-                    const BBox& box = boxes[t];
-                    for (std::uint32_t u : near) {
-                        if (u <= t || !overlap(boxes[u], box) || !usable(u)) continue;
-                        // Triangles sharing a corner position (in any object) touch there: no line.
-                        const auto& pa = tri_position[t];
-                        const auto& pb = tri_position[u];
-                        bool shared = false;
-                        for (std::uint32_t a_corner : pa) shared = shared || a_corner == pb[0] || a_corner == pb[1] || a_corner == pb[2];
-                        if (shared) continue;
-                        const auto b = corners(scene, u);
-                        TriangleCrossing c;
-                        if (!intersect_triangles(a, b, c)) continue;
-                        FeatureSegment seg;
-                        seg.type = EdgeType::Intersection;
-                        seg.p0 = c.p[0];
-                        seg.p1 = c.p[1];
-                        seg.faces = {t, u};
-                        for (int e = 0; e < 2; ++e) {
-                            const std::uint32_t on = c.on_b[e] ? u : t, other = c.on_b[e] ? t : u;
-                            std::uint32_t w0 = mesh.tri_vertices[on][c.edge[e][0]], w1 = mesh.tri_vertices[on][c.edge[e][1]];
-                            if (w1 < w0) std::swap(w0, w1);
-                            (e == 0 ? seg.key0 : seg.key1) = {w0, w1, other};
+        auto found = gather_chunks<FeatureSegment>(
+            static_cast<int>(leaves.size()), 16, threads,
+            [&](int l0, int l1, std::vector<FeatureSegment>& out) {
+                std::vector<std::uint32_t> stack, near;
+                for (int l = l0; l < l1; ++l) {
+                    const BvhNode& leaf = bvh.nodes[leaves[static_cast<std::size_t>(l)]];
+                    near.clear();
+                    stack.assign(1, 0);
+                    while (!stack.empty()) {
+                        const BvhNode& node = bvh.nodes[stack.back()];
+                        stack.pop_back();
+                        if (!overlap(node.bounds, leaf.bounds)) continue;
+                        if (node.is_leaf()) {
+                            near.insert(near.end(), bvh.prim_indices.begin() + node.first,
+                                        bvh.prim_indices.begin() + node.first + node.count);
+                        } else {
+                            stack.push_back(node.first);
+                            stack.push_back(node.first + 1);
                         }
-                        out.push_back(seg);
+                    }
+                    for (std::uint32_t i = leaf.first; i < leaf.first + leaf.count; ++i) {
+                        const std::uint32_t t = bvh.prim_indices[i];
+                        if (!usable(t)) continue;
+                        const auto a = corners(scene, t);
+                        const BBox& box = boxes[t];
+                        for (std::uint32_t u : near) {
+                            if (u <= t || !overlap(boxes[u], box) || !usable(u)) continue;
+                            // Triangles sharing a corner position (in any object) touch there: no line.
+                            const auto& pa = tri_position[t];
+                            const auto& pb = tri_position[u];
+                            bool shared = false;
+                            for (std::uint32_t a_corner : pa)
+                                shared = shared || a_corner == pb[0] || a_corner == pb[1] ||
+                                         a_corner == pb[2];
+                            if (shared) continue;
+                            const auto b = corners(scene, u);
+                            TriangleCrossing c;
+                            if (!intersect_triangles(a, b, c)) continue;
+                            FeatureSegment seg;
+                            seg.type = EdgeType::Intersection;
+                            seg.p0 = c.p[0];
+                            seg.p1 = c.p[1];
+                            seg.faces = {t, u};
+                            for (int e = 0; e < 2; ++e) {
+                                const std::uint32_t on = c.on_b[e] ? u : t,
+                                                    other = c.on_b[e] ? t : u;
+                                std::uint32_t w0 = mesh.tri_vertices[on][c.edge[e][0]],
+                                              w1 = mesh.tri_vertices[on][c.edge[e][1]];
+                                if (w1 < w0) std::swap(w0, w1);
+                                (e == 0 ? seg.key0 : seg.key1) = {w0, w1, other};
+                            }
+                            out.push_back(seg);
+                        }
                     }
                 }
-            }
-        });
+            });
         // In the order of the triangle pairs, whatever the tree.
-        std::sort(found.begin(), found.end(),
-                  [](const FeatureSegment& x, const FeatureSegment& y) { return x.faces < y.faces; });
+        std::sort(found.begin(), found.end(), [](const FeatureSegment& x, const FeatureSegment& y) {
+            return x.faces < y.faces;
+        });
         segments.insert(segments.end(), found.begin(), found.end());
     }
     return segments;

@@ -83,9 +83,11 @@ struct WeldedMesh {
 /// vertex pair, then smooth contours by triangle, then intersection lines by triangle pair),
 /// whatever the thread count. `bvh` is a BVH over the scene's triangles (TriangleAccel::bvh())
 /// for the intersection lines.
-[[nodiscard]] std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedMesh& mesh,
-                                                             const Bvh& bvh, const Vec3f& eye,
-                                                             const FeatureEdgeSettings& settings, int threads);
+[[nodiscard]] std::vector<FeatureSegment> find_feature_edges(const Scene& scene,
+                                                             const WeldedMesh& mesh, const Bvh& bvh,
+                                                             const Vec3f& eye,
+                                                             const FeatureEdgeSettings& settings,
+                                                             int threads);
 
 /// The segment where triangles (a0, a1, a2) and (b0, b1, b2) cross, if they do properly (each
 /// has corners strictly on both sides of the other's plane; coplanar or touching pairs give

@@ -13,20 +13,24 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
 
 }  // namespace
 
-void draw_ink_lines(const Scene& scene, const TriangleAccel& accel, const CameraSpec& camera, int width, int height,
-                    const InkSettings& settings, int threads, InkLines& out) {
+void draw_ink_lines(const Scene& scene, const TriangleAccel& accel, const CameraSpec& camera,
+                    int width, int height, const InkSettings& settings, int threads,
+                    InkLines& out) {
     const ViewPlane plane = make_view_plane(camera, width, height);
     const ScreenProjection view(plane, width, height);
 
     auto start = std::chrono::steady_clock::now();
     out.mesh = weld_vertices(scene);
-    out.segments = find_feature_edges(scene, out.mesh, accel.bvh(), plane.eye, settings.edges, threads);
+    out.segments =
+        find_feature_edges(scene, out.mesh, accel.bvh(), plane.eye, settings.edges, threads);
     out.timings.edges = seconds_since(start);
 
     start = std::chrono::steady_clock::now();
     VisibilitySettings visibility = settings.visibility;
-    if (!settings.chain.hidden) visibility.max_invisibility = std::min(visibility.max_invisibility, 1);
-    out.pieces = split_by_visibility(out.segments, VisibilityContext{scene, out.mesh, accel, view}, visibility, threads);
+    if (!settings.chain.hidden)
+        visibility.max_invisibility = std::min(visibility.max_invisibility, 1);
+    out.pieces = split_by_visibility(out.segments, VisibilityContext{scene, out.mesh, accel, view},
+                                     visibility, threads);
     out.timings.visibility = seconds_since(start);
 
     start = std::chrono::steady_clock::now();

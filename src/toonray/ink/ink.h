@@ -42,7 +42,7 @@ struct InkLines {
 /// order. Without hidden strokes (settings.chain.hidden false) visibility only tells visible
 /// from hidden (max_invisibility 1), which needs one ray query per hidden point. The same
 /// result for any thread count.
-void draw_ink_lines(const Scene& scene, const TriangleAccel& accel, const CameraSpec& camera, int width, int height,
-                    const InkSettings& settings, int threads, InkLines& out);
+void draw_ink_lines(const Scene& scene, const TriangleAccel& accel, const CameraSpec& camera,
+                    int width, int height, const InkSettings& settings, int threads, InkLines& out);
 
 }  // namespace toonray::ink

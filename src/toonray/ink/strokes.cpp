@@ -21,8 +21,8 @@ float distance_to_segment(const Point2& p, const Point2& a, const Point2& b) {
     return portable::hypot(p.x - (a.x + dx * t), p.y - (a.y + dy * t));
 }
 
-void douglas_peucker(std::span<const Point2> points, std::size_t first, std::size_t last, float tolerance,
-                     std::vector<bool>& keep) {
+void douglas_peucker(std::span<const Point2> points, std::size_t first, std::size_t last,
+                     float tolerance, std::vector<bool>& keep) {
     if (last <= first + 1) return;
     float worst = -1.0f;
     std::size_t at = first;
@@ -85,13 +85,15 @@ std::vector<Stroke> chain_pieces(std::span<const EdgePiece> pieces, const ChainS
                 const bool before = k > 0 ? visible[k - 1] : visible[k + 1];
                 const bool after = k + 1 < n ? visible[k + 1] : visible[k - 1];
                 // Only when cut from both sides, and contiguous with them (not cut by clipping).
-                const bool contiguous = (k == 0 || pieces[i + k - 1].t1 == p.t0) && (k + 1 == n || pieces[i + k + 1].t0 == p.t1);
+                const bool contiguous = (k == 0 || pieces[i + k - 1].t1 == p.t0) &&
+                                        (k + 1 == n || pieces[i + k + 1].t0 == p.t1);
                 if (before == after && before != visible[k] && contiguous) visible[k] = before;
             }
         for (std::size_t k = 0; k < n; ++k) {
             const EdgePiece& p = pieces[i + k];
             if (!visible[k] && !settings.hidden) continue;
-            if (k > 0 && visible[k] == visible[k - 1] && pieces[i + k - 1].t1 == p.t0 && !links.empty()) {
+            if (k > 0 && visible[k] == visible[k - 1] && pieces[i + k - 1].t1 == p.t0 &&
+                !links.empty()) {
                 links.back().s1 = p.s1;
                 links.back().key1 = p.key1;
                 continue;
@@ -109,17 +111,23 @@ std::vector<Stroke> chain_pieces(std::span<const EdgePiece> pieces, const ChainS
     };
     std::vector<End> ends;
     for (std::size_t l = 0; l < links.size(); ++l) {
-        if (has_key(links[l].key0)) ends.push_back({links[l].key0, static_cast<std::uint32_t>(l), 0});
-        if (has_key(links[l].key1)) ends.push_back({links[l].key1, static_cast<std::uint32_t>(l), 1});
+        if (has_key(links[l].key0))
+            ends.push_back({links[l].key0, static_cast<std::uint32_t>(l), 0});
+        if (has_key(links[l].key1))
+            ends.push_back({links[l].key1, static_cast<std::uint32_t>(l), 1});
     }
-    std::sort(ends.begin(), ends.end(),
-              [](const End& a, const End& b) { return std::tie(a.key, a.link, a.side) < std::tie(b.key, b.link, b.side); });
+    std::sort(ends.begin(), ends.end(), [](const End& a, const End& b) {
+        return std::tie(a.key, a.link, a.side) < std::tie(b.key, b.link, b.side);
+    });
     auto ends_at = [&](const EndpointKey& key) {
-        auto lo = std::lower_bound(ends.begin(), ends.end(), key, [](const End& e, const EndpointKey& k) { return e.key < k; });
-        auto hi = std::upper_bound(ends.begin(), ends.end(), key, [](const EndpointKey& k, const End& e) { return k < e.key; });
+        auto lo = std::lower_bound(ends.begin(), ends.end(), key,
+                                   [](const End& e, const EndpointKey& k) { return e.key < k; });
+        auto hi = std::upper_bound(ends.begin(), ends.end(), key,
+                                   [](const EndpointKey& k, const End& e) { return k < e.key; });
         return std::span<const End>(&*lo, static_cast<std::size_t>(hi - lo));
     };
-    const float cos_max_turn = portable::cos(settings.max_turn * std::numbers::pi_v<float> / 180.0f);
+    const float cos_max_turn =
+        portable::cos(settings.max_turn * std::numbers::pi_v<float> / 180.0f);
 
     std::vector<bool> used(links.size(), false);
     std::vector<Stroke> strokes;
@@ -145,13 +153,16 @@ std::vector<Stroke> chain_pieces(std::span<const EdgePiece> pieces, const ChainS
                 std::uint32_t last_link = kNoIndex;
                 for (const End& e : ends_at(key)) {
                     const Link& l = links[e.link];
-                    if (used[e.link] || l.type != first.type || l.visible != first.visible || e.link == last_link) continue;
+                    if (used[e.link] || l.type != first.type || l.visible != first.visible ||
+                        e.link == last_link)
+                        continue;
                     last_link = e.link;
                     ++candidates;
                     const Point2 next = e.side == 0 ? l.s1 : l.s0;
                     const float nx = next.x - tip.x, ny = next.y - tip.y;
                     const float nlen = portable::hypot(nx, ny);
-                    const float c = hlen > 0 && nlen > 0 ? (hx * nx + hy * ny) / (hlen * nlen) : 1.0f;
+                    const float c =
+                        hlen > 0 && nlen > 0 ? (hx * nx + hy * ny) / (hlen * nlen) : 1.0f;
                     if (c > best_cos) {
                         best_cos = c;
                         best = &e;
@@ -173,14 +184,17 @@ std::vector<Stroke> chain_pieces(std::span<const EdgePiece> pieces, const ChainS
         // Thin out points closer than min_spacing, keeping both ends.
         std::vector<Point2> spaced{points.front()};
         for (std::size_t i = 1; i + 1 < points.size(); ++i)
-            if (distance(points[i], spaced.back()) >= settings.min_spacing) spaced.push_back(points[i]);
+            if (distance(points[i], spaced.back()) >= settings.min_spacing)
+                spaced.push_back(points[i]);
         spaced.push_back(points.back());
         Stroke stroke;
         stroke.type = first.type;
         stroke.visible = first.visible;
         stroke.closed = closed;
         stroke.points = simplify_polyline(spaced, settings.simplify);
-        if (stroke.visible && settings.min_length > 0.0f && polyline_length(stroke.points) < settings.min_length) continue;
+        if (stroke.visible && settings.min_length > 0.0f &&
+            polyline_length(stroke.points) < settings.min_length)
+            continue;
         strokes.push_back(std::move(stroke));
     }
     return strokes;

@@ -41,11 +41,13 @@ struct ChainSettings {
 /// with the straightest on the image if that turns by at most max_turn, else it stops. A
 /// stroke that comes back to its start is closed. Strokes come out in the order of their
 /// first pieces (so deterministic).
-[[nodiscard]] std::vector<Stroke> chain_pieces(std::span<const EdgePiece> pieces, const ChainSettings& settings);
+[[nodiscard]] std::vector<Stroke> chain_pieces(std::span<const EdgePiece> pieces,
+                                               const ChainSettings& settings);
 
 /// Douglas-Peucker: the fewest points of `points` (ends kept) such that every dropped point
 /// is within `tolerance` of the simplified polyline.
-[[nodiscard]] std::vector<Point2> simplify_polyline(std::span<const Point2> points, float tolerance);
+[[nodiscard]] std::vector<Point2> simplify_polyline(std::span<const Point2> points,
+                                                    float tolerance);
 
 /// Length of a polyline in pixels.
 [[nodiscard]] float polyline_length(std::span<const Point2> points);

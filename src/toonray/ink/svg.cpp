@@ -11,7 +11,9 @@ namespace toonray::ink {
 namespace {
 
 std::string hex_colour(const Vec3f& c) {
-    auto byte = [](float v) { return static_cast<int>(std::min(std::max(v, 0.0f), 1.0f) * 255.0f + 0.5f); };
+    auto byte = [](float v) {
+        return static_cast<int>(std::min(std::max(v, 0.0f), 1.0f) * 255.0f + 0.5f);
+    };
     return fmt::format("#{:02x}{:02x}{:02x}", byte(c.x), byte(c.y), byte(c.z));
 }
 
@@ -28,18 +30,22 @@ std::string svg_text(std::span<const Stroke> strokes, const SvgSettings& setting
     std::string out;
     auto it = std::back_inserter(out);
     fmt::format_to(it, "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
-    fmt::format_to(it,
-                   "<svg xmlns=\"http://www.w3.org/2000/svg\" version=\"1.1\" width=\"{0}\" height=\"{1}\" "
-                   "viewBox=\"0 0 {0} {1}\">\n",
-                   settings.width, settings.height);
+    fmt::format_to(
+        it,
+        "<svg xmlns=\"http://www.w3.org/2000/svg\" version=\"1.1\" width=\"{0}\" height=\"{1}\" "
+        "viewBox=\"0 0 {0} {1}\">\n",
+        settings.width, settings.height);
     for (int layer = 0; layer < (settings.hidden ? 2 : 1); ++layer) {
         const bool visible = layer == 0;
         const char* name = visible ? "visible" : "hidden";
-        const float width = visible ? settings.thickness : settings.thickness * settings.hidden_thickness_scale;
-        fmt::format_to(it,
-                       "<g id=\"{}\" fill=\"none\" stroke=\"{}\" stroke-width=\"{}\" stroke-linecap=\"round\" "
-                       "stroke-linejoin=\"round\">\n",
-                       name, hex_colour(visible ? settings.colour : settings.hidden_colour), coordinate(width));
+        const float width =
+            visible ? settings.thickness : settings.thickness * settings.hidden_thickness_scale;
+        fmt::format_to(
+            it,
+            "<g id=\"{}\" fill=\"none\" stroke=\"{}\" stroke-width=\"{}\" stroke-linecap=\"round\" "
+            "stroke-linejoin=\"round\">\n",
+            name, hex_colour(visible ? settings.colour : settings.hidden_colour),
+            coordinate(width));
         for (int t = 0; t < kEdgeTypeCount; ++t) {
             const auto type = static_cast<EdgeType>(t);
             fmt::format_to(it, "<g id=\"{}-{}\">\n", name, edge_type_name(type));

@@ -14,7 +14,7 @@ struct SvgSettings {
     int width = 1280, height = 720;  ///< the image size: the viewBox, in pixels
     float thickness = 2.0f;          ///< visible stroke width, pixels
     Vec3f colour{0.0f};
-    bool hidden = false;               ///< write hidden strokes too (in group "hidden")
+    bool hidden = false;  ///< write hidden strokes too (in group "hidden")
     Vec3f hidden_colour{0.5f};
     float hidden_thickness_scale = 0.5f;
 };

@@ -9,7 +9,8 @@
 
 namespace toonray::ink {
 
-std::vector<std::uint32_t> ignored_triangles(const FeatureSegment& segment, const WeldedMesh& mesh) {
+std::vector<std::uint32_t> ignored_triangles(const FeatureSegment& segment,
+                                             const WeldedMesh& mesh) {
     std::vector<std::uint32_t> out;
     for (std::uint32_t f : segment.faces)
         if (f != kNoIndex) out.push_back(f);
@@ -61,10 +62,13 @@ struct ClippedSegment {
         const float u = s * za / ((1.0f - s) * zb + s * za);
         return ta + (tb - ta) * u;
     }
-    [[nodiscard]] Point2 image(float s) const { return {a.x + (b.x - a.x) * s, a.y + (b.y - a.y) * s}; }
+    [[nodiscard]] Point2 image(float s) const {
+        return {a.x + (b.x - a.x) * s, a.y + (b.y - a.y) * s};
+    }
 };
 
-bool clip_to_view(const FeatureSegment& seg, const ScreenProjection& view, float margin, ClippedSegment& c) {
+bool clip_to_view(const FeatureSegment& seg, const ScreenProjection& view, float margin,
+                  ClippedSegment& c) {
     const float z0 = view.depth(seg.p0), z1 = view.depth(seg.p1), near = view.near_depth();
     if (!(z0 >= near || z1 >= near)) return false;  // also rejects NaN
     if (z0 < near) c.ta = (near - z0) / (z1 - z0);
@@ -78,7 +82,8 @@ bool clip_to_view(const FeatureSegment& seg, const ScreenProjection& view, float
     const float d[2] = {c.b.x - c.a.x, c.b.y - c.a.y};
     const float o[2] = {c.a.x, c.a.y};
     const float lo[2] = {-margin, -margin};
-    const float hi[2] = {static_cast<float>(view.width()) + margin, static_cast<float>(view.height()) + margin};
+    const float hi[2] = {static_cast<float>(view.width()) + margin,
+                         static_cast<float>(view.height()) + margin};
     for (int axis = 0; axis < 2; ++axis) {
         if (d[axis] == 0.0f) {
             if (o[axis] < lo[axis] || o[axis] > hi[axis]) return false;
@@ -94,11 +99,13 @@ bool clip_to_view(const FeatureSegment& seg, const ScreenProjection& view, float
 
 }  // namespace
 
-std::vector<EdgePiece> split_by_visibility(std::span<const FeatureSegment> segments, const VisibilityContext& context,
+std::vector<EdgePiece> split_by_visibility(std::span<const FeatureSegment> segments,
+                                           const VisibilityContext& context,
                                            const VisibilitySettings& settings, int threads) {
     const ScreenProjection& view = context.view;
     return gather_chunks<EdgePiece>(
-        static_cast<int>(segments.size()), 32, threads, [&](int i0, int i1, std::vector<EdgePiece>& out) {
+        static_cast<int>(segments.size()), 32, threads,
+        [&](int i0, int i1, std::vector<EdgePiece>& out) {
             std::vector<float> cuts;
             std::vector<int> states, sample_states;
             std::vector<Vec3f> dirs, points;
@@ -129,14 +136,18 @@ std::vector<EdgePiece> split_by_visibility(std::span<const FeatureSegment> segme
                 const std::vector<std::uint32_t> ignored = ignored_triangles(seg, context.mesh);
                 auto state_at = [&](float s) {
                     const float t = c.t_of(s);
-                    return count_occluders(context.accel, seg.p0 + (seg.p1 - seg.p0) * t, view.eye(), ignored, settings);
+                    return count_occluders(context.accel, seg.p0 + (seg.p1 - seg.p0) * t,
+                                           view.eye(), ignored, settings);
                 };
                 // Samples at the middles of n equal steps of at most `step` pixels; a change
                 // between two samples is found by bisection.
                 const float image_length = portable::hypot(c.b.x - c.a.x, c.b.y - c.a.y);
                 const float span = c.s_hi - c.s_lo;
-                const int n = std::max(1, static_cast<int>(std::ceil(image_length * span / settings.step)));
-                auto sample_s = [&](int k) { return c.s_lo + span * (static_cast<float>(k) + 0.5f) / static_cast<float>(n); };
+                const int n =
+                    std::max(1, static_cast<int>(std::ceil(image_length * span / settings.step)));
+                auto sample_s = [&](int k) {
+                    return c.s_lo + span * (static_cast<float>(k) + 0.5f) / static_cast<float>(n);
+                };
                 sample_states.resize(static_cast<std::size_t>(n));
                 if (settings.max_invisibility <= 1) {
                     // Only hidden or not: the samples' rays are traced together, from the eye (one
@@ -155,20 +166,23 @@ std::vector<EdgePiece> split_by_visibility(std::span<const FeatureSegment> segme
                         points[k] = seg.p0 + (seg.p1 - seg.p0) * c.t_of(sample_s(sample));
                         dirs[k] = points[k] - view.eye();
                     }
-                    context.accel.intersect_tile(view.eye(), dirs.data(), kPacketWidth, rows, hits.data(), found.get(),
+                    context.accel.intersect_tile(view.eye(), dirs.data(), kPacketWidth, rows,
+                                                 hits.data(), found.get(),
                                                  1.0f - settings.self_epsilon);
                     for (int k = 0; k < n; ++k) {
                         const Hit& hit = hits[static_cast<std::size_t>(k)];
-                        if (!found[k])
-                            sample_states[static_cast<std::size_t>(k)] = 0;
-                        else if (hit.t >= settings.self_epsilon && !std::binary_search(ignored.begin(), ignored.end(), hit.prim))
+                        if (!found[k]) sample_states[static_cast<std::size_t>(k)] = 0;
+                        else if (hit.t >= settings.self_epsilon &&
+                                 !std::binary_search(ignored.begin(), ignored.end(), hit.prim))
                             sample_states[static_cast<std::size_t>(k)] = 1;
                         else
                             sample_states[static_cast<std::size_t>(k)] =
-                                count_occluders(context.accel, points[static_cast<std::size_t>(k)], view.eye(), ignored, settings);
+                                count_occluders(context.accel, points[static_cast<std::size_t>(k)],
+                                                view.eye(), ignored, settings);
                     }
                 } else {
-                    for (int k = 0; k < n; ++k) sample_states[static_cast<std::size_t>(k)] = state_at(sample_s(k));
+                    for (int k = 0; k < n; ++k)
+                        sample_states[static_cast<std::size_t>(k)] = state_at(sample_s(k));
                 }
                 cuts.assign(1, c.s_lo);
                 states.clear();
@@ -200,7 +214,8 @@ std::vector<EdgePiece> split_by_visibility(std::span<const FeatureSegment> segme
                     const float s0 = cuts[k], s1 = cuts[k + 1];
                     piece.t0 = c.t_of(s0);
                     piece.t1 = c.t_of(s1);
-                    if (k == 0 && c.s_lo == 0.0f) piece.t0 = c.ta;  // exactly, so that the key below holds
+                    if (k == 0 && c.s_lo == 0.0f)
+                        piece.t0 = c.ta;  // exactly, so that the key below holds
                     if (k + 1 == states.size() && c.s_hi == 1.0f) piece.t1 = c.tb;
                     if (!(piece.t0 < piece.t1)) continue;
                     piece.p0 = seg.p0 + (seg.p1 - seg.p0) * piece.t0;

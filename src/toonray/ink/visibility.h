@@ -14,7 +14,7 @@
 namespace toonray::ink {
 
 struct VisibilitySettings {
-    float step = 1.0f;           ///< pixels between samples along a segment's image
+    float step = 1.0f;            ///< pixels between samples along a segment's image
     float precision = 1.0f / 16;  ///< change points are refined by bisection to this many pixels
     /// A ray from a point toward the eye ignores hits closer to the point than this fraction
     /// of the distance to the eye, so that the surface a line lies on does not hide it.
@@ -53,19 +53,22 @@ struct VisibilityContext {
 
 /// Triangles whose hits do not count against `segment`: its faces, and for a smooth contour
 /// every triangle sharing a vertex with its face. Sorted.
-[[nodiscard]] std::vector<std::uint32_t> ignored_triangles(const FeatureSegment& segment, const WeldedMesh& mesh);
+[[nodiscard]] std::vector<std::uint32_t> ignored_triangles(const FeatureSegment& segment,
+                                                           const WeldedMesh& mesh);
 
 /// Surfaces between `point` and the eye: hits of the segment from point to eye with parameter
 /// in (self_epsilon, 1 - self_epsilon), not on an `ignored` triangle (sorted), at most
 /// max_invisibility. Hits closer together than a hundredth of self_epsilon count once.
 [[nodiscard]] int count_occluders(const TriangleAccel& accel, const Vec3f& point, const Vec3f& eye,
-                                  std::span<const std::uint32_t> ignored, const VisibilitySettings& settings);
+                                  std::span<const std::uint32_t> ignored,
+                                  const VisibilitySettings& settings);
 
 /// The segments cut into pieces of constant visibility, in segment order and along each
 /// segment, the same for any thread count. Parts behind the eye or outside the image (grown by
 /// the margin) are left out.
 [[nodiscard]] std::vector<EdgePiece> split_by_visibility(std::span<const FeatureSegment> segments,
                                                          const VisibilityContext& context,
-                                                         const VisibilitySettings& settings, int threads);
+                                                         const VisibilitySettings& settings,
+                                                         int threads);
 
 }  // namespace toonray::ink

@@ -17,7 +17,8 @@ namespace toonray {
 std::string read_file(const std::filesystem::path& path, std::uint64_t max_bytes) {
     // O_NONBLOCK: opening a FIFO must not wait for a writer; a FIFO is refused below anyway.
     const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
-    if (fd < 0) throw Error(fmt::format("{}: cannot open: {}", path.string(), std::strerror(errno)));
+    if (fd < 0)
+        throw Error(fmt::format("{}: cannot open: {}", path.string(), std::strerror(errno)));
     struct Closer {
         int fd;
         ~Closer() { ::close(fd); }
@@ -25,11 +26,13 @@ std::string read_file(const std::filesystem::path& path, std::uint64_t max_bytes
     struct stat st {};
     if (::fstat(fd, &st) != 0)
         throw Error(fmt::format("{}: cannot read: {}", path.string(), std::strerror(errno)));
-    if (S_ISDIR(st.st_mode)) throw Error(fmt::format("{}: is a directory, not a file", path.string()));
+    if (S_ISDIR(st.st_mode))
+        throw Error(fmt::format("{}: is a directory, not a file", path.string()));
     if (!S_ISREG(st.st_mode))
-        throw Error(fmt::format("{}: not a regular file (a device, FIFO or socket); toonray reads "
-                                "inputs from regular files only",
-                                path.string()));
+        throw Error(
+            fmt::format("{}: not a regular file (a device, FIFO or socket); toonray reads "
+                        "inputs from regular files only",
+                        path.string()));
     const auto size = static_cast<std::uint64_t>(st.st_size);
     auto too_large = [&](std::uint64_t bytes) {
         return LimitError(Limit::InputBytes,
@@ -101,7 +104,8 @@ void write_file_atomic(const std::filesystem::path& path, std::span<const std::u
     if (::rename(tmpl.c_str(), path.c_str()) != 0) {
         int err = errno;
         ::unlink(tmpl.c_str());
-        throw Error(fmt::format("{}: cannot rename into place: {}", path.string(), std::strerror(err)));
+        throw Error(
+            fmt::format("{}: cannot rename into place: {}", path.string(), std::strerror(err)));
     }
 }
 

@@ -43,8 +43,8 @@ struct CompressorDeleter {
 /// (docs/performance.md). Fills `rows` with each row's filter byte (0, None) and its pixels'
 /// palette indices, and `palette` with the colours (RGB triplets) in order of first use.
 /// Returns false as soon as a 257th colour appears.
-bool index_colours(const std::uint8_t* pixels, int width, int height, std::vector<std::uint8_t>& rows,
-                   std::vector<std::uint8_t>& palette) {
+bool index_colours(const std::uint8_t* pixels, int width, int height,
+                   std::vector<std::uint8_t>& rows, std::vector<std::uint8_t>& palette) {
     // Open addressing over colour + 1 (0 marks a free slot); 1024 slots for 256 colours keep
     // probes short. Runs of one colour, the common case, skip the table (`previous`).
     constexpr std::uint32_t kSlotBits = 10;
@@ -59,9 +59,11 @@ bool index_colours(const std::uint8_t* pixels, int width, int height, std::vecto
     for (int y = 0; y < height; ++y) {
         *out++ = 0;  // filter None: filters predict colours, not palette indices
         for (int x = 0; x < width; ++x, p += 3) {
-            const std::uint32_t colour = std::uint32_t{p[0]} << 16 | std::uint32_t{p[1]} << 8 | p[2];
+            const std::uint32_t colour =
+                std::uint32_t{p[0]} << 16 | std::uint32_t{p[1]} << 8 | p[2];
             if (colour != previous) {
-                std::uint32_t slot = (colour * 0x9E3779B1u) >> (32 - kSlotBits);  // Fibonacci hashing
+                std::uint32_t slot =
+                    (colour * 0x9E3779B1u) >> (32 - kSlotBits);  // Fibonacci hashing
                 while (keys[slot] != colour + 1) {
                     if (keys[slot] == 0) {
                         if (palette.size() == 3 * 256) return false;
@@ -114,13 +116,16 @@ std::vector<std::uint8_t> encode_png(int width, int height, int channels,
     out.insert(out.end(), signature, signature + 8);
     std::uint8_t ihdr[13];
     auto be32 = [](std::uint8_t* p, std::uint32_t v) {
-        p[0] = v >> 24; p[1] = v >> 16; p[2] = v >> 8; p[3] = v;
+        p[0] = v >> 24;
+        p[1] = v >> 16;
+        p[2] = v >> 8;
+        p[3] = v;
     };
     be32(ihdr, static_cast<std::uint32_t>(width));
     be32(ihdr + 4, static_cast<std::uint32_t>(height));
-    ihdr[8] = 8;                                            // bit depth
-    ihdr[9] = indexed ? 3 : channels == 3 ? 2 : 0;          // colour type: indexed, RGB or grayscale
-    ihdr[10] = ihdr[11] = ihdr[12] = 0;                     // deflate, adaptive filtering, no interlace
+    ihdr[8] = 8;                                    // bit depth
+    ihdr[9] = indexed ? 3 : channels == 3 ? 2 : 0;  // colour type: indexed, RGB or grayscale
+    ihdr[10] = ihdr[11] = ihdr[12] = 0;             // deflate, adaptive filtering, no interlace
     put_chunk(out, "IHDR", ihdr, sizeof ihdr);
     if (indexed) put_chunk(out, "PLTE", palette.data(), palette.size());
     put_chunk(out, "IDAT", idat.data(), idat_size);
@@ -128,13 +133,15 @@ std::vector<std::uint8_t> encode_png(int width, int height, int channels,
     return out;
 }
 
-void write_png(const std::filesystem::path& path, const ImageRgb8& image, const PngOptions& options) {
+void write_png(const std::filesystem::path& path, const ImageRgb8& image,
+               const PngOptions& options) {
     auto bytes = encode_png(image.width(), image.height(), 3,
                             reinterpret_cast<const std::uint8_t*>(image.data()), options);
     write_file_atomic(path, bytes);
 }
 
-void write_png(const std::filesystem::path& path, const ImageGray8& image, const PngOptions& options) {
+void write_png(const std::filesystem::path& path, const ImageGray8& image,
+               const PngOptions& options) {
     auto bytes = encode_png(image.width(), image.height(), 1, image.data(), options);
     write_file_atomic(path, bytes);
 }
@@ -157,8 +164,9 @@ DecodedPng decode_png(std::span<const std::uint8_t> bytes, std::string_view name
     // The header may announce any size up to 2^31 - 1 squared: check before allocating.
     const std::uint64_t pixels = std::uint64_t{img.width} * img.height;
     if (img.width > 0x7FFFFFFFu || img.height > 0x7FFFFFFFu || pixels > limits().max_image_pixels)
-        throw LimitError(Limit::ImagePixels, fmt::format("{}: a {}x{} PNG has more pixels than the limit of {}",
-                                                         name, img.width, img.height, limits().max_image_pixels));
+        throw LimitError(Limit::ImagePixels,
+                         fmt::format("{}: a {}x{} PNG has more pixels than the limit of {}", name,
+                                     img.width, img.height, limits().max_image_pixels));
     img.format = PNG_FORMAT_RGB;
     DecodedPng result;
     result.width = static_cast<int>(img.width);

@@ -28,8 +28,10 @@ std::vector<std::uint8_t> encode_png(int width, int height, int channels,
                                      const std::uint8_t* pixels, const PngOptions& options = {});
 
 /// Encodes and writes atomically. Throws Error on failure.
-void write_png(const std::filesystem::path& path, const ImageRgb8& image, const PngOptions& options = {});
-void write_png(const std::filesystem::path& path, const ImageGray8& image, const PngOptions& options = {});
+void write_png(const std::filesystem::path& path, const ImageRgb8& image,
+               const PngOptions& options = {});
+void write_png(const std::filesystem::path& path, const ImageGray8& image,
+               const PngOptions& options = {});
 
 /// A decoded PNG, converted to 8-bit RGB.
 struct DecodedPng {

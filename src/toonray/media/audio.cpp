@@ -77,15 +77,17 @@ void check_soundfont_file(const std::filesystem::path& path) {
     std::error_code ec;
     auto status = std::filesystem::status(path, ec);
     if (!std::filesystem::exists(status))
-        throw Error(fmt::format("{}: SoundFont not found{}", path.string(),
-                                path == default_soundfont()
-                                    ? " (the default SoundFont, installed by the Debian package fluid-soundfont-gm)"
-                                    : ""));
+        throw Error(fmt::format(
+            "{}: SoundFont not found{}", path.string(),
+            path == default_soundfont()
+                ? " (the default SoundFont, installed by the Debian package fluid-soundfont-gm)"
+                : ""));
     if (!std::filesystem::is_regular_file(status))
         throw Error(fmt::format("{}: SoundFont is not a regular file", path.string()));
     std::FILE* f = std::fopen(path.c_str(), "rb");
     if (!f)
-        throw Error(fmt::format("{}: cannot open SoundFont: {}", path.string(), std::strerror(errno)));
+        throw Error(
+            fmt::format("{}: cannot open SoundFont: {}", path.string(), std::strerror(errno)));
     std::array<char, 12> header{};
     std::size_t n = std::fread(header.data(), 1, header.size(), f);
     std::fclose(f);
@@ -94,14 +96,16 @@ void check_soundfont_file(const std::filesystem::path& path) {
         throw Error(fmt::format("{}: not a SoundFont 2 file (no RIFF sfbk header)", path.string()));
     // A truncated download is the common way to get a bad .sf2; FluidSynth would then hand it to
     // its DLS loader, whose complaints are less clear than this.
-    const std::uint64_t riff_size = static_cast<std::uint8_t>(header[4]) |
-                                    static_cast<std::uint8_t>(header[5]) << 8 |
-                                    static_cast<std::uint8_t>(header[6]) << 16 |
-                                    static_cast<std::uint64_t>(static_cast<std::uint8_t>(header[7])) << 24;
+    const std::uint64_t riff_size =
+        static_cast<std::uint8_t>(header[4]) | static_cast<std::uint8_t>(header[5]) << 8 |
+        static_cast<std::uint8_t>(header[6]) << 16 |
+        static_cast<std::uint64_t>(static_cast<std::uint8_t>(header[7])) << 24;
     const std::uint64_t file_size = std::filesystem::file_size(path, ec);
     if (!ec && riff_size + 8 != file_size)
-        throw Error(fmt::format("{}: SoundFont is truncated or corrupt (its header says {} bytes, "
-                                "the file has {})", path.string(), riff_size + 8, file_size));
+        throw Error(
+            fmt::format("{}: SoundFont is truncated or corrupt (its header says {} bytes, "
+                        "the file has {})",
+                        path.string(), riff_size + 8, file_size));
 }
 
 /// One thing to tell the synthesiser, at a sample of the output.
@@ -146,7 +150,8 @@ void validate(const Score& score, const AudioOptions& o) {
     if (!std::isfinite(o.gain) || o.gain <= 0 || o.gain > 10)
         throw Error(fmt::format("audio: gain {} outside (0, 10]", o.gain));
     if (o.bank < 0 || o.bank > 16383 || o.program < 0 || o.program > 127)
-        throw Error(fmt::format("audio: bank {} / program {} out of MIDI range", o.bank, o.program));
+        throw Error(
+            fmt::format("audio: bank {} / program {} out of MIDI range", o.bank, o.program));
     for (std::size_t i = 0; i < score.notes.size(); ++i) {
         const Note& n = score.notes[i];
         if (!std::isfinite(n.start) || !std::isfinite(n.end) || n.start < 0)
@@ -176,9 +181,10 @@ std::string select_preset(fluid_synth_t* synth, int sfont_id, const AudioOptions
     if (!first) throw Error(fmt::format("{}: SoundFont has no presets", path.string()));
     const int bank = fluid_preset_get_banknum(first), program = fluid_preset_get_num(first);
     std::string name = fluid_preset_get_name(first);
-    warnings.push_back(fmt::format("{}: no preset at bank {} program {}; using '{}' (bank {} "
-                                   "program {})", path.string(), o.bank, o.program, name, bank,
-                                   program));
+    warnings.push_back(
+        fmt::format("{}: no preset at bank {} program {}; using '{}' (bank {} "
+                    "program {})",
+                    path.string(), o.bank, o.program, name, bank, program));
     fluid_synth_program_select(synth, 0, sfont_id, bank, program);
     return name;
 }
@@ -195,8 +201,8 @@ AudioResult synthesize_score(const Score& score, const AudioOptions& options) {
 
     // --- Events, in output samples. ---
     const double window_start = options.start;
-    const double window_end = options.length ? window_start + *options.length
-                                             : std::numeric_limits<double>::infinity();
+    const double window_end =
+        options.length ? window_start + *options.length : std::numeric_limits<double>::infinity();
     std::vector<SynthEvent> events;
     AudioResult result;
     double last_end = window_start;  // score time at which the last played note ends
@@ -213,12 +219,13 @@ AudioResult synthesize_score(const Score& score, const AudioOptions& options) {
     }
     if (result.notes == 0) {
         if (score.notes.empty()) throw Error("audio: the score has no notes");
-        auto [first, last] = std::minmax_element(
-            score.notes.begin(), score.notes.end(),
-            [](const Note& a, const Note& b) { return a.start < b.start; });
-        throw Error(fmt::format("audio: no notes start in the window {:.3f} .. {:.3f} s (the "
-                                "score's notes start at {:.3f} .. {:.3f} s)", window_start,
-                                window_end, first->start, last->start));
+        auto [first, last] =
+            std::minmax_element(score.notes.begin(), score.notes.end(),
+                                [](const Note& a, const Note& b) { return a.start < b.start; });
+        throw Error(
+            fmt::format("audio: no notes start in the window {:.3f} .. {:.3f} s (the "
+                        "score's notes start at {:.3f} .. {:.3f} s)",
+                        window_start, window_end, first->start, last->start));
     }
     // The pedal as it stands at the window start, then its changes inside the window.
     bool pedal_down = false;
@@ -227,16 +234,16 @@ AudioResult synthesize_score(const Score& score, const AudioOptions& options) {
     if (pedal_down) events.push_back({0, SynthEvent::Pedal, 127, 0});
     for (const PedalEvent& p : score.sustain) {
         if (p.time <= window_start || p.time >= window_end) continue;
-        events.push_back({to_sample(p.time - window_start, rate), SynthEvent::Pedal,
-                          p.down ? 127 : 0, 0});
+        events.push_back(
+            {to_sample(p.time - window_start, rate), SynthEvent::Pedal, p.down ? 127 : 0, 0});
         last_end = std::max(last_end, p.time);
     }
     std::sort(events.begin(), events.end());
 
     const std::int64_t total =
-        options.length ? to_sample(*options.length, rate)
-                       : to_sample(std::max(last_end, score_end(score)) - window_start + options.tail,
-                                   rate);
+        options.length
+            ? to_sample(*options.length, rate)
+            : to_sample(std::max(last_end, score_end(score)) - window_start + options.tail, rate);
 
     // --- The synthesiser. ---
     install_fluid_logging();
@@ -311,19 +318,18 @@ AudioResult synthesize_score(const Score& score, const AudioOptions& options) {
         if (e.sample >= total) break;
         render_until(e.sample);
         switch (e.kind) {
-        case SynthEvent::NoteOn:
-            // A second strike of a key already sounding restarts it, as on a real piano;
-            // FluidSynth releases the old voice.
-            ++held[e.key];
-            fluid_synth_noteon(synth.get(), 0, e.key, e.value);
-            break;
-        case SynthEvent::NoteOff:
-            // Only the last of overlapping same-key notes releases the key.
-            if (held[e.key] > 0 && --held[e.key] == 0) fluid_synth_noteoff(synth.get(), 0, e.key);
-            break;
-        case SynthEvent::Pedal:
-            fluid_synth_cc(synth.get(), 0, 64, e.key);
-            break;
+            case SynthEvent::NoteOn:
+                // A second strike of a key already sounding restarts it, as on a real piano;
+                // FluidSynth releases the old voice.
+                ++held[e.key];
+                fluid_synth_noteon(synth.get(), 0, e.key, e.value);
+                break;
+            case SynthEvent::NoteOff:
+                // Only the last of overlapping same-key notes releases the key.
+                if (held[e.key] > 0 && --held[e.key] == 0)
+                    fluid_synth_noteoff(synth.get(), 0, e.key);
+                break;
+            case SynthEvent::Pedal: fluid_synth_cc(synth.get(), 0, 64, e.key); break;
         }
     }
     render_until(total);

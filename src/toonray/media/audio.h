@@ -35,12 +35,12 @@ struct AudioOptions {
 };
 
 struct AudioResult {
-    WavAudio audio;              ///< 2 channels at options.sample_rate
-    int notes = 0;               ///< notes played (those starting in the window)
-    std::string preset;          ///< name of the SoundFont preset used
-    float peak = 0.0f;           ///< largest absolute sample before clamping, 1 = full scale
-    std::int64_t clipped = 0;    ///< samples clamped to the 16-bit range
-    Warnings warnings;           ///< clipping, preset fallback, FluidSynth warnings
+    WavAudio audio;            ///< 2 channels at options.sample_rate
+    int notes = 0;             ///< notes played (those starting in the window)
+    std::string preset;        ///< name of the SoundFont preset used
+    float peak = 0.0f;         ///< largest absolute sample before clamping, 1 = full scale
+    std::int64_t clipped = 0;  ///< samples clamped to the 16-bit range
+    Warnings warnings;         ///< clipping, preset fallback, FluidSynth warnings
 };
 
 /// Renders the score to memory. Events are sent to FluidSynth between rendering calls split at

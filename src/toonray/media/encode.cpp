@@ -43,7 +43,8 @@ std::string ffmpeg_url(const fs::path& path) { return "file:" + fs::absolute(pat
 /// Width and height from a PNG's IHDR chunk, without decoding the image.
 std::pair<int, int> png_size(const fs::path& path) {
     std::FILE* f = std::fopen(path.c_str(), "rb");
-    if (!f) throw Error(fmt::format("{}: cannot open frame: {}", path.string(), std::strerror(errno)));
+    if (!f)
+        throw Error(fmt::format("{}: cannot open frame: {}", path.string(), std::strerror(errno)));
     unsigned char h[24];
     const std::size_t n = std::fread(h, 1, sizeof h, f);
     std::fclose(f);
@@ -51,7 +52,8 @@ std::pair<int, int> png_size(const fs::path& path) {
     if (n != sizeof h || std::memcmp(h, kSignature, 8) != 0 || std::memcmp(h + 12, "IHDR", 4) != 0)
         throw Error(fmt::format("{}: frame is not a PNG file", path.string()));
     auto be32 = [&](int at) {
-        return static_cast<std::uint32_t>(h[at]) << 24 | static_cast<std::uint32_t>(h[at + 1]) << 16 |
+        return static_cast<std::uint32_t>(h[at]) << 24 |
+               static_cast<std::uint32_t>(h[at + 1]) << 16 |
                static_cast<std::uint32_t>(h[at + 2]) << 8 | h[at + 3];
     };
     const std::uint32_t w = be32(16), ht = be32(20);
@@ -67,15 +69,17 @@ FrameSequence make_sequence(FrameSequence seq, const std::set<int>& numbers,
     if (numbers.empty()) throw Error(fmt::format("{}: no frames found", where));
     seq.first = start_number ? *start_number : *numbers.begin();
     if (!numbers.contains(seq.first))
-        throw Error(fmt::format("{}: first frame not found (start number {}; frames present are "
-                                "numbered {} .. {})", seq.frame_path(seq.first).string(), seq.first,
-                                *numbers.begin(), *numbers.rbegin()));
+        throw Error(fmt::format(
+            "{}: first frame not found (start number {}; frames present are "
+            "numbered {} .. {})",
+            seq.frame_path(seq.first).string(), seq.first, *numbers.begin(), *numbers.rbegin()));
     const int last = *numbers.rbegin();
     for (int n = seq.first; n <= last; ++n) {
         if (!numbers.contains(n))
-            throw Error(fmt::format("{}: missing frame: the sequence {} has a gap (frames {} .. {} "
-                                    "present, {} missing)", seq.frame_path(n).string(),
-                                    seq.pattern(), seq.first, n - 1, n));
+            throw Error(
+                fmt::format("{}: missing frame: the sequence {} has a gap (frames {} .. {} "
+                            "present, {} missing)",
+                            seq.frame_path(n).string(), seq.pattern(), seq.first, n - 1, n));
     }
     seq.count = last - seq.first + 1;
     for (int n = seq.first; n <= last; ++n) {
@@ -85,9 +89,9 @@ FrameSequence make_sequence(FrameSequence seq, const std::set<int>& numbers,
             seq.width = w;
             seq.height = h;
         } else if (w != seq.width || h != seq.height) {
-            throw Error(fmt::format("{}: frame is {}x{} but the first frame {} is {}x{}",
-                                    path.string(), w, h, seq.frame_path(seq.first).filename().string(),
-                                    seq.width, seq.height));
+            throw Error(fmt::format(
+                "{}: frame is {}x{} but the first frame {} is {}x{}", path.string(), w, h,
+                seq.frame_path(seq.first).filename().string(), seq.width, seq.height));
         }
     }
     return seq;
@@ -159,7 +163,8 @@ FrameSequence find_frame_sequence(const fs::path& dir, std::optional<int> start_
         groups[stem.substr(0, d)][digits] = number;
     }
     if (groups.empty())
-        throw Error(fmt::format("{}: no PNG frames (files named like frame_0001.png)", dir.string()));
+        throw Error(
+            fmt::format("{}: no PNG frames (files named like frame_0001.png)", dir.string()));
 
     std::vector<FrameSequence> found;
     std::vector<std::set<int>> found_numbers;
@@ -182,9 +187,10 @@ FrameSequence find_frame_sequence(const fs::path& dir, std::optional<int> start_
             }
         }
         if (!odd.empty())
-            throw Error(fmt::format("{}: frames numbered with different zero padding: {} and {}{}",
-                                    dir.string(), seq.frame_path(*numbers.begin()).filename().string(),
-                                    odd.front(), odd.size() > 1 ? fmt::format(" ({} more)", odd.size() - 1) : ""));
+            throw Error(fmt::format(
+                "{}: frames numbered with different zero padding: {} and {}{}", dir.string(),
+                seq.frame_path(*numbers.begin()).filename().string(), odd.front(),
+                odd.size() > 1 ? fmt::format(" ({} more)", odd.size() - 1) : ""));
         found.push_back(seq);
         found_numbers.push_back(numbers);
     }
@@ -193,13 +199,16 @@ FrameSequence find_frame_sequence(const fs::path& dir, std::optional<int> start_
         for (std::size_t i = 0; i < found.size(); ++i)
             list += fmt::format("{}{} ({} files)", i ? ", " : "", found[i].pattern(),
                                 found_numbers[i].size());
-        throw Error(fmt::format("{}: several image sequences in one directory: {}; give the one to "
-                                "encode as a pattern", dir.string(), list));
+        throw Error(
+            fmt::format("{}: several image sequences in one directory: {}; give the one to "
+                        "encode as a pattern",
+                        dir.string(), list));
     }
     return make_sequence(found.front(), found_numbers.front(), start_number);
 }
 
-FrameSequence frame_sequence_from_pattern(const fs::path& pattern, std::optional<int> start_number) {
+FrameSequence frame_sequence_from_pattern(const fs::path& pattern,
+                                          std::optional<int> start_number) {
     const std::string name = pattern.filename().string();
     FrameSequence seq;
     seq.dir = pattern.parent_path().empty() ? fs::path(".") : pattern.parent_path();
@@ -221,10 +230,13 @@ FrameSequence frame_sequence_from_pattern(const fs::path& pattern, std::optional
         while (j < name.size() && name[j] >= '0' && name[j] <= '9' && width < 100)
             width = width * 10 + (name[j++] - '0');
         if (j >= name.size() || name[j] != 'd' || have_field)
-            throw Error(fmt::format("{}: frame pattern needs exactly one %d or %0Nd number field "
-                                    "(write a literal % as %%)", pattern.string()));
+            throw Error(
+                fmt::format("{}: frame pattern needs exactly one %d or %0Nd number field "
+                            "(write a literal % as %%)",
+                            pattern.string()));
         if (width > 10)
-            throw Error(fmt::format("{}: frame number width {} is too wide", pattern.string(), width));
+            throw Error(
+                fmt::format("{}: frame number width {} is too wide", pattern.string(), width));
         have_field = true;
         seq.prefix = literal;
         literal.clear();
@@ -232,7 +244,8 @@ FrameSequence frame_sequence_from_pattern(const fs::path& pattern, std::optional
         i = j;
     }
     if (!have_field)
-        throw Error(fmt::format("{}: frame pattern has no %d or %0Nd number field", pattern.string()));
+        throw Error(
+            fmt::format("{}: frame pattern has no %d or %0Nd number field", pattern.string()));
     seq.suffix = literal;
     require_directory(seq.dir);
 
@@ -258,16 +271,16 @@ FrameSequence frame_sequence_from_pattern(const fs::path& pattern, std::optional
 
 std::vector<std::string> ffmpeg_arguments(const EncodeOptions& o, const FrameSequence& frames,
                                           const fs::path& output) {
-    std::vector<std::string> a = {o.ffmpeg, "-hide_banner", "-nostdin", "-nostats",
-                                  "-loglevel", "error", "-y"};
+    std::vector<std::string> a = {o.ffmpeg,    "-hide_banner", "-nostdin", "-nostats",
+                                  "-loglevel", "error",        "-y"};
     // Input 0: the frames, read as an exact image sequence (no globbing). '%' in the names is
     // doubled, the number field kept.
     const std::string field = frames.digits > 1 ? fmt::format("%0{}d", frames.digits) : "%d";
     const std::string input = escape_percent(ffmpeg_url(frames.dir / frames.prefix)) + field +
                               escape_percent(frames.suffix);
-    a.insert(a.end(), {"-framerate", fmt::format("{}", o.fps), "-start_number",
-                       std::to_string(frames.first), "-f", "image2", "-pattern_type", "sequence",
-                       "-i", input});
+    a.insert(a.end(),
+             {"-framerate", fmt::format("{}", o.fps), "-start_number", std::to_string(frames.first),
+              "-f", "image2", "-pattern_type", "sequence", "-i", input});
 
     const bool audio = !o.audio.empty();
     if (audio) a.insert(a.end(), {"-i", ffmpeg_url(o.audio)});
@@ -286,13 +299,14 @@ std::vector<std::string> ffmpeg_arguments(const EncodeOptions& o, const FrameSeq
                                frames.width + pad_w, frames.height + pad_h, pad_w, pad_h);
     // BT.709 matrix, limited range, and tagged so: players assume BT.709 for video this size,
     // and ffmpeg's default conversion would use BT.601 untagged, shifting the toon colours.
-    filters += "scale=out_color_matrix=bt709:out_range=tv:flags=bicubic+accurate_rnd+full_chroma_int,"
-               "format=yuv420p";
+    filters +=
+        "scale=out_color_matrix=bt709:out_range=tv:flags=bicubic+accurate_rnd+full_chroma_int,"
+        "format=yuv420p";
     a.insert(a.end(), {"-vf", filters, "-c:v", "libx264", "-preset", o.preset});
     if (!o.tune.empty()) a.insert(a.end(), {"-tune", o.tune});
-    a.insert(a.end(), {"-crf", std::to_string(o.crf), "-pix_fmt", "yuv420p",
-                       "-color_primaries", "bt709", "-color_trc", "bt709", "-colorspace", "bt709",
-                       "-color_range", "tv"});
+    a.insert(a.end(),
+             {"-crf", std::to_string(o.crf), "-pix_fmt", "yuv420p", "-color_primaries", "bt709",
+              "-color_trc", "bt709", "-colorspace", "bt709", "-color_range", "tv"});
     if (audio) a.insert(a.end(), {"-c:a", "aac", "-b:a", fmt::format("{}k", o.audio_bitrate_kbps)});
     // The length of the frames, which also stops the sequence at its last checked frame. (Not
     // -frames:v: in ffmpeg 5 reaching it closes every stream of the output, audio included.)
@@ -307,10 +321,12 @@ EncodeResult encode_video(const EncodeOptions& o) {
         throw Error(fmt::format("encode: frame rate {} outside (0, 1000]", o.fps));
     if (o.crf < 0 || o.crf > 51) throw Error(fmt::format("encode: crf {} outside 0..51", o.crf));
     if (o.audio_bitrate_kbps < 8 || o.audio_bitrate_kbps > 1024)
-        throw Error(fmt::format("encode: audio bit rate {}k outside 8..1024", o.audio_bitrate_kbps));
+        throw Error(
+            fmt::format("encode: audio bit rate {}k outside 8..1024", o.audio_bitrate_kbps));
     if (o.output.empty()) throw Error("encode: no output file given");
     if (find_program(o.ffmpeg).empty())
-        throw Error(fmt::format("{} not found on PATH; install the Debian package ffmpeg", o.ffmpeg));
+        throw Error(
+            fmt::format("{} not found on PATH; install the Debian package ffmpeg", o.ffmpeg));
 
     EncodeResult result;
     if (!o.pattern.empty()) {
@@ -327,7 +343,8 @@ EncodeResult encode_video(const EncodeOptions& o) {
         // Checked here so the message names the file, instead of ffmpeg's stderr saying it.
         std::FILE* f = std::fopen(o.audio.c_str(), "rb");
         if (!f)
-            throw Error(fmt::format("{}: cannot open audio file: {}", o.audio.string(), std::strerror(errno)));
+            throw Error(fmt::format("{}: cannot open audio file: {}", o.audio.string(),
+                                    std::strerror(errno)));
         std::fclose(f);
         std::error_code ec;
         if (!fs::is_regular_file(o.audio, ec))
@@ -342,14 +359,17 @@ EncodeResult encode_video(const EncodeOptions& o) {
             throw Error(fmt::format("{}: has no audio stream", o.audio.string()));
     }
 
-    const fs::path out_dir = o.output.parent_path().empty() ? fs::path(".") : o.output.parent_path();
+    const fs::path out_dir =
+        o.output.parent_path().empty() ? fs::path(".") : o.output.parent_path();
     std::error_code ec;
     if (!fs::is_directory(out_dir, ec))
-        throw Error(fmt::format("{}: output directory {} not found", o.output.string(), out_dir.string()));
+        throw Error(
+            fmt::format("{}: output directory {} not found", o.output.string(), out_dir.string()));
     std::string tmp = (out_dir / ("." + o.output.filename().string() + ".tmp.XXXXXX")).string();
     const int fd = ::mkstemp(tmp.data());
     if (fd < 0)
-        throw Error(fmt::format("{}: cannot create a file: {}", o.output.string(), std::strerror(errno)));
+        throw Error(
+            fmt::format("{}: cannot create a file: {}", o.output.string(), std::strerror(errno)));
     ::close(fd);
     RemoveOnExit remove_tmp(tmp);
 
@@ -363,13 +383,15 @@ EncodeResult encode_video(const EncodeOptions& o) {
     }
     struct stat st {};
     if (::stat(tmp.c_str(), &st) != 0 || st.st_size == 0)
-        throw Error(fmt::format("{}: ffmpeg reported success but wrote nothing", o.output.string()));
+        throw Error(
+            fmt::format("{}: ffmpeg reported success but wrote nothing", o.output.string()));
     // mkstemp made the file 0600; give it the permissions any new file would have.
     const mode_t mask = ::umask(0);
     ::umask(mask);
     ::chmod(tmp.c_str(), 0666 & ~mask);
     if (::rename(tmp.c_str(), o.output.c_str()) != 0)
-        throw Error(fmt::format("{}: cannot rename into place: {}", o.output.string(), std::strerror(errno)));
+        throw Error(fmt::format("{}: cannot rename into place: {}", o.output.string(),
+                                std::strerror(errno)));
     remove_tmp.release();
     return result;
 }
@@ -384,7 +406,8 @@ const StreamInfo* MediaInfo::first(std::string_view type) const {
 
 MediaInfo probe_media(const fs::path& path, bool count_frames, const std::string& ffprobe) {
     if (find_program(ffprobe).empty())
-        throw Error(fmt::format("{} not found on PATH; install the Debian package ffmpeg", ffprobe));
+        throw Error(
+            fmt::format("{} not found on PATH; install the Debian package ffmpeg", ffprobe));
     std::vector<std::string> argv = {ffprobe, "-v", "error"};
     if (count_frames) argv.push_back("-count_frames");
     argv.insert(argv.end(),

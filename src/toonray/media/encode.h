@@ -52,11 +52,11 @@ struct EncodeOptions {
     /// Cut the soundtrack at the end of the last frame (a longer track would leave the player
     /// showing a frozen last frame). Off: the MP4 lasts as long as the longer stream.
     bool cut_audio_to_video = true;
-    int crf = 18;                       ///< x264 quality, 0 (lossless) .. 51; 18 looks lossless
-    std::string preset = "medium";      ///< x264 speed/size trade-off
-    std::string tune = "animation";     ///< x264 tuning for flat colours and hard edges; "" none
-    int audio_bitrate_kbps = 192;       ///< AAC bit rate
-    std::string ffmpeg = "ffmpeg";      ///< program name (searched on PATH) or path
+    int crf = 18;                    ///< x264 quality, 0 (lossless) .. 51; 18 looks lossless
+    std::string preset = "medium";   ///< x264 speed/size trade-off
+    std::string tune = "animation";  ///< x264 tuning for flat colours and hard edges; "" none
+    int audio_bitrate_kbps = 192;    ///< AAC bit rate
+    std::string ffmpeg = "ffmpeg";   ///< program name (searched on PATH) or path
     std::string ffprobe = "ffprobe";
 };
 
@@ -93,8 +93,8 @@ struct StreamInfo {
 };
 
 struct MediaInfo {
-    std::string format;     ///< container format names, e.g. "mov,mp4,m4a,3gp,3g2,mj2"
-    double duration = -1.0; ///< container duration, seconds (-1 when unknown)
+    std::string format;      ///< container format names, e.g. "mov,mp4,m4a,3gp,3g2,mj2"
+    double duration = -1.0;  ///< container duration, seconds (-1 when unknown)
     std::vector<StreamInfo> streams;
 
     /// The first stream of a type ("video", "audio"), or nullptr.

@@ -23,7 +23,8 @@ namespace {
 
 bool is_executable_file(const std::filesystem::path& path) {
     struct stat st {};
-    return ::stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode) && ::access(path.c_str(), X_OK) == 0;
+    return ::stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode) &&
+           ::access(path.c_str(), X_OK) == 0;
 }
 
 /// Closes a file descriptor once.
@@ -166,7 +167,8 @@ std::string tail_lines(std::string_view text, int max_lines) {
         text.remove_prefix(nl + 1);
     }
     std::string out;
-    std::size_t from = lines.size() > static_cast<std::size_t>(max_lines) ? lines.size() - max_lines : 0;
+    std::size_t from =
+        lines.size() > static_cast<std::size_t>(max_lines) ? lines.size() - max_lines : 0;
     for (std::size_t i = from; i < lines.size(); ++i) {
         if (!out.empty()) out += '\n';
         out += lines[i];

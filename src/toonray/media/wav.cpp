@@ -39,7 +39,8 @@ std::uint32_t get_u32(const std::string& s, std::size_t at) {
 std::vector<std::uint8_t> encode_wav(const WavAudio& audio) {
     if (audio.channels < 1 || audio.channels > 16)
         throw Error(fmt::format("WAV: unsupported channel count {}", audio.channels));
-    if (audio.sample_rate < 1) throw Error(fmt::format("WAV: invalid sample rate {}", audio.sample_rate));
+    if (audio.sample_rate < 1)
+        throw Error(fmt::format("WAV: invalid sample rate {}", audio.sample_rate));
     if (audio.samples.size() % static_cast<std::size_t>(audio.channels) != 0)
         throw Error("WAV: sample count is not a multiple of the channel count");
     // RIFF sizes are 32-bit; 4 GB is about 6.7 hours of 44.1 kHz stereo, far beyond a demo.
@@ -94,8 +95,10 @@ WavAudio read_wav(const std::filesystem::path& path) {
             const std::uint32_t bits = get_u16(data, body + 14);
             // 0xfffe is WAVE_FORMAT_EXTENSIBLE, which ffmpeg writes for some layouts.
             if ((format != 1 && format != 0xfffe) || bits != 16)
-                return fail(fmt::format("unsupported WAV encoding (format {}, {} bits); "
-                                        "16-bit PCM expected", format, bits));
+                return fail(
+                    fmt::format("unsupported WAV encoding (format {}, {} bits); "
+                                "16-bit PCM expected",
+                                format, bits));
             if (audio.channels < 1) return fail("WAV with no channels");
             have_fmt = true;
         } else if (tag == "data") {

@@ -90,7 +90,8 @@ void append_arc(std::vector<ProfilePoint>& out, float cu, float cv, float radius
     for (int i = 0; i <= segments; ++i) {
         float a = a0 + (a1 - a0) * static_cast<float>(i) / static_cast<float>(segments);
         bool end = i == 0 || i == segments;
-        out.push_back({cu + radius * portable::cos(a), cv + radius * portable::sin(a), !end || smooth_ends});
+        out.push_back(
+            {cu + radius * portable::cos(a), cv + radius * portable::sin(a), !end || smooth_ends});
     }
 }
 
@@ -204,8 +205,8 @@ void MeshBuilder::box(const Vec3f& lo, const Vec3f& hi) {
     const Vec3f pts[8] = {{lo.x, lo.y, lo.z}, {hi.x, lo.y, lo.z}, {hi.x, hi.y, lo.z},
                           {lo.x, hi.y, lo.z}, {lo.x, lo.y, hi.z}, {hi.x, lo.y, hi.z},
                           {hi.x, hi.y, hi.z}, {lo.x, hi.y, hi.z}};
-    convex_solid(pts, {{0, 1, 2, 3}, {4, 5, 6, 7}, {0, 1, 5, 4}, {3, 2, 6, 7}, {0, 3, 7, 4},
-                       {1, 2, 6, 5}});
+    convex_solid(
+        pts, {{0, 1, 2, 3}, {4, 5, 6, 7}, {0, 1, 5, 4}, {3, 2, 6, 7}, {0, 3, 7, 4}, {1, 2, 6, 5}});
 }
 
 void MeshBuilder::chamfer_box(const Vec3f& lo, const Vec3f& hi, float c) {

@@ -20,8 +20,9 @@ PianoPlayback::PianoPlayback(const Score& score, const PlaybackSettings& setting
     : settings_(settings), roll_(score, settings.roll) {
     if (!(settings.attack > 0.0) || !(settings.release > 0.0) || settings.min_hold < 0.0 ||
         settings.min_up < 0.0 || !(settings.pedal_cycle > 0.0))
-        throw Error("PianoPlayback: attack, release and pedal_cycle must be positive, min_hold and "
-                    "min_up not negative");
+        throw Error(
+            "PianoPlayback: attack, release and pedal_cycle must be positive, min_hold and "
+            "min_up not negative");
     bool any = false;
     for (const Note& note : score.notes) {
         if (note.key < kLowestKey || note.key > kHighestKey) {

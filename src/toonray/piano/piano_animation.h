@@ -30,23 +30,24 @@ namespace toonray {
 inline constexpr float kKeyDownDepth = 0.8f;
 
 struct PlaybackSettings {
-    double attack = 0.015;        ///< seconds from rest to fully down, ending at the onset
-    double release = 0.025;       ///< seconds from fully down to rest
-    double min_hold = 1.0 / 24.0; ///< a key stays fully down at least this long after onset
-    double min_up = 1.0 / 24.0;   ///< fully up at least this long between presses of one key
+    double attack = 0.015;         ///< seconds from rest to fully down, ending at the onset
+    double release = 0.025;        ///< seconds from fully down to rest
+    double min_hold = 1.0 / 24.0;  ///< a key stays fully down at least this long after onset
+    double min_up = 1.0 / 24.0;    ///< fully up at least this long between presses of one key
     float key_dip_angle = kKeyDipAngle;
-    double pedal_cycle = 1.2;     ///< seconds per pumping cycle (each pedal pressed once)
+    double pedal_cycle = 1.2;  ///< seconds per pumping cycle (each pedal pressed once)
     float pedal_stroke = kPedalStrokeAngle;
-    double pedal_lead = 0.8;      ///< pumping starts this long before the first note
-    double pedal_ease = 0.5;      ///< seconds to ease pumping in and out
-    RollGeometry roll;            ///< paper speed and window (keep it the model's)
+    double pedal_lead = 0.8;  ///< pumping starts this long before the first note
+    double pedal_ease = 0.5;  ///< seconds to ease pumping in and out
+    RollGeometry roll;        ///< paper speed and window (keep it the model's)
 };
 
 /// One press of a key after the adjustments above.
 struct KeyPress {
-    double on = 0.0;           ///< the note's onset: fully down (it starts `attack` earlier)
-    double off = 0.0;          ///< starts coming up
-    float start_depth = 0.0f;  ///< depth at on - attack (above 0 only when presses crowd each other)
+    double on = 0.0;   ///< the note's onset: fully down (it starts `attack` earlier)
+    double off = 0.0;  ///< starts coming up
+    float start_depth =
+        0.0f;  ///< depth at on - attack (above 0 only when presses crowd each other)
 };
 
 class PianoPlayback {

@@ -19,25 +19,25 @@ constexpr float kPi = 3.14159265358979f;
 // Keyboard: 52 white keys at a 23.5 mm pitch (1.222 m), centred on x = 0.
 constexpr float kWhitePitch = 0.0235f;
 constexpr float kKeyboardLeft = -26.0f * kWhitePitch;
-constexpr float kKeyGap = 0.0011f;          // between neighbouring keys
-constexpr float kKeyTop = 0.72f;            // white key top above the floor
+constexpr float kKeyGap = 0.0011f;  // between neighbouring keys
+constexpr float kKeyTop = 0.72f;    // white key top above the floor
 constexpr float kWhiteThickness = 0.022f;
 constexpr float kKeyBottom = kKeyTop - kWhiteThickness;
 constexpr float kKeyFront = 0.34f;
-constexpr float kKeyBack = 0.10f;           // pivot line (hidden under the fallboard)
-constexpr float kBlackFront = 0.29f;        // black keys stop 50 mm behind the white fronts
-constexpr float kBlackTopFront = 0.2825f;   // their front face slopes back
+constexpr float kKeyBack = 0.10f;          // pivot line (hidden under the fallboard)
+constexpr float kBlackFront = 0.29f;       // black keys stop 50 mm behind the white fronts
+constexpr float kBlackTopFront = 0.2825f;  // their front face slopes back
 constexpr float kBlackBaseWidth = 0.0130f;
 constexpr float kBlackTopWidth = 0.0096f;
 constexpr float kBlackShoulder = kKeyTop + 0.002f;  // vertical sides up to here, then taper
 constexpr float kBlackTop = kKeyTop + 0.012f;       // 12 mm above the white keys
 
 // Case.
-constexpr float kSideOuter = 0.765f;        // outer face of the side panels (|x|)
+constexpr float kSideOuter = 0.765f;  // outer face of the side panels (|x|)
 constexpr float kSideInner = 0.730f;
 constexpr float kCaseBack = -0.34f;
 constexpr float kSideFront = 0.055f;
-constexpr float kCaseTop = 1.315f;          // top board; the lid sits on it
+constexpr float kCaseTop = 1.315f;  // top board; the lid sits on it
 constexpr float kLidTop = 1.35f;
 constexpr float kLidHalfWidth = 0.778f;
 constexpr float kLidFront = 0.085f;
@@ -64,7 +64,7 @@ constexpr float kSpoolBoxBack = -0.10f;
 constexpr float kPedalX = 0.095f;
 constexpr float kPedalPivotY = 0.100f;
 constexpr float kPedalPivotZ = 0.030f;
-constexpr float kPedalRestTilt = 0.34f;     // radians, toe up
+constexpr float kPedalRestTilt = 0.34f;  // radians, toe up
 constexpr float kPedalLength = 0.245f;
 constexpr float kPedalHalfWidth = 0.052f;
 constexpr float kPedalOpeningHalfWidth = 0.20f;
@@ -112,7 +112,7 @@ std::vector<ProfilePoint> bolection_profile(float s) {
     p.push_back({0.022f * s, 0.0f});
     append_arc(p, 0.022f * s, 0.0095f * s, 0.007f * s, 1.5f * kPi, kPi, 5);  // cove
     p.pop_back();  // the bead starts where the cove ends
-    append_arc(p, 0.0105f * s, 0.0095f * s, 0.0045f * s, 0.0f, kPi, 8);     // bead
+    append_arc(p, 0.0105f * s, 0.0095f * s, 0.0045f * s, 0.0f, kPi, 8);  // bead
     p.push_back({0.0035f * s, 0.0095f * s});
     p.push_back({0.0035f * s, 0.006f * s});
     p.push_back({0.0f, 0.006f * s});
@@ -154,7 +154,8 @@ std::vector<ProfilePoint> leg_profile() {
     const int vase_steps = 28;
     for (int i = 0; i <= vase_steps; ++i) {
         float s = static_cast<float>(i) / vase_steps;
-        float bump = portable::pow(std::max(0.0f, portable::sin(kPi * portable::pow(s, 0.62f))), 1.4f);
+        float bump =
+            portable::pow(std::max(0.0f, portable::sin(kPi * portable::pow(s, 0.62f))), 1.4f);
         float r = 0.0175f + 0.002f * (1.0f - s) + 0.0215f * bump;
         p.push_back({r, 0.150f + 0.250f * s, i > 0 && i < vase_steps});
     }
@@ -253,15 +254,22 @@ void build_keys(MeshBuilder& b, PianoModel& model, const Materials& m) {
             black_edges(midi, xl, xr);
             float c = 0.5f * (xl + xr), t = 0.5f * kBlackTopWidth;
             const Vec3f pts[12] = {
-                {xl, kKeyBottom, kKeyBack}, {xr, kKeyBottom, kKeyBack},
-                {xr, kKeyBottom, kBlackFront}, {xl, kKeyBottom, kBlackFront},
-                {xl, kBlackShoulder, kKeyBack}, {xr, kBlackShoulder, kKeyBack},
-                {xr, kBlackShoulder, kBlackFront}, {xl, kBlackShoulder, kBlackFront},
-                {c - t, kBlackTop, kKeyBack}, {c + t, kBlackTop, kKeyBack},
+                {xl, kKeyBottom, kKeyBack},         {xr, kKeyBottom, kKeyBack},
+                {xr, kKeyBottom, kBlackFront},      {xl, kKeyBottom, kBlackFront},
+                {xl, kBlackShoulder, kKeyBack},     {xr, kBlackShoulder, kKeyBack},
+                {xr, kBlackShoulder, kBlackFront},  {xl, kBlackShoulder, kBlackFront},
+                {c - t, kBlackTop, kKeyBack},       {c + t, kBlackTop, kKeyBack},
                 {c + t, kBlackTop, kBlackTopFront}, {c - t, kBlackTop, kBlackTopFront}};
-            b.convex_solid(pts, {{0, 1, 2, 3}, {8, 9, 10, 11}, {0, 1, 5, 4}, {1, 2, 6, 5},
-                                 {2, 3, 7, 6}, {3, 0, 4, 7}, {4, 5, 9, 8}, {5, 6, 10, 9},
-                                 {6, 7, 11, 10}, {7, 4, 8, 11}});
+            b.convex_solid(pts, {{0, 1, 2, 3},
+                                 {8, 9, 10, 11},
+                                 {0, 1, 5, 4},
+                                 {1, 2, 6, 5},
+                                 {2, 3, 7, 6},
+                                 {3, 0, 4, 7},
+                                 {4, 5, 9, 8},
+                                 {5, 6, 10, 9},
+                                 {6, 7, 11, 10},
+                                 {7, 4, 8, 11}});
             key.width = xr - xl;
             key.front_top = {c, kBlackTop, kBlackTopFront};
             part.pivot = {c, kKeyBottom, kKeyBack};
@@ -276,7 +284,9 @@ void build_keys(MeshBuilder& b, PianoModel& model, const Materials& m) {
 /// A U-shaped path at height y along the left side, the front and the right side of the case,
 /// counter-clockwise seen from above (so a sweep's outside is away from the case).
 std::vector<Vec3f> u_path(float y, float half_width, float front) {
-    return {{-half_width, y, kCaseBack}, {-half_width, y, front}, {half_width, y, front},
+    return {{-half_width, y, kCaseBack},
+            {-half_width, y, front},
+            {half_width, y, front},
             {half_width, y, kCaseBack}};
 }
 
@@ -354,8 +364,10 @@ void build_lower_front(MeshBuilder& b, const Materials& m) {
         std::vector<ProfilePoint> bead;
         append_arc(bead, 0.0f, 0.0f, 0.006f, 0.0f, kPi, 8);
         const float e = 0.006f;
-        std::vector<Vec3f> path = {{-ow - e, kPlinthTop, z1}, {-ow - e, ot + e, z1},
-                                   {ow + e, ot + e, z1}, {ow + e, kPlinthTop, z1}};
+        std::vector<Vec3f> path = {{-ow - e, kPlinthTop, z1},
+                                   {-ow - e, ot + e, z1},
+                                   {ow + e, ot + e, z1},
+                                   {ow + e, kPlinthTop, z1}};
         b.sweep(path, false, {0.0f, 0.0f, 1.0f}, bead);
     }
     // Three raised panels above the opening.
@@ -476,8 +488,8 @@ void build_upper_front(MeshBuilder& b, const Materials& m) {
     b.box({w, kWindowBottom, z0}, {kSideInner, kWindowTop, z1});
     // Moulded frame around the spool-box window (counter-clockwise seen from the front, so the
     // moulding lies outside the opening).
-    std::vector<Vec3f> window = {{-w, kWindowBottom, z1}, {w, kWindowBottom, z1},
-                                 {w, kWindowTop, z1}, {-w, kWindowTop, z1}};
+    std::vector<Vec3f> window = {
+        {-w, kWindowBottom, z1}, {w, kWindowBottom, z1}, {w, kWindowTop, z1}, {-w, kWindowTop, z1}};
     b.sweep(window, true, {0.0f, 0.0f, 1.0f}, bolection_profile(1.0f));
     // Three raised panels above the window.
     for (float xc : {-0.47f, 0.0f, 0.47f}) {
@@ -587,8 +599,10 @@ void build_spool(MeshBuilder& b, const Materials& m, const RollGeometry& roll, f
         // Hub.
         b.set_material(m.brass);
         const float h0 = c + s * t, h1 = c + s * (t + 0.012f);
-        std::vector<ProfilePoint> hub = {{0.0f, std::min(h0, h1)}, {0.011f, std::min(h0, h1)},
-                                         {0.011f, std::max(h0, h1)}, {0.0f, std::max(h0, h1)}};
+        std::vector<ProfilePoint> hub = {{0.0f, std::min(h0, h1)},
+                                         {0.011f, std::min(h0, h1)},
+                                         {0.011f, std::max(h0, h1)},
+                                         {0.0f, std::max(h0, h1)}};
         b.lathe(hub, 24);
         // Three spokes on the outer face: they show the spool turning.
         b.set_material(spoke_material);

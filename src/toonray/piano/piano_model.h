@@ -44,12 +44,12 @@ struct RollGeometry {
     /// `window_bottom` (top of the take-up spool's paper) to `window_top` (the music roll).
     float window_bottom = 0.870f;
     float window_top = 0.995f;
-    float tracker_y = 0.930f;    ///< a note sounds while its slot passes this line
+    float tracker_y = 0.930f;       ///< a note sounds while its slot passes this line
     float hole_pitch = 0.0028222f;  ///< across the paper: 9 holes per inch, as real 88-note rolls
     float hole_width = 0.0018f;
     float min_slot_length = 0.002f;  ///< even the shortest note punches at least this much
-    float spool_z = -0.035f;     ///< both spool axes (parallel to x)
-    float spool_radius = 0.028f; ///< radius of the paper wound on either spool
+    float spool_z = -0.035f;         ///< both spool axes (parallel to x)
+    float spool_radius = 0.028f;     ///< radius of the paper wound on either spool
 
     /// Centre of the slot column for MIDI note `midi` across the paper (bass at -x).
     [[nodiscard]] float hole_x(int midi) const {
@@ -75,9 +75,9 @@ struct RigidPart {
 struct PianoKey : RigidPart {
     int midi = 0;
     bool black = false;
-    Vec3f front_top;  ///< rest position of the middle of the key's top front edge
-    float width = 0;  ///< at the front (white) or at the base (black)
-    float length = 0; ///< from the pivot to the front
+    Vec3f front_top;   ///< rest position of the middle of the key's top front edge
+    float width = 0;   ///< at the front (white) or at the base (black)
+    float length = 0;  ///< from the pivot to the front
 };
 
 /// The roll's hole pool: `capacity` quads (4 positions and 2 triangles each, contiguous),
@@ -110,11 +110,11 @@ struct PianoModel {
     std::uint32_t floor_object = 0;
 
     // Anchors for cameras (world space, rest pose).
-    BBox bounds;                 ///< the piano without the floor
-    Vec3f keyboard_center;       ///< middle of the white keys' visible tops
-    Vec3f roll_window_center;    ///< middle of the spool-box window, in the front board's plane
-    Vec3f pedal_center;          ///< between the two pedals' treads
-    Vec3f front_center;          ///< middle of the case front at keyboard height (a look-at point)
+    BBox bounds;               ///< the piano without the floor
+    Vec3f keyboard_center;     ///< middle of the white keys' visible tops
+    Vec3f roll_window_center;  ///< middle of the spool-box window, in the front board's plane
+    Vec3f pedal_center;        ///< between the two pedals' treads
+    Vec3f front_center;        ///< middle of the case front at keyboard height (a look-at point)
 };
 
 /// Builds the piano (and a floor) in its rest pose.

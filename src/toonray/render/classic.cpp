@@ -105,9 +105,10 @@ void normal_row(const Vec3f* normals, const float* distance, int w, Rgb8* out) {
     for (; i + 16 <= values; i += 16) {
         auto channel = [&](int j) {
             // (n * 0.5 + 0.5) * 255 as normal_channel_to_byte computes it.
-            const __m128 scaled = _mm_mul_ps(_mm_add_ps(_mm_mul_ps(_mm_loadu_ps(n + i + j), _mm_set1_ps(0.5f)),
-                                                        _mm_set1_ps(0.5f)),
-                                             _mm_set1_ps(255.0f));
+            const __m128 scaled =
+                _mm_mul_ps(_mm_add_ps(_mm_mul_ps(_mm_loadu_ps(n + i + j), _mm_set1_ps(0.5f)),
+                                      _mm_set1_ps(0.5f)),
+                           _mm_set1_ps(255.0f));
             return round_half_away_low_byte_x4(scaled);
         };
         store_bytes_x16(bytes + i, channel(0), channel(4), channel(8), channel(12));
@@ -119,8 +120,8 @@ void normal_row(const Vec3f* normals, const float* distance, int w, Rgb8* out) {
 
 // Squared Sobel magnitudes gx^2 + gy^2 of one row of n values interleaved `stride` to a pixel
 // (one per channel), from the three rows around it. vert and diff are scratch of n + 2 stride.
-void sobel_row(const std::uint8_t* up, const std::uint8_t* mid, const std::uint8_t* down, int n, int stride,
-               std::int16_t* vert, std::int16_t* diff, std::int32_t* magnitude2) {
+void sobel_row(const std::uint8_t* up, const std::uint8_t* mid, const std::uint8_t* down, int n,
+               int stride, std::int16_t* vert, std::int16_t* diff, std::int32_t* magnitude2) {
     std::int16_t* v = vert + stride;
     std::int16_t* d = diff + stride;
     for (int i = 0; i < n; ++i) {
@@ -140,16 +141,18 @@ void threshold_row(const std::int32_t* magnitude2, int w, std::int32_t limit, st
     for (int x = 0; x < w; ++x) edges[x] = magnitude2[x] > limit ? 0 : 255;
 }
 
-void threshold_rgb_row(const std::int32_t* magnitude2, int w, std::int32_t limit, std::uint8_t* edges) {
+void threshold_rgb_row(const std::int32_t* magnitude2, int w, std::int32_t limit,
+                       std::uint8_t* edges) {
     for (int x = 0; x < w; ++x)
-        edges[x] = magnitude2[3 * x] + magnitude2[3 * x + 1] + magnitude2[3 * x + 2] > limit ? 0 : 255;
+        edges[x] =
+            magnitude2[3 * x] + magnitude2[3 * x + 1] + magnitude2[3 * x + 2] > limit ? 0 : 255;
 }
 
 // The blur weights k = blur(E) / 16 of one row, from the 0/1 edge flags of the rows around it,
 // once per channel (3w values) so the colour rows can be weighted as flat arrays. column is
 // scratch of w + 2.
-void blur_weight_row(const std::uint8_t* up, const std::uint8_t* mid, const std::uint8_t* down, int w,
-                     std::int16_t* column, float* weight3) {
+void blur_weight_row(const std::uint8_t* up, const std::uint8_t* mid, const std::uint8_t* down,
+                     int w, std::int16_t* column, float* weight3) {
     std::int16_t* c = column + 1;
     for (int x = 0; x < w; ++x)
         c[x] = static_cast<std::int16_t>((up[x] != 0) + 2 * (mid[x] != 0) + (down[x] != 0));
@@ -174,7 +177,8 @@ void compose_row(const float* colour, const float* weight3, int values, std::uin
     int i = 0;
     for (; i + 16 <= values; i += 16) {
         auto weighted = [&](int j) {
-            return to_byte_x4(_mm_mul_ps(_mm_loadu_ps(colour + i + j), _mm_loadu_ps(weight3 + i + j)));
+            return to_byte_x4(
+                _mm_mul_ps(_mm_loadu_ps(colour + i + j), _mm_loadu_ps(weight3 + i + j)));
         };
         store_bytes_x16(out + i, weighted(0), weighted(4), weighted(8), weighted(12));
     }
@@ -194,8 +198,8 @@ void cel_row(const float* colour, int values, std::uint8_t* out) {
 }  // namespace
 
 float classic_cel_level(float l_dot_n) {
-    static constexpr float kRamp[16] = {0.5f,  0.5f,  0.5f,  0.5f,  0.75f, 0.75f, 0.75f, 0.75f,
-                                        1.0f,  1.0f,  1.0f,  1.0f,  1.0f,  1.0f,  1.0f,  1.0f};
+    static constexpr float kRamp[16] = {0.5f, 0.5f, 0.5f, 0.5f, 0.75f, 0.75f, 0.75f, 0.75f,
+                                        1.0f, 1.0f, 1.0f, 1.0f, 1.0f,  1.0f,  1.0f,  1.0f};
     float scaled = l_dot_n * 16.0f;
     // int() truncates toward zero as in the seed; clamp before converting so NaN or huge
     // values cannot overflow the conversion.
@@ -237,7 +241,8 @@ void classic_depth_map(const ImageF& distance, ImageGray8& out, int threads) {
     });
 }
 
-void classic_normal_map(const Image<Vec3f>& normals, const ImageF& distance, ImageRgb8& out, int threads) {
+void classic_normal_map(const Image<Vec3f>& normals, const ImageF& distance, ImageRgb8& out,
+                        int threads) {
     const int w = normals.width(), h = normals.height();
     out.reshape(w, h);  // every pixel is written below
     parallel_for(h, kRowGrain, threads, [&](int y0, int y1) {
@@ -254,7 +259,8 @@ void sobel_edges(const ImageGray8& in, float threshold, ImageGray8& edges, int t
         std::vector<std::int32_t> magnitude2(w);
         for (int y = y0; y < y1; ++y) {
             const RowTriple<std::uint8_t> rows(in, y);
-            sobel_row(rows.up, rows.mid, rows.down, w, 1, vert.data(), diff.data(), magnitude2.data());
+            sobel_row(rows.up, rows.mid, rows.down, w, 1, vert.data(), diff.data(),
+                      magnitude2.data());
             threshold_row(magnitude2.data(), w, limit, edges.row(y));
         }
     });
@@ -271,8 +277,8 @@ void sobel_edges(const ImageRgb8& in, float threshold, ImageGray8& edges, int th
         std::vector<std::int32_t> magnitude2(3 * static_cast<std::size_t>(w));
         for (int y = y0; y < y1; ++y) {
             const RowTriple<Rgb8> rows(in, y);
-            sobel_row(rows.up->data(), rows.mid->data(), rows.down->data(), 3 * w, 3, vert.data(), diff.data(),
-                      magnitude2.data());
+            sobel_row(rows.up->data(), rows.mid->data(), rows.down->data(), 3 * w, 3, vert.data(),
+                      diff.data(), magnitude2.data());
             threshold_rgb_row(magnitude2.data(), w, limit, edges.row(y));
         }
     });

@@ -34,7 +34,8 @@ inline std::uint8_t normal_channel_to_byte(float n) {
     return static_cast<std::uint8_t>(round_half_away((n * 0.5f + 0.5f) * 255.0f));
 }
 
-void classic_normal_map(const Image<Vec3f>& normals, const ImageF& distance, ImageRgb8& out, int threads);
+void classic_normal_map(const Image<Vec3f>& normals, const ImageF& distance, ImageRgb8& out,
+                        int threads);
 
 /// Sobel magnitude sqrt(gx^2 + gy^2) with clamped borders; edge pixels (magnitude > threshold)
 /// become 0, others 255 (black lines on white).

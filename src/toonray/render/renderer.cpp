@@ -19,7 +19,8 @@ Rgb8 id_colour(std::uint32_t id) {
     if (id == kNoIndex) return {0, 0, 0};
     std::uint32_t h = id * 2654435761u;
     h ^= h >> 15;
-    return {static_cast<std::uint8_t>(64 + (h & 127)), static_cast<std::uint8_t>(64 + ((h >> 8) & 127)),
+    return {static_cast<std::uint8_t>(64 + (h & 127)),
+            static_cast<std::uint8_t>(64 + ((h >> 8) & 127)),
             static_cast<std::uint8_t>(64 + ((h >> 16) & 127))};
 }
 
@@ -38,17 +39,22 @@ void gbuffer_feature_images(const GBuffer& g, Aovs& aovs) {
         for (int x = 0; x < w; ++x) {
             int fx = x * sub, fy = y * sub;
             float z = g.view_depth(fx, fy);
-            aovs.depth(x, y) = std::isfinite(z) && z_max > 0 ? static_cast<std::uint8_t>(std::lround(z / z_max * 255.0f)) : 255;
+            aovs.depth(x, y) = std::isfinite(z) && z_max > 0
+                                   ? static_cast<std::uint8_t>(std::lround(z / z_max * 255.0f))
+                                   : 255;
             Vec3f n = g.geometric_normal(fx, fy);
-            aovs.normal(x, y) = std::isfinite(z) ? Rgb8{to_byte(n.x * 0.5f + 0.5f), to_byte(n.y * 0.5f + 0.5f), to_byte(n.z * 0.5f + 0.5f)}
-                                                 : Rgb8{0, 0, 0};
+            aovs.normal(x, y) = std::isfinite(z)
+                                    ? Rgb8{to_byte(n.x * 0.5f + 0.5f), to_byte(n.y * 0.5f + 0.5f),
+                                           to_byte(n.z * 0.5f + 0.5f)}
+                                    : Rgb8{0, 0, 0};
             aovs.object_id(x, y) = id_colour(g.object(fx, fy));
             aovs.material_id(x, y) = id_colour(g.material(fx, fy));
         }
 }
 
 // gbuffer_feature_images, and the line seeds of each type filtered down.
-void robust_feature_images(const GBuffer& g, const Image<std::uint8_t>& seeds, Aovs& aovs, int threads) {
+void robust_feature_images(const GBuffer& g, const Image<std::uint8_t>& seeds, Aovs& aovs,
+                           int threads) {
     gbuffer_feature_images(g, aovs);
     resolve_seed_type(seeds, kLineSilhouette, g.sub, aovs.lines_silhouette, threads);
     resolve_seed_type(seeds, kLineCrease, g.sub, aovs.lines_crease, threads);
@@ -68,7 +74,8 @@ void average_samples(const Image<Vec3f>& fine, int sub, ImageRgb8& out, int thre
                 Vec3f sum(0.0f);
                 for (int j = 0; j < sub; ++j)
                     for (int i = 0; i < sub; ++i) sum += fine(x * sub + i, y * sub + j);
-                out(x, y) = {to_byte(sum.x * inv_n), to_byte(sum.y * inv_n), to_byte(sum.z * inv_n)};
+                out(x, y) = {to_byte(sum.x * inv_n), to_byte(sum.y * inv_n),
+                             to_byte(sum.z * inv_n)};
             }
     });
 }
@@ -98,7 +105,8 @@ Vec3f default_light(const Scene& scene, const ViewPlane& view) {
 int samples_per_side(int samples) {
     for (int sub = 1; sub <= 4; ++sub)
         if (sub * sub == samples) return sub;
-    throw Error(fmt::format("{} samples per pixel: must be 1, 4, 9 or 16 (a square grid per pixel)", samples));
+    throw Error(fmt::format("{} samples per pixel: must be 1, 4, 9 or 16 (a square grid per pixel)",
+                            samples));
 }
 
 std::span<const FeatureImage> feature_images() {
@@ -126,19 +134,22 @@ namespace {
 std::uint64_t feature_bytes_per_pixel(EdgeMode mode) {
     std::uint64_t bytes = 0;
     for (const FeatureImage& f : feature_images())
-        if (f.in(mode)) bytes += std::holds_alternative<ImageRgb8 Aovs::*>(f.image) ? sizeof(Rgb8) : 1;
+        if (f.in(mode))
+            bytes += std::holds_alternative<ImageRgb8 Aovs::*>(f.image) ? sizeof(Rgb8) : 1;
     return bytes;
 }
 
 }  // namespace
 
 std::uint64_t frame_buffer_bytes(const RenderSettings& settings) {
-    const std::uint64_t pixels = mul_saturated(static_cast<std::uint64_t>(std::max(settings.width, 0)),
-                                               static_cast<std::uint64_t>(std::max(settings.height, 0)));
+    const std::uint64_t pixels =
+        mul_saturated(static_cast<std::uint64_t>(std::max(settings.width, 0)),
+                      static_cast<std::uint64_t>(std::max(settings.height, 0)));
     const std::uint64_t final_image = sizeof(Rgb8);
     // Per sample, the G-buffer of prepare_gbuffer: colour, material and object, and the mode's
     // depth and normal.
-    const std::uint64_t gbuffer = sizeof(float) + sizeof(Vec3f) + sizeof(Vec3f) + 2 * sizeof(std::uint32_t);
+    const std::uint64_t gbuffer =
+        sizeof(float) + sizeof(Vec3f) + sizeof(Vec3f) + 2 * sizeof(std::uint32_t);
     if (settings.edges == EdgeMode::Classic) {
         // The maps the lines are drawn from (depth, normal, edges_depth, edges_normal, edges);
         // cel only as a feature image.
@@ -153,12 +164,14 @@ std::uint64_t frame_buffer_bytes(const RenderSettings& settings) {
         // The G-buffer, the line coverage (a float a pixel) and the final image. The edges,
         // pieces and strokes grow with the scene, not the image: they are not counted here.
         const std::uint64_t per_pixel =
-            sizeof(float) + final_image + (settings.feature_images ? feature_bytes_per_pixel(EdgeMode::Ink) : 0);
+            sizeof(float) + final_image +
+            (settings.feature_images ? feature_bytes_per_pixel(EdgeMode::Ink) : 0);
         return mul_saturated(pixels, add_saturated(mul_saturated(gbuffer, samples), per_pixel));
     }
     const float thickness = line_thickness(settings.lines.width, settings.height, sub);
     const std::uint64_t per_sample =
-        gbuffer + 1 /* line seed */ + (line_distance_band(thickness) > kMaxDistanceBand ? sizeof(float) : 0);
+        gbuffer + 1 /* line seed */ +
+        (line_distance_band(thickness) > kMaxDistanceBand ? sizeof(float) : 0);
     const std::uint64_t per_pixel =
         final_image + (settings.feature_images ? feature_bytes_per_pixel(EdgeMode::Robust) : 0);
     return mul_saturated(pixels, add_saturated(mul_saturated(per_sample, samples), per_pixel));
@@ -221,8 +234,9 @@ void shade_tile_rows(const ShadingContext& ctx, const ViewPlane& view, const Vec
                 normal[i] = geometric_normal(scene, hit, dir);
             }
             const std::uint32_t m = scene.tri_material[hit.prim];
-            colour[i] = plain && !material_texture(ctx, m) ? shade_plain(ctx, *plain, hit, view.eye, dir, n)
-                                                            : shade_hit(ctx, hit, view.eye, dir, n);
+            colour[i] = plain && !material_texture(ctx, m)
+                            ? shade_plain(ctx, *plain, hit, view.eye, dir, n)
+                            : shade_hit(ctx, hit, view.eye, dir, n);
             material[i] = m;
             object[i] = scene.tri_object[hit.prim];
         }
@@ -235,8 +249,7 @@ void shade_tile(const ShadingContext& ctx, const ViewPlane& view, const RenderSe
                 const SampleTile& tile, GBuffer& g) {
     if (settings.edges == EdgeMode::Classic)
         shade_tile_rows<true>(ctx, view, settings.background, tile, g);
-    else
-        shade_tile_rows<false>(ctx, view, settings.background, tile, g);
+    else shade_tile_rows<false>(ctx, view, settings.background, tile, g);
 }
 
 void Renderer::trace(const Scene& scene, const TriangleAccel& accel, const ViewPlane& view,
@@ -280,7 +293,8 @@ void Renderer::render_classic(const RenderSettings& settings) {
     sobel_edges(aovs_.depth, settings.depth_threshold, aovs_.edges_depth, threads);
     sobel_edges(aovs_.normal, settings.normal_threshold, aovs_.edges_normal, threads);
     merge_edges(aovs_.edges_depth, aovs_.edges_normal, aovs_.edges);
-    compose_lines(gbuffer_.colour, aovs_.edges, final_, threads, settings.feature_images ? &aovs_.cel : nullptr);
+    compose_lines(gbuffer_.colour, aovs_.edges, final_, threads,
+                  settings.feature_images ? &aovs_.cel : nullptr);
 }
 
 void Renderer::render_robust(const RenderSettings& settings) {
@@ -292,7 +306,8 @@ void Renderer::render_robust(const RenderSettings& settings) {
     // Distance to the seeds and line coverage in one banded pass: no full-size distance image.
     const bool features = settings.feature_images;
     resolve_lines_from_seeds(g.colour, seeds_, thickness, g.sub, settings.lines.colour, final_,
-                             features ? &aovs_.cel : nullptr, features ? &aovs_.edges : nullptr, threads);
+                             features ? &aovs_.cel : nullptr, features ? &aovs_.edges : nullptr,
+                             threads);
     if (features) robust_feature_images(g, seeds_, aovs_, threads);
 }
 
@@ -303,7 +318,8 @@ void Renderer::render_ink(const Scene& scene, const TriangleAccel& accel, const 
     average_samples(g.colour, g.sub, final_, threads);
     const bool features = settings.feature_images;
     if (features) aovs_.cel = final_;
-    ink::draw_ink_lines(scene, accel, camera, settings.width, settings.height, ink_settings(settings), threads, ink_);
+    ink::draw_ink_lines(scene, accel, camera, settings.width, settings.height,
+                        ink_settings(settings), threads, ink_);
     ink::composite_lines(ink_.coverage, settings.lines.colour, final_);
     if (features) {
         ink::coverage_to_gray(ink_.coverage, aovs_.edges);

@@ -30,15 +30,15 @@ struct RenderSettings {
     int width = 1280;
     int height = 720;
     std::optional<Vec3f> light;  ///< the point light when shading.lights is empty; default: the
-                                 ///< eye moved by half the scene radius along the camera's up and right
-    ShadingSettings shading;     ///< ramp, extra lights, shadows, specular, rim, textures
-    Vec3f background{1.0f};      ///< colour of pixels that hit nothing
+        ///< eye moved by half the scene radius along the camera's up and right
+    ShadingSettings shading;  ///< ramp, extra lights, shadows, specular, rim, textures
+    Vec3f background{1.0f};   ///< colour of pixels that hit nothing
     EdgeMode edges = EdgeMode::Robust;
     float depth_threshold = 8.0f;   ///< classic: Sobel magnitude on the 8-bit depth map
     float normal_threshold = 4.0f;  ///< classic: Sobel magnitude on the 8-bit normal map
     RobustLineSettings lines;       ///< robust and ink: line types, crease angle, width, colour
-    int samples = 4;                ///< robust and ink: samples per pixel on a regular grid (1, 4, 9 or 16)
-    int threads = 0;                ///< 0 = all hardware threads
+    int samples = 4;  ///< robust and ink: samples per pixel on a regular grid (1, 4, 9 or 16)
+    int threads = 0;  ///< 0 = all hardware threads
     /// Also compute the feature images (Renderer::aovs). The final image is the same either way.
     bool feature_images = false;
     /// Ink: also chain the hidden lines into strokes (Renderer::ink_lines, for SVG), with the
@@ -53,26 +53,27 @@ int samples_per_side(int samples);
 /// Per-sample results of the primary rays. Classic mode fills distance and normal; robust mode
 /// fills view_depth and geometric_normal, on a grid `sub` times finer than the image.
 struct GBuffer {
-    int sub = 1;                       ///< samples per pixel side
-    ImageF distance;                   ///< Euclidean distance from the eye; +inf where the ray misses
-    Image<Vec3f> normal;               ///< shading normal facing the viewer; zero where the ray misses
-    ImageF view_depth;                 ///< distance along the view direction; +inf where it misses
-    Image<Vec3f> geometric_normal;     ///< facing the viewer; zero where the ray misses
-    Image<Vec3f> colour;               ///< cel-shaded colour (background where the ray misses)
-    Image<std::uint32_t> material;     ///< kNoIndex where the ray misses
-    Image<std::uint32_t> object;       ///< kNoIndex where the ray misses
+    int sub = 1;                    ///< samples per pixel side
+    ImageF distance;                ///< Euclidean distance from the eye; +inf where the ray misses
+    Image<Vec3f> normal;            ///< shading normal facing the viewer; zero where the ray misses
+    ImageF view_depth;              ///< distance along the view direction; +inf where it misses
+    Image<Vec3f> geometric_normal;  ///< facing the viewer; zero where the ray misses
+    Image<Vec3f> colour;            ///< cel-shaded colour (background where the ray misses)
+    Image<std::uint32_t> material;  ///< kNoIndex where the ray misses
+    Image<std::uint32_t> object;    ///< kNoIndex where the ray misses
 };
 
 /// Feature images a user tunes thresholds with; all 8-bit. Which are filled depends on the
 /// line mode (see feature_images()).
 struct Aovs {
-    ImageGray8 depth;         ///< lighter = farther
+    ImageGray8 depth;  ///< lighter = farther
     ImageRgb8 normal;
     ImageGray8 edges_depth;   ///< classic: Sobel lines of the depth map, black on white
     ImageGray8 edges_normal;  ///< classic: Sobel lines of the normal map
     ImageGray8 edges;         ///< all lines: classic merged before blur; robust and ink coverage
     ImageRgb8 cel;            ///< colour without lines
-    ImageGray8 lines_silhouette, lines_crease, lines_depth, lines_object, lines_material;  ///< robust
+    ImageGray8 lines_silhouette, lines_crease, lines_depth, lines_object,
+        lines_material;                ///< robust
     ImageRgb8 object_id, material_id;  ///< robust and ink: ids in false colour
 };
 
@@ -125,8 +126,9 @@ public:
     /// Renders the final image. `textures` are the decoded textures of the scene's materials
     /// (null: none). Never throws for a valid scene, camera and settings; the camera must
     /// already have been validated (make_view_plane throws on a bad one).
-    const ImageRgb8& render(const Scene& scene, const TriangleAccel& accel, const CameraSpec& camera,
-                            const RenderSettings& settings, const TextureSet* textures = nullptr);
+    const ImageRgb8& render(const Scene& scene, const TriangleAccel& accel,
+                            const CameraSpec& camera, const RenderSettings& settings,
+                            const TextureSet* textures = nullptr);
 
     /// Valid after render(): the G-buffer of the last frame.
     [[nodiscard]] const GBuffer& gbuffer() const { return gbuffer_; }

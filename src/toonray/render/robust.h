@@ -14,11 +14,13 @@ namespace toonray {
 
 /// Line types, combinable as bits (`--lines silhouette,crease,depth,object,material`).
 enum LineType : unsigned {
-    kLineSilhouette = 1u << 0,  ///< surface next to background, or in front of something much farther
-    kLineCrease = 1u << 1,      ///< geometric normals of neighbours differ by more than the crease angle
-    kLineDepth = 1u << 2,       ///< a step in depth where the surface is not a continuous plane or slope
-    kLineObject = 1u << 3,      ///< neighbours belong to different objects
-    kLineMaterial = 1u << 4,    ///< neighbours have different materials
+    kLineSilhouette =
+        1u << 0,  ///< surface next to background, or in front of something much farther
+    kLineCrease =
+        1u << 1,           ///< geometric normals of neighbours differ by more than the crease angle
+    kLineDepth = 1u << 2,  ///< a step in depth where the surface is not a continuous plane or slope
+    kLineObject = 1u << 3,    ///< neighbours belong to different objects
+    kLineMaterial = 1u << 4,  ///< neighbours have different materials
     kLineAll = 31u,
 };
 
@@ -28,14 +30,14 @@ unsigned parse_line_types(const std::string& text);
 
 struct RobustLineSettings {
     unsigned types = kLineAll;
-    float crease_angle = 40.0f;      ///< degrees between neighbouring geometric normals
+    float crease_angle = 40.0f;  ///< degrees between neighbouring geometric normals
     /// Depth lines where |second difference of 1/z| / (1/z) exceeds this. 1/z is linear in
     /// screen space across any plane, so planes never cross it however steep the view.
     float depth_threshold = 0.02f;
     /// A depth discontinuity larger than this fraction of the nearer depth is a silhouette
     /// (one thing in front of another) rather than a depth line (a fold of one surface).
     float silhouette_ratio = 0.1f;
-    float width = 2.0f;              ///< line width in pixels at 720 lines; scales with image height
+    float width = 2.0f;  ///< line width in pixels at 720 lines; scales with image height
     Vec3f colour{0.0f};
 };
 
@@ -49,8 +51,8 @@ struct FineBuffers {
 
 /// Marks line seeds: each fine pixel gets the bits of the line types found between it and a
 /// 4-neighbour, on the nearer of the two (the foreground owns the line). 0 = no line.
-void find_line_seeds(const FineBuffers& fine, const RobustLineSettings& settings, Image<std::uint8_t>& seeds,
-                     int threads);
+void find_line_seeds(const FineBuffers& fine, const RobustLineSettings& settings,
+                     Image<std::uint8_t>& seeds, int threads);
 
 /// Squared Euclidean distance (in fine pixels) from every pixel to the nearest non-zero seed
 /// (Felzenszwalb and Huttenlocher's linear-time transform, exact). +inf where there is none.
@@ -64,8 +66,8 @@ inline constexpr int kMaxDistanceBand = 64;
 /// seed: the exact d^2 wherever d < band + 1, else (band + 1)^2 (also where there is no seed).
 /// Looks only band pixels around each pixel, so it costs O(band) per pixel. Throws Error for a
 /// band outside [0, kMaxDistanceBand].
-void distance_to_seeds_banded(const Image<std::uint8_t>& seeds, int band, Image<std::uint16_t>& squared_distance,
-                              int threads);
+void distance_to_seeds_banded(const Image<std::uint8_t>& seeds, int band,
+                              Image<std::uint16_t>& squared_distance, int threads);
 
 /// Line thickness in fine pixels for `width` (pixels at 720 lines), an image `height` pixels
 /// tall and `sub` x `sub` samples per pixel: width * height / 720 * sub.
@@ -77,9 +79,9 @@ float line_thickness(float width, int height, int sub);
 /// over its samples, and its colour the mean fine colour. Writes
 /// final = colour * (1 - coverage) + line * coverage and, where not null, the mean colour
 /// (`cel`) and the coverage as 8-bit (`lines`, 255 = no line: black lines on white).
-void resolve_lines(const Image<Vec3f>& fine_colour, const ImageF& squared_distance, float thickness, int sub,
-                   const Vec3f& line_colour, ImageRgb8& final_image, ImageRgb8* cel, ImageGray8* lines,
-                   int threads);
+void resolve_lines(const Image<Vec3f>& fine_colour, const ImageF& squared_distance, float thickness,
+                   int sub, const Vec3f& line_colour, ImageRgb8& final_image, ImageRgb8* cel,
+                   ImageGray8* lines, int threads);
 
 /// The band of distance_to_seeds_banded that covers every fine pixel a line of `thickness`
 /// reaches. Above kMaxDistanceBand, resolve_lines_from_seeds uses the full distance image.
@@ -89,11 +91,13 @@ int line_distance_band(float thickness);
 /// distance image unless line_distance_band(thickness) > kMaxDistanceBand: strips of rows get
 /// their distances from distance_to_seeds_banded's method, over the few pixels a line can reach
 /// (see robust.cpp for why that is exact).
-void resolve_lines_from_seeds(const Image<Vec3f>& fine_colour, const Image<std::uint8_t>& seeds, float thickness,
-                              int sub, const Vec3f& line_colour, ImageRgb8& final_image, ImageRgb8* cel,
-                              ImageGray8* lines, int threads);
+void resolve_lines_from_seeds(const Image<Vec3f>& fine_colour, const Image<std::uint8_t>& seeds,
+                              float thickness, int sub, const Vec3f& line_colour,
+                              ImageRgb8& final_image, ImageRgb8* cel, ImageGray8* lines,
+                              int threads);
 
 /// One line type's seeds filtered down to pixels (255 = none, 0 = a seed in every sample), for AOVs.
-void resolve_seed_type(const Image<std::uint8_t>& seeds, unsigned type, int sub, ImageGray8& out, int threads);
+void resolve_seed_type(const Image<std::uint8_t>& seeds, unsigned type, int sub, ImageGray8& out,
+                       int threads);
 
 }  // namespace toonray

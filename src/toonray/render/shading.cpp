@@ -52,11 +52,13 @@ ToonRamp parse_ramp(const std::string& text) {
     ToonRamp ramp;
     const std::string what = fmt::format("ramp '{}'", text);
     ramp.levels = parse_float_list(text.substr(0, at), what);
-    ramp.thresholds = at == std::string::npos ? std::vector<float>{} : parse_float_list(text.substr(at + 1), what);
+    ramp.thresholds = at == std::string::npos ? std::vector<float>{}
+                                              : parse_float_list(text.substr(at + 1), what);
     if (ramp.levels.empty()) throw Error(fmt::format("{}: needs at least one level", what));
     if (ramp.thresholds.size() + 1 != ramp.levels.size())
         throw Error(fmt::format("ramp '{}': {} levels need {} thresholds after '@', got {}", text,
-                                ramp.levels.size(), ramp.levels.size() - 1, ramp.thresholds.size()));
+                                ramp.levels.size(), ramp.levels.size() - 1,
+                                ramp.thresholds.size()));
     for (std::size_t i = 1; i < ramp.thresholds.size(); ++i)
         if (!(ramp.thresholds[i] > ramp.thresholds[i - 1]))
             throw Error(fmt::format("ramp '{}': thresholds must increase", text));
@@ -76,7 +78,8 @@ Light parse_light(const std::string& text) {
     auto at = body.find('@');
     if (at != std::string::npos) {
         auto v = parse_float_list(body.substr(at + 1), what);
-        if (v.size() != 1 || v[0] < 0) throw Error(fmt::format("{}: intensity must be one number >= 0", what));
+        if (v.size() != 1 || v[0] < 0)
+            throw Error(fmt::format("{}: intensity must be one number >= 0", what));
         light.intensity = v[0];
         body = body.substr(0, at);
     }
@@ -92,8 +95,9 @@ namespace {
 // the hit at p. Kept out of line (noinline) so that shade_hit's plain path (shade_plain), taken
 // for almost every hit of a default frame, does not pay for this function's register saves and
 // stack frame.
-[[gnu::noinline]] Vec3f shade_hit_general(const ShadingContext& ctx, const Hit& hit, const Vec3f& dir,
-                                          const Vec3f& n, const Vec3f& p, const ImageRgb8* texture) {
+[[gnu::noinline]] Vec3f shade_hit_general(const ShadingContext& ctx, const Hit& hit,
+                                          const Vec3f& dir, const Vec3f& n, const Vec3f& p,
+                                          const ImageRgb8* texture) {
     const Scene& scene = ctx.scene;
     const ShadingSettings& s = ctx.settings;
     const Material& material = scene.materials[scene.tri_material[hit.prim]];
@@ -118,10 +122,12 @@ namespace {
             if (ctx.accel.occluded(Ray{origin, to_light, distance})) continue;
         }
         diffuse += light.intensity * std::max(0.0f, l_dot_n);
-        if (s.specular && material.ns > 0.0f && (material.ks.x > 0 || material.ks.y > 0 || material.ks.z > 0)) {
+        if (s.specular && material.ns > 0.0f &&
+            (material.ks.x > 0 || material.ks.y > 0 || material.ks.z > 0)) {
             Vec3f half = normalize(to_light - dir);
             float n_dot_h = std::max(0.0f, dot(n, half));
-            if (portable::pow(n_dot_h, material.ns) > 0.5f) highlight = 1.0f;  // one hard-edged band
+            if (portable::pow(n_dot_h, material.ns) > 0.5f)
+                highlight = 1.0f;  // one hard-edged band
         }
     }
     // With one unit light this is max(0, l.n): the same band as the seed's int(l.n * 16).
@@ -133,7 +139,8 @@ namespace {
             const Vec2f& a = scene.texcoords[tt[0]];
             const Vec2f& b = scene.texcoords[tt[1]];
             const Vec2f& c = scene.texcoords[tt[2]];
-            kd = kd * sample_texture(*texture, a.x * w0 + b.x * hit.u + c.x * hit.v, a.y * w0 + b.y * hit.u + c.y * hit.v);
+            kd = kd * sample_texture(*texture, a.x * w0 + b.x * hit.u + c.x * hit.v,
+                                     a.y * w0 + b.y * hit.u + c.y * hit.v);
         }
     }
     Vec3f colour = kd * s.ramp.level(std::min(diffuse, 1.0f));
@@ -146,12 +153,13 @@ namespace {
 
 const Light* plain_point_light(const ShadingContext& ctx) {
     const ShadingSettings& s = ctx.settings;
-    const bool plain = ctx.lights.size() == 1 && ctx.lights[0].kind == Light::Kind::Point && !s.shadows &&
-                       !s.specular && !(s.rim > 0.0f);
+    const bool plain = ctx.lights.size() == 1 && ctx.lights[0].kind == Light::Kind::Point &&
+                       !s.shadows && !s.specular && !(s.rim > 0.0f);
     return plain ? &ctx.lights[0] : nullptr;
 }
 
-Vec3f shade_hit(const ShadingContext& ctx, const Hit& hit, const Vec3f& eye, const Vec3f& dir, const Vec3f& n) {
+Vec3f shade_hit(const ShadingContext& ctx, const Hit& hit, const Vec3f& eye, const Vec3f& dir,
+                const Vec3f& n) {
     const ImageRgb8* texture = material_texture(ctx, ctx.scene.tri_material[hit.prim]);
     if (const Light* light = plain_point_light(ctx); light && !texture)
         return shade_plain(ctx, *light, hit, eye, dir, n);

@@ -36,7 +36,7 @@ ToonRamp parse_ramp(const std::string& text);
 struct Light {
     enum class Kind { Point, Directional };
     Kind kind = Kind::Point;
-    Vec3f vector;            ///< point: position; directional: direction the light travels
+    Vec3f vector;  ///< point: position; directional: direction the light travels
     float intensity = 1.0f;
 };
 
@@ -47,12 +47,12 @@ Light parse_light(const std::string& text);
 
 struct ShadingSettings {
     ToonRamp ramp;
-    std::vector<Light> lights;  ///< empty: the default point light (see Renderer)
-    bool shadows = false;       ///< lights blocked by geometry do not count (toon shadows)
-    bool specular = false;      ///< hard highlight band from MTL Ks and Ns where given
-    float rim = 0.0f;           ///< rim band width in [0, 1) of (1 - n.v); 0 = off
-    float rim_strength = 0.35f; ///< how much the rim band brightens
-    bool textures = true;       ///< multiply Kd by map_Kd where a material has one
+    std::vector<Light> lights;   ///< empty: the default point light (see Renderer)
+    bool shadows = false;        ///< lights blocked by geometry do not count (toon shadows)
+    bool specular = false;       ///< hard highlight band from MTL Ks and Ns where given
+    float rim = 0.0f;            ///< rim band width in [0, 1) of (1 - n.v); 0 = off
+    float rim_strength = 0.35f;  ///< how much the rim band brightens
+    bool textures = true;        ///< multiply Kd by map_Kd where a material has one
 };
 
 /// The decoded textures of a scene's materials, by material index; a material without one
@@ -67,7 +67,7 @@ inline const ImageRgb8* texture_of(const TextureSet& textures, std::uint32_t m) 
 /// Everything shading needs for one frame.
 struct ShadingContext {
     const Scene& scene;
-    const TriangleAccel& accel;   ///< for shadow rays
+    const TriangleAccel& accel;  ///< for shadow rays
     const ShadingSettings& settings;
     const std::vector<Light>& lights;  ///< resolved (never empty)
     const TextureSet* textures = nullptr;
@@ -110,7 +110,8 @@ inline Vec3f shading_normal(const Scene& scene, const Hit& hit, const Vec3f& dir
 }
 
 /// Toon colour of a hit seen along `dir` from `eye`, with shading normal `n`.
-Vec3f shade_hit(const ShadingContext& ctx, const Hit& hit, const Vec3f& eye, const Vec3f& dir, const Vec3f& n);
+Vec3f shade_hit(const ShadingContext& ctx, const Hit& hit, const Vec3f& eye, const Vec3f& dir,
+                const Vec3f& n);
 
 /// The texture that multiplies material m's Kd in this frame, or null.
 inline const ImageRgb8* material_texture(const ShadingContext& ctx, std::uint32_t m) {
@@ -141,8 +142,8 @@ inline PointLighting light_point(const Vec3f& light_position, const Vec3f& p, co
 /// shade_hit under plain lighting (`light` from plain_point_light) on an untextured material:
 /// Kd times the ramp's band for the light's l.n. It is what shade_hit's general path computes
 /// there: its diffuse sum starts at 0 and 0 + x == x, with nothing else added.
-inline Vec3f shade_plain(const ShadingContext& ctx, const Light& light, const Hit& hit, const Vec3f& eye,
-                         const Vec3f& dir, const Vec3f& n) {
+inline Vec3f shade_plain(const ShadingContext& ctx, const Light& light, const Hit& hit,
+                         const Vec3f& eye, const Vec3f& dir, const Vec3f& n) {
     const Vec3f p = eye + dir * hit.t;
     const float diffuse = light.intensity * std::max(0.0f, light_point(light.vector, p, n).l_dot_n);
     const Material& material = ctx.scene.materials[ctx.scene.tri_material[hit.prim]];

@@ -17,18 +17,22 @@ constexpr int kTile = 16;
 // The directions of samples [x0, x1) x [y0, y1), row by row, four at a time: the same IEEE
 // operations in the same order as normalize(view.pixel_point(fx, fy) - view.eye) with
 // fx = x + 0.5 (times 1 / sub when sub > 1), so every direction is bit-identical to that.
-void tile_dirs(const ViewPlane& view, int x0, int x1, int y0, int y1, int sub, float inv_sub, Vec3f* dirs) {
+void tile_dirs(const ViewPlane& view, int x0, int x1, int y0, int y1, int sub, float inv_sub,
+               Vec3f* dirs) {
     const int tw = x1 - x0;
     // upper_left + step_x * fx, per column (pixel_point adds step_y * fy to it afterwards).
     alignas(16) float col[3][kTile] = {};
     for (int i = 0; i < tw; ++i) {
-        const float fx = sub == 1 ? static_cast<float>(x0 + i) + 0.5f : (static_cast<float>(x0 + i) + 0.5f) * inv_sub;
+        const float fx = sub == 1 ? static_cast<float>(x0 + i) + 0.5f
+                                  : (static_cast<float>(x0 + i) + 0.5f) * inv_sub;
         for (int c = 0; c < 3; ++c) col[c][i] = view.upper_left[c] + view.step_x[c] * fx;
     }
-    const __m128 ex = _mm_set1_ps(view.eye.x), ey = _mm_set1_ps(view.eye.y), ez = _mm_set1_ps(view.eye.z);
+    const __m128 ex = _mm_set1_ps(view.eye.x), ey = _mm_set1_ps(view.eye.y),
+                 ez = _mm_set1_ps(view.eye.z);
     int k = 0;
     for (int y = y0; y < y1; ++y) {
-        const float fy = sub == 1 ? static_cast<float>(y) + 0.5f : (static_cast<float>(y) + 0.5f) * inv_sub;
+        const float fy =
+            sub == 1 ? static_cast<float>(y) + 0.5f : (static_cast<float>(y) + 0.5f) * inv_sub;
         const __m128 sy_x = _mm_set1_ps(view.step_y.x * fy), sy_y = _mm_set1_ps(view.step_y.y * fy),
                      sy_z = _mm_set1_ps(view.step_y.z * fy);
         for (int i = 0; i < tw; i += 4) {
@@ -49,8 +53,8 @@ void tile_dirs(const ViewPlane& view, int x0, int x1, int y0, int y1, int sub, f
 
 }  // namespace
 
-void trace_primary(const TriangleAccel& accel, const ViewPlane& view, int width, int height, int sub,
-                   int threads, const TileShader& shade) {
+void trace_primary(const TriangleAccel& accel, const ViewPlane& view, int width, int height,
+                   int sub, int threads, const TileShader& shade) {
     const int w = width * sub, h = height * sub;
     const float inv_sub = 1.0f / static_cast<float>(sub);
     const int tiles_x = (w + kTile - 1) / kTile, tiles_y = (h + kTile - 1) / kTile;
@@ -67,7 +71,8 @@ void trace_primary(const TriangleAccel& accel, const ViewPlane& view, int width,
             tile_dirs(view, t.x0, t.x1, t.y0, t.y1, sub, inv_sub, dirs.data());
             // The whole tile at once: a frustum of ray packets, with exactly the hits that
             // accel.intersect gives ray by ray.
-            accel.intersect_tile(view.eye, dirs.data(), t.x1 - t.x0, t.y1 - t.y0, hits.data(), found.data());
+            accel.intersect_tile(view.eye, dirs.data(), t.x1 - t.x0, t.y1 - t.y0, hits.data(),
+                                 found.data());
             t.dirs = dirs.data();
             t.hits = hits.data();
             t.found = found.data();

@@ -28,7 +28,7 @@ using TileShader = std::function<void(const SampleTile&)>;
 /// (exactly the pixel centre when sub = 1) from view.eye, with a unit direction. Tiles run
 /// in parallel on `threads` threads (0 = all); each is shaded by exactly one call, so results
 /// never depend on the thread count.
-void trace_primary(const TriangleAccel& accel, const ViewPlane& view, int width, int height, int sub,
-                   int threads, const TileShader& shade);
+void trace_primary(const TriangleAccel& accel, const ViewPlane& view, int width, int height,
+                   int sub, int threads, const TileShader& shade);
 
 }  // namespace toonray

@@ -15,7 +15,8 @@ void validate_camera(const CameraSpec& camera) {
         throw Error("invalid camera: eye, gaze and up must be finite");
     // In double precision, so that large values cannot overflow into a camera that passes here
     // and yields NaN rays in make_view_plane's float arithmetic.
-    const double vx = double{camera.gaze.x} - camera.eye.x, vy = double{camera.gaze.y} - camera.eye.y,
+    const double vx = double{camera.gaze.x} - camera.eye.x,
+                 vy = double{camera.gaze.y} - camera.eye.y,
                  vz = double{camera.gaze.z} - camera.eye.z;
     const double ux = camera.up.x, uy = camera.up.y, uz = camera.up.z;
     const double view = std::sqrt(vx * vx + vy * vy + vz * vz);
@@ -24,10 +25,12 @@ void validate_camera(const CameraSpec& camera) {
     // |gaze - eye| sets the field of view (2 atan(1 / |gaze - eye|)) and up is a direction:
     // beyond 1e6 neither means anything, and the float arithmetic overflows.
     if (view > kMaxCameraLength)
-        throw Error(fmt::format("invalid camera: the gaze point is {:g} from the eye (at most 1e6; the "
-                                "distance sets the field of view, 1 gives 90 degrees)",
-                                view));
-    if (up > kMaxCameraLength) throw Error(fmt::format("invalid camera: up vector of length {:g} (at most 1e6)", up));
+        throw Error(
+            fmt::format("invalid camera: the gaze point is {:g} from the eye (at most 1e6; the "
+                        "distance sets the field of view, 1 gives 90 degrees)",
+                        view));
+    if (up > kMaxCameraLength)
+        throw Error(fmt::format("invalid camera: up vector of length {:g} (at most 1e6)", up));
     // The sine of the angle between up and the view direction; below ~0.06 degrees the view's
     // right vector is unusable.
     const double cx = vy * uz - vz * uy, cy = vz * ux - vx * uz, cz = vx * uy - vy * ux;
@@ -39,7 +42,8 @@ void validate_camera(const CameraSpec& camera) {
     const Vec3f view_dir = camera.gaze - camera.eye;
     const float view_len = length(view_dir), up_len = length(camera.up);
     if (!(view_len > 0)) throw Error("invalid camera: eye and gaze point are the same point");
-    if (!(up_len > 0) || !(length(cross(view_dir, camera.up)) > static_cast<float>(kMinUpSine) * view_len * up_len))
+    if (!(up_len > 0) ||
+        !(length(cross(view_dir, camera.up)) > static_cast<float>(kMinUpSine) * view_len * up_len))
         throw Error("invalid camera: up vector is zero or parallel to the view direction");
 }
 
@@ -94,7 +98,8 @@ CameraSpec auto_camera(std::span<const Vec3f> points, int width, int height) {
     for (const Vec3f& p : points) {
         Vec3f o = p - center;
         float need = std::max(std::abs(dot(o, right)) / (tan_x * margin),
-                              std::abs(dot(o, up)) / (tan_y * margin)) + dot(o, dir);
+                              std::abs(dot(o, up)) / (tan_y * margin)) +
+                     dot(o, dir);
         distance = std::max(distance, need);
     }
     float radius = 0.5f * length(box.extent());
@@ -119,14 +124,17 @@ CameraSpec parse_camera_spec(const std::string& text) {
         values.push_back(v);
         p = next;
         if (p < end) {
-            if (*p != ',') throw Error(fmt::format("camera '{}': expected ',' between numbers", text));
+            if (*p != ',')
+                throw Error(fmt::format("camera '{}': expected ',' between numbers", text));
             ++p;
         }
     }
     if (values.size() != 9)
-        throw Error(fmt::format("camera '{}': expected 9 numbers ex,ey,ez,gx,gy,gz,ux,uy,uz, got {}", text,
-                                values.size()));
-    return {{values[0], values[1], values[2]}, {values[3], values[4], values[5]},
+        throw Error(
+            fmt::format("camera '{}': expected 9 numbers ex,ey,ez,gx,gy,gz,ux,uy,uz, got {}", text,
+                        values.size()));
+    return {{values[0], values[1], values[2]},
+            {values[3], values[4], values[5]},
             {values[6], values[7], values[8]}};
 }
 

@@ -22,11 +22,11 @@ struct CameraSpec {
 struct ViewPlane {
     Vec3f eye;
     Vec3f upper_left;
-    Vec3f step_x;  ///< (UR - UL) / width
-    Vec3f step_y;  ///< (LL - UL) / height
-    Vec3f right;   ///< unit vector to the right of the view
-    Vec3f up;      ///< unit vector up in the image (orthogonal to right and the view direction)
-    Vec3f forward; ///< unit view direction (gaze - eye)
+    Vec3f step_x;   ///< (UR - UL) / width
+    Vec3f step_y;   ///< (LL - UL) / height
+    Vec3f right;    ///< unit vector to the right of the view
+    Vec3f up;       ///< unit vector up in the image (orthogonal to right and the view direction)
+    Vec3f forward;  ///< unit view direction (gaze - eye)
 
     [[nodiscard]] Vec3f pixel_point(float x, float y) const {
         return upper_left + step_x * x + step_y * y;

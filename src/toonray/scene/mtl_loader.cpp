@@ -40,8 +40,9 @@ void parse_mtl(std::string_view text, const std::filesystem::path& path,
             if (index.contains(key)) {
                 // The first definition wins, in this file or an earlier library, as in
                 // tinyobjloader: replacing it would recolour the faces already given it.
-                warn.add(located(file, line_number,
-                                 fmt::format("material '{}' defined again; the first definition is kept", key)));
+                warn.add(located(
+                    file, line_number,
+                    fmt::format("material '{}' defined again; the first definition is kept", key)));
                 ignored = Material{key};
                 current = &ignored;
             } else {
@@ -84,7 +85,8 @@ void parse_mtl(std::string_view text, const std::filesystem::path& path,
         } else if (kw == "illum") {
             // The specification has models 0 to 10; any whole number that fits is kept.
             const float v = parse.number(t, kw);
-            if (!(v >= -1e9f && v <= 1e9f)) parse.fail(fmt::format("illumination model {} out of range", v));
+            if (!(v >= -1e9f && v <= 1e9f))
+                parse.fail(fmt::format("illumination model {} out of range", v));
             current->illum = static_cast<int>(v);
         } else if (kw == "map_Kd") {
             // Options (-s 1 1 1, -clamp on, ...) come first; the file name is the last token.

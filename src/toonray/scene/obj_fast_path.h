@@ -72,7 +72,8 @@ inline const char* read_face_line(const char* p, const char* end, const Scene& s
         if (p == before) return nullptr;  // corners are separated by blanks
         long long index;
         Corner c{0, kNoIndex, kNoIndex};
-        if (!parse_index(p, end, index) || !resolve_index(index, scene.positions.size(), c.v)) return nullptr;
+        if (!parse_index(p, end, index) || !resolve_index(index, scene.positions.size(), c.v))
+            return nullptr;
         if (p < end && *p == '/') {
             ++p;
             if (p < end && *p != '/' &&

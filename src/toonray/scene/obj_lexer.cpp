@@ -22,7 +22,8 @@ bool is_comment(std::string_view s) {
 
 LineReader::LineReader(std::string_view text, std::string_view file, std::uint64_t max_line)
     : text_(text), file_(file), max_line_(max_line) {
-    if (text_.size() >= 3 && std::memcmp(text_.data(), "\xEF\xBB\xBF", 3) == 0) text_.remove_prefix(3);
+    if (text_.size() >= 3 && std::memcmp(text_.data(), "\xEF\xBB\xBF", 3) == 0)
+        text_.remove_prefix(3);
 }
 
 bool LineReader::next(std::string_view& line, std::size_t& line_number) {
@@ -65,9 +66,9 @@ std::string_view LineReader::take_physical() {
 
 void LineReader::too_long(std::size_t line, bool joined) const {
     LineParser(file_, line)
-        .fail_limit(Limit::LineBytes,
-                    fmt::format("line{} longer than the limit of {}", joined ? " (with its continuations)" : "",
-                                format_bytes(max_line_)));
+        .fail_limit(Limit::LineBytes, fmt::format("line{} longer than the limit of {}",
+                                                  joined ? " (with its continuations)" : "",
+                                                  format_bytes(max_line_)));
 }
 
 void LineParser::fail(std::string_view message) const { throw_at(file_, line_, message); }
@@ -99,7 +100,8 @@ float LineParser::number(Tokens& t, std::string_view what) const {
         v = dec == std::errc() ? static_cast<float>(d) : 0.0f;
         ec = std::errc();
     }
-    if (ec != std::errc() || ptr != e) fail(fmt::format("malformed number '{}' in '{}' statement", tok, what));
+    if (ec != std::errc() || ptr != e)
+        fail(fmt::format("malformed number '{}' in '{}' statement", tok, what));
     if (!std::isfinite(v)) fail(fmt::format("non-finite number '{}' in '{}' statement", tok, what));
     return v;
 }
@@ -107,7 +109,8 @@ float LineParser::number(Tokens& t, std::string_view what) const {
 void refuse_binary(std::string_view text, std::string_view file, std::string_view what) {
     const std::size_t nul = text.find('\0');
     if (nul == std::string_view::npos) return;
-    const auto line = 1 + static_cast<std::size_t>(std::count(text.begin(), text.begin() + nul, '\n'));
+    const auto line =
+        1 + static_cast<std::size_t>(std::count(text.begin(), text.begin() + nul, '\n'));
     throw_at(file, line, fmt::format("binary data (NUL byte): not {} text file", what));
 }
 

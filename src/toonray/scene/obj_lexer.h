@@ -14,7 +14,9 @@
 namespace toonray::wavefront {
 
 inline bool is_digit(char c) { return static_cast<unsigned char>(c - '0') < 10; }
-inline bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v'; }
+inline bool is_space(char c) {
+    return c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v';
+}
 /// Blanks: the separators of a line's tokens in the plain statement forms.
 inline bool is_blank(char c) { return c == ' ' || c == '\t'; }
 
@@ -108,7 +110,8 @@ inline bool scan_short_decimal(const char*& pos, const char* e, float& out) {
     std::size_t digits = 0, decimals = 0;  // size_t: a line may be longer than 2^31 bytes
     for (; p < e && is_digit(*p); ++p, ++digits) m = m * 10 + static_cast<std::uint64_t>(*p - '0');
     if (p < e && *p == '.')
-        for (++p; p < e && is_digit(*p); ++p, ++decimals) m = m * 10 + static_cast<std::uint64_t>(*p - '0');
+        for (++p; p < e && is_digit(*p); ++p, ++decimals)
+            m = m * 10 + static_cast<std::uint64_t>(*p - '0');
     digits += decimals;
     // Past 15 digits m may have wrapped, but then the result is not used.
     if (digits == 0 || digits > 15) return false;

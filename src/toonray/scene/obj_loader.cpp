@@ -21,7 +21,8 @@ namespace {
 
 std::uint32_t intern(std::unordered_map<std::string, std::uint32_t>& ids,
                      std::vector<std::string>& names, std::string_view name) {
-    auto [it, inserted] = ids.try_emplace(std::string(name), static_cast<std::uint32_t>(names.size()));
+    auto [it, inserted] =
+        ids.try_emplace(std::string(name), static_cast<std::uint32_t>(names.size()));
     if (inserted) names.emplace_back(name);
     return it->second;
 }
@@ -67,7 +68,8 @@ void reserve_for(std::string_view text, Scene& scene, const Limits& limits) {
 
 /// The corners of an 'f' statement in any form, with a precise message for each malformed or
 /// out-of-range index.
-void read_face_corners(const LineParser& parse, Tokens& t, const Scene& scene, std::vector<Corner>& corners) {
+void read_face_corners(const LineParser& parse, Tokens& t, const Scene& scene,
+                       std::vector<Corner>& corners) {
     corners.clear();
     while (!t.at_end()) {
         std::string_view tok = t.next();
@@ -91,7 +93,10 @@ void read_face_corners(const LineParser& parse, Tokens& t, const Scene& scene, s
                 auto [ptr, ec] = std::from_chars(p, e, idx[slot]);
                 if (ec == std::errc::result_out_of_range && (ptr == e || *ptr == '/'))
                     parse.fail(fmt::format("face {} index in '{}' out of range",
-                                           slot == 0 ? "vertex" : slot == 1 ? "texture" : "normal", tok));
+                                           slot == 0   ? "vertex"
+                                           : slot == 1 ? "texture"
+                                                       : "normal",
+                                           tok));
                 if (ec != std::errc() || (ptr != e && *ptr != '/'))
                     parse.fail(fmt::format("malformed face corner '{}'", tok));
                 present[slot] = true;
@@ -106,18 +111,21 @@ void read_face_corners(const LineParser& parse, Tokens& t, const Scene& scene, s
         if (!present[0]) parse.fail(fmt::format("face corner '{}' has no vertex index", tok));
         Corner c{0, kNoIndex, kNoIndex};
         if (!resolve_index(idx[0], scene.positions.size(), c.v))
-            parse.fail(idx[0] == 0 ? fmt::format("face vertex index 0 in '{}' (OBJ indices start at 1)", tok)
-                                   : fmt::format("face vertex index {} out of range ({} vertices defined so far)",
-                                                 idx[0], scene.positions.size()));
+            parse.fail(
+                idx[0] == 0
+                    ? fmt::format("face vertex index 0 in '{}' (OBJ indices start at 1)", tok)
+                    : fmt::format("face vertex index {} out of range ({} vertices defined so far)",
+                                  idx[0], scene.positions.size()));
         if (present[1] && !resolve_index(idx[1], scene.texcoords.size(), c.t))
-            parse.fail(fmt::format("face texture index {} out of range ({} defined so far)",
-                                   idx[1], scene.texcoords.size()));
+            parse.fail(fmt::format("face texture index {} out of range ({} defined so far)", idx[1],
+                                   scene.texcoords.size()));
         if (present[2] && !resolve_index(idx[2], scene.normals.size(), c.n))
-            parse.fail(fmt::format("face normal index {} out of range ({} defined so far)",
-                                   idx[2], scene.normals.size()));
+            parse.fail(fmt::format("face normal index {} out of range ({} defined so far)", idx[2],
+                                   scene.normals.size()));
         corners.push_back(c);
     }
-    if (corners.size() < 3) parse.fail(fmt::format("face needs at least 3 corners, has {}", corners.size()));
+    if (corners.size() < 3)
+        parse.fail(fmt::format("face needs at least 3 corners, has {}", corners.size()));
 }
 
 /// The camera block statement `c eye gaze up`: the indices of two vertices and a normal.
@@ -152,13 +160,12 @@ CameraSpec read_camera(const LineParser& parse, Tokens& t, const Scene& scene) {
 /// Statements that are accepted and ignored: smoothing groups are implied by vn; lines,
 /// points and free-form geometry are not rendered.
 bool is_ignored_statement(std::string_view kw) {
-    return kw == "s" || kw == "l" || kw == "p" || kw == "vp" || kw == "cstype" ||
-           kw == "deg" || kw == "curv" || kw == "curv2" || kw == "surf" || kw == "parm" ||
-           kw == "end" || kw == "mg" || kw == "lod" || kw == "usemap" || kw == "maplib" ||
-           kw == "shadow_obj" || kw == "trace_obj" || kw == "bevel" || kw == "c_interp" ||
-           kw == "d_interp" || kw == "ctech" || kw == "stech" || kw == "trim" ||
-           kw == "hole" || kw == "scrv" || kw == "sp" || kw == "con" || kw == "bmat" ||
-           kw == "step";
+    return kw == "s" || kw == "l" || kw == "p" || kw == "vp" || kw == "cstype" || kw == "deg" ||
+           kw == "curv" || kw == "curv2" || kw == "surf" || kw == "parm" || kw == "end" ||
+           kw == "mg" || kw == "lod" || kw == "usemap" || kw == "maplib" || kw == "shadow_obj" ||
+           kw == "trace_obj" || kw == "bevel" || kw == "c_interp" || kw == "d_interp" ||
+           kw == "ctech" || kw == "stech" || kw == "trim" || kw == "hole" || kw == "scrv" ||
+           kw == "sp" || kw == "con" || kw == "bmat" || kw == "step";
 }
 
 }  // namespace
@@ -195,7 +202,8 @@ void parse_obj(std::string_view text, const std::filesystem::path& path, Scene& 
     const std::uint64_t max_vertices = std::min(lim.max_vertices, kMaxIndexable);
     const std::uint64_t max_triangles = std::min(lim.max_triangles, kMaxIndexable);
     auto estimate = [&] {
-        const std::uint64_t vertices = scene.positions.size() + scene.normals.size() + scene.texcoords.size();
+        const std::uint64_t vertices =
+            scene.positions.size() + scene.normals.size() + scene.texcoords.size();
         const std::uint64_t names = scene.objects.size() + scene.materials.size();
         return lim.reserved_memory + text.size() +
                std::max<std::uint64_t>(lim.scenes_in_flight, 1) *
@@ -204,11 +212,13 @@ void parse_obj(std::string_view text, const std::filesystem::path& path, Scene& 
     auto check_estimate = [&](const LineParser& parse) {
         const std::uint64_t bytes = estimate();
         if (bytes > lim.max_memory)
-            parse.fail_limit(Limit::Memory,
-                             fmt::format("the scene so far ({} vertices, {} triangles) needs about {} of memory, "
-                                         "more than the limit of {}",
-                                         scene.positions.size(), scene.triangle_count(), format_bytes(bytes),
-                                         format_bytes(lim.max_memory)));
+            parse.fail_limit(
+                Limit::Memory,
+                fmt::format(
+                    "the scene so far ({} vertices, {} triangles) needs about {} of memory, "
+                    "more than the limit of {}",
+                    scene.positions.size(), scene.triangle_count(), format_bytes(bytes),
+                    format_bytes(lim.max_memory)));
     };
     auto grew = [&](const LineParser& parse) {
         if (memory.due(scene.positions.size() + scene.normals.size() + scene.texcoords.size() +
@@ -219,11 +229,13 @@ void parse_obj(std::string_view text, const std::filesystem::path& path, Scene& 
     // What both paths do before adding an element (so a limit names the line that exceeds it),
     // and the face's triangles from `corners`.
     auto adding_position = [&](const LineParser& parse) {
-        check_count(parse, scene.positions.size() + 1, max_vertices, "vertices ('v')", Limit::Vertices);
+        check_count(parse, scene.positions.size() + 1, max_vertices, "vertices ('v')",
+                    Limit::Vertices);
         grew(parse);
     };
     auto adding_normal = [&](const LineParser& parse) {
-        check_count(parse, scene.normals.size() + 1, max_vertices, "normals ('vn')", Limit::Vertices);
+        check_count(parse, scene.normals.size() + 1, max_vertices, "normals ('vn')",
+                    Limit::Vertices);
         grew(parse);
     };
     auto adding_texcoord = [&](const LineParser& parse) {
@@ -233,7 +245,8 @@ void parse_obj(std::string_view text, const std::filesystem::path& path, Scene& 
     };
     auto add_face = [&](const LineParser& parse) {
         if (scene.triangle_count() + (corners.size() - 2) > max_triangles)
-            parse.fail_limit(Limit::Triangles, fmt::format("more than {} triangles (the limit)", max_triangles));
+            parse.fail_limit(Limit::Triangles,
+                             fmt::format("more than {} triangles (the limit)", max_triangles));
         grew(parse);
         for (std::size_t i = 1; i + 1 < corners.size(); ++i) {
             const Corner& a = corners[0];
@@ -255,7 +268,8 @@ void parse_obj(std::string_view text, const std::filesystem::path& path, Scene& 
             float f[3];
             const char* next;
             if (begin[0] == 'f') {
-                if (is_blank(begin[1]) && within_limit(next = read_face_line(begin + 1, end, scene, corners))) {
+                if (is_blank(begin[1]) &&
+                    within_limit(next = read_face_line(begin + 1, end, scene, corners))) {
                     add_face(LineParser(file, reader.consumed_line(next)));
                     continue;
                 }
@@ -311,11 +325,13 @@ void parse_obj(std::string_view text, const std::filesystem::path& path, Scene& 
             material = it == material_ids.end() ? 0 : it->second;
             if (material == 0 && !name.empty() && warned_materials.size() < 10'000 &&
                 warned_materials.emplace(std::string(name), 0).second)
-                warn.add(located(file, line_number,
-                                 fmt::format("unknown material '{}'; using the default material", name)));
+                warn.add(located(
+                    file, line_number,
+                    fmt::format("unknown material '{}'; using the default material", name)));
         } else if (kw == "o" || kw == "g") {
             std::string_view name = t.rest();
-            if (!name.empty() && scene.objects.size() >= kMaxIndexable && !object_ids.contains(std::string(name)))
+            if (!name.empty() && scene.objects.size() >= kMaxIndexable &&
+                !object_ids.contains(std::string(name)))
                 check_indexable(parse, scene.objects.size() + 1, "objects ('o' and 'g')");
             object = name.empty() ? 0 : intern(object_ids, scene.objects, name);
             grew(parse);
@@ -323,7 +339,8 @@ void parse_obj(std::string_view text, const std::filesystem::path& path, Scene& 
             if (!options.load_materials) continue;
             while (!t.at_end()) {
                 std::string_view name = t.next();
-                std::filesystem::path library = (path.parent_path() / std::string(name)).lexically_normal();
+                std::filesystem::path library =
+                    (path.parent_path() / std::string(name)).lexically_normal();
                 // Each library once: "mtllib a.mtl a.mtl ..." must not read a.mtl again and again.
                 if (!libraries.emplace(library.string(), true).second) continue;
                 Warnings library_warnings;
@@ -348,8 +365,9 @@ void load_obj(const std::filesystem::path& path, Scene& scene, Warnings& warning
     std::string text = read_file(path, options.limits.max_input_bytes);
     // An empty file is a failed download or export, not a scene.
     if (text.find_first_not_of(" \t\r\n\f\v") == std::string::npos)
-        throw Error(located(path.string(), 0, text.empty() ? "empty file: no OBJ statements"
-                                                            : "blank file: no OBJ statements"));
+        throw Error(located(
+            path.string(), 0,
+            text.empty() ? "empty file: no OBJ statements" : "blank file: no OBJ statements"));
     parse_obj(text, path, scene, warnings, options);
 }
 

@@ -68,9 +68,10 @@ void check_name(std::string_view name, std::string_view what) {
     auto is_space = [](char c) { return c == ' ' || c == '\t' || c == '\f' || c == '\v'; };
     if (ok) ok = !is_space(name.front()) && !is_space(name.back());
     if (!ok)
-        throw Error(fmt::format("cannot write {} name '{}' to OBJ/MTL: it must be non-empty, "
-                                "without '#' or line breaks and without surrounding white space",
-                                what, name));
+        throw Error(
+            fmt::format("cannot write {} name '{}' to OBJ/MTL: it must be non-empty, "
+                        "without '#' or line breaks and without surrounding white space",
+                        what, name));
 }
 
 void check_finite(const Vec3f& v, std::string_view what, std::size_t index) {
@@ -295,8 +296,10 @@ void format_obj_impl(const Scene& scene, std::string_view mtl_name, std::string&
                 bool has_t = any_texcoords && t[c] != kNoIndex;
                 bool has_n = any_normals && n[c] != kNoIndex;
                 if (has_t && t[c] >= ntex)
-                    throw Error(fmt::format("cannot write OBJ: triangle {} uses texture coordinate "
-                                            "{} of {}", i, t[c], ntex));
+                    throw Error(
+                        fmt::format("cannot write OBJ: triangle {} uses texture coordinate "
+                                    "{} of {}",
+                                    i, t[c], ntex));
                 if (has_n && n[c] >= nnorm)
                     throw Error(fmt::format("cannot write OBJ: triangle {} uses normal {} of {}", i,
                                             n[c], nnorm));
@@ -375,8 +378,8 @@ void format_mtl(const Scene& scene, const std::filesystem::path& mtl_dir, std::s
         check_name(m.name, "material");
         for (const Vec3f* c : {&m.ka, &m.kd, &m.ks})
             if (!is_finite(*c))
-                throw Error(fmt::format("cannot write MTL: material '{}' has a non-finite colour",
-                                        m.name));
+                throw Error(
+                    fmt::format("cannot write MTL: material '{}' has a non-finite colour", m.name));
         if (!std::isfinite(m.ns) || !std::isfinite(m.d))
             throw Error(
                 fmt::format("cannot write MTL: material '{}' has a non-finite value", m.name));

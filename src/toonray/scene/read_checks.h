@@ -21,15 +21,17 @@ inline constexpr std::uint64_t kNamedBytes = 160;
 
 /// Throws LimitError(limit_kind) when `count` exceeds `limit` (never above what 32-bit indices
 /// can address).
-inline void check_count(const LineParser& parse, std::uint64_t count, std::uint64_t limit, std::string_view what,
-                        Limit limit_kind) {
+inline void check_count(const LineParser& parse, std::uint64_t count, std::uint64_t limit,
+                        std::string_view what, Limit limit_kind) {
     limit = std::min(limit, kMaxIndexable);
-    if (count > limit) parse.fail_limit(limit_kind, fmt::format("more than {} {} (the limit)", limit, what));
+    if (count > limit)
+        parse.fail_limit(limit_kind, fmt::format("more than {} {} (the limit)", limit, what));
 }
 
 /// Throws Error when `count` exceeds what 32-bit indices can address, a bound no option raises.
 inline void check_indexable(const LineParser& parse, std::uint64_t count, std::string_view what) {
-    if (count > kMaxIndexable) parse.fail(fmt::format("more than {} {} (the limit)", kMaxIndexable, what));
+    if (count > kMaxIndexable)
+        parse.fail(fmt::format("more than {} {} (the limit)", kMaxIndexable, what));
 }
 
 /// Says when to check the memory estimate: every time `count` doubles (so the cost is O(1)
@@ -57,14 +59,13 @@ public:
     WarningSink& operator=(const WarningSink&) = delete;
     ~WarningSink() {
         if (dropped_ > 0)
-            warnings_.push_back(
-                located(file_, 0, fmt::format("{} more warning{} not shown", dropped_, dropped_ == 1 ? "" : "s")));
+            warnings_.push_back(located(
+                file_, 0,
+                fmt::format("{} more warning{} not shown", dropped_, dropped_ == 1 ? "" : "s")));
     }
     void add(std::string message) {
-        if (count_++ < kMaxWarnings)
-            warnings_.push_back(std::move(message));
-        else
-            ++dropped_;
+        if (count_++ < kMaxWarnings) warnings_.push_back(std::move(message));
+        else ++dropped_;
     }
 
 private:

@@ -33,7 +33,8 @@ std::uint64_t scene_bytes(std::uint64_t vertices, std::uint64_t triangles) {
     // the packed triangles (36 bytes) and the corner list the automatic camera gathers (36
     // bytes). Measured: a 2M-triangle, 1M-vertex grid peaks at 431 MB including its 55 MB of
     // text; this estimates 518 MB.
-    return add_saturated(mul_saturated(vertices, 12 + 12 + 8), mul_saturated(triangles, 44 + 100 + 36 + 36));
+    return add_saturated(mul_saturated(vertices, 12 + 12 + 8),
+                         mul_saturated(triangles, 44 + 100 + 36 + 36));
 }
 
 }  // namespace toonray

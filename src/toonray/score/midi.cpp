@@ -231,10 +231,8 @@ private:
             open_[static_cast<std::size_t>(channel * 128 + d1)].items.push_back(OpenNote{tick, d2});
         } else if (kind == 0x80 || kind == 0x90) {
             OpenQueue& q = open_[static_cast<std::size_t>(channel * 128 + d1)];
-            if (q.empty())
-                ++unmatched_offs;
-            else
-                add_note(q.pop(), tick, d1, track, channel);
+            if (q.empty()) ++unmatched_offs;
+            else add_note(q.pop(), tick, d1, track, channel);
         } else if (kind == 0xB0 && d1 == 64) {
             score_.pedal.push_back(PedalChange{tick, d2, track, channel});
         }

@@ -84,8 +84,10 @@ public:
         if (text.size() >= 3 && std::memcmp(text.data(), "\xEF\xBB\xBF", 3) == 0)
             text.remove_prefix(3);
         if (const std::size_t nul = text.find('\0'); nul != std::string_view::npos) {
-            line_ = 1 + static_cast<std::size_t>(std::count(text.begin(), text.begin() + nul, '\n'));
-            fail("binary data (NUL byte): neither a note script nor a MIDI file (no \"MThd\" header)");
+            line_ =
+                1 + static_cast<std::size_t>(std::count(text.begin(), text.begin() + nul, '\n'));
+            fail(
+                "binary data (NUL byte): neither a note script nor a MIDI file (no \"MThd\" header)");
         }
         while (!text.empty()) {
             ++line_;
@@ -198,10 +200,8 @@ private:
             channel_ = int_argument(word, arg, 1, 16) - 1;
         } else if (word == "pedal") {
             int value = 0;
-            if (arg == "down")
-                value = 127;
-            else if (arg == "up")
-                value = 0;
+            if (arg == "down") value = 127;
+            else if (arg == "up") value = 0;
             else if (!parse_int(arg, value) || value > 127)
                 fail(fmt::format("bad pedal value '{}': expected down, up or 0..127", arg));
             score_.pedal.push_back(PedalChange{cursor(), value, track_, channel_});

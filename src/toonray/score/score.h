@@ -12,9 +12,9 @@ namespace toonray {
 struct Note {
     double start = 0.0;
     double end = 0.0;
-    int key = 60;        ///< MIDI note number; an 88-key piano spans 21 (A0) to 108 (C8)
-    int velocity = 80;   ///< 1..127
-    int track = 0;       ///< source track (MIDI) or 0 (note script)
+    int key = 60;       ///< MIDI note number; an 88-key piano spans 21 (A0) to 108 (C8)
+    int velocity = 80;  ///< 1..127
+    int track = 0;      ///< source track (MIDI) or 0 (note script)
 };
 
 /// Sustain pedal (MIDI CC64) changes.

@@ -30,8 +30,9 @@ TimedScore load_timed_score(const std::filesystem::path& path, Warnings* warning
     const std::string name = path.string();
     // An empty file is a failed download or export, not a score.
     if (data.find_first_not_of(" \t\r\n\f\v") == std::string::npos)
-        throw Error(located(name, 0, data.empty() ? "empty file: not a score (MIDI file or note script)"
-                                                  : "blank file: not a score (MIDI file or note script)"));
+        throw Error(located(name, 0,
+                            data.empty() ? "empty file: not a score (MIDI file or note script)"
+                                         : "blank file: not a score (MIDI file or note script)"));
     const std::span bytes(reinterpret_cast<const std::uint8_t*>(data.data()), data.size());
     if (is_midi(bytes)) return read_midi(bytes, name, warnings, limits);
     return parse_note_script(data, name, warnings);

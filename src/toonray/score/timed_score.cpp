@@ -14,10 +14,8 @@ void sort_last_wins(std::vector<T>& v) {
     std::vector<T> out;
     out.reserve(v.size());
     for (const T& x : v) {
-        if (!out.empty() && out.back().tick == x.tick)
-            out.back() = x;
-        else
-            out.push_back(x);
+        if (!out.empty() && out.back().tick == x.tick) out.back() = x;
+        else out.push_back(x);
     }
     v = std::move(out);
 }
