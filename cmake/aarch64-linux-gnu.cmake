@@ -22,4 +22,14 @@ set(ENV{PKG_CONFIG_LIBDIR} /usr/lib/aarch64-linux-gnu/pkgconfig:/usr/share/pkgco
 set(ENV{PKG_CONFIG_SYSROOT_DIR} "")
 
 # Target programs (tests, gtest_discover_tests' listing, the CLI in CLI tests) run under qemu.
-set(CMAKE_CROSSCOMPILING_EMULATOR qemu-aarch64 -L /usr/aarch64-linux-gnu)
+# The dynamic loader must come from the same glibc build as the libc it loads. The programs link
+# arm64 multiarch libraries (libc6:arm64 and the -dev packages), and the loader searches
+# /lib/aarch64-linux-gnu first, so it finds the multiarch libc; the loader must then be the
+# multiarch one too (prefix /). The cross toolchain's own loader (prefix /usr/aarch64-linux-gnu,
+# libc6-arm64-cross, another Debian revision) with the multiarch libc spins for ever in
+# pthread_create: every program that starts a thread (TBB: every render) never finishes.
+if(EXISTS /lib/ld-linux-aarch64.so.1)
+    set(CMAKE_CROSSCOMPILING_EMULATOR qemu-aarch64 -L /)
+else()
+    set(CMAKE_CROSSCOMPILING_EMULATOR qemu-aarch64 -L /usr/aarch64-linux-gnu)
+endif()

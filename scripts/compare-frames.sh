@@ -32,7 +32,10 @@ if has avx2 fma bmi1 bmi2 avx512f avx512vl avx512bw avx512dq; then
   add_config x86-avx512 "env TOONRAY_ACCEL_ISA=avx512 $x86"
 fi
 if [ -n "$arm_build" ]; then
-  add_config aarch64 "qemu-aarch64 -L /usr/aarch64-linux-gnu $arm_build/apps/toonray"
+  # The multiarch loader with the multiarch libc (cmake/aarch64-linux-gnu.cmake says why).
+  qemu_prefix=/
+  [ -e /lib/ld-linux-aarch64.so.1 ] || qemu_prefix=/usr/aarch64-linux-gnu
+  add_config aarch64 "qemu-aarch64 -L $qemu_prefix $arm_build/apps/toonray"
 fi
 
 # The renders: NAME, scene ("piano" for the build's own piano export), options.

@@ -40,16 +40,19 @@ if [ "${TOONRAY_TEST_PORTABILITY:-1}" != 0 ]; then
   cmake --build --preset clang --parallel "$(nproc)"
   ctest --preset clang --parallel "$(nproc)"
   stage_done "the clang-14 build and unit tests"
-  # (b) aarch64: cross g++ and the unit tests under qemu-aarch64 that finish there: the preset
-  # runs core, io, scene, score, piano and media. Rendering under qemu-aarch64 does not finish
-  # in time yet (render, anim, cli, robustness and the brute-force accel tests time out), so
-  # they and the aarch64 frame comparison are left out until that is understood.
+  # (b) aarch64: cross g++ and every unit test under qemu-aarch64 (the preset leaves out
+  # slurm|blender, as the others do; PortableMath.FloatCorrectlyRounded, whose long double
+  # reference is software quad precision on aarch64 and too slow under emulation; and
+  # Batch.MemoryStaysFlatOverThousandsOfFrames, which fails under qemu-aarch64: peak RSS grows
+  # from 57 to 576 MiB over 2000 frames; whether toonray on aarch64 or the emulator grows is
+  # not yet known, docs/cluster.md).
   cmake --preset aarch64 "${launcher[@]}" >/dev/null
   cmake --build --preset aarch64 --parallel "$(nproc)"
   ctest --preset aarch64 --parallel "$(nproc)"
   stage_done "the aarch64 cross build and its tests under qemu"
-  # (c) The same frames from every x86 kernel the CPU runs (aarch64: see (b)).
-  bash scripts/compare-frames.sh "${TOONRAY_BUILD_DIR:-build}"
+  # (c) The same frames from every x86 kernel the CPU runs and from the aarch64 build under
+  # qemu-aarch64, byte for byte.
+  bash scripts/compare-frames.sh "${TOONRAY_BUILD_DIR:-build}" build-aarch64
   stage_done "the frame comparison"
 fi
 
