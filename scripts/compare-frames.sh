@@ -4,7 +4,8 @@
 # kernel the CPU runs (TOONRAY_ACCEL_ISA = sse4.2, avx2, avx512) and, when given, the aarch64
 # build under qemu-aarch64. Scenes: the teapot, spot, tests/data/scene/mixed.obj (several
 # materials) and a piano frame exported by each build itself (so its OBJ, which piano posing
-# computes, is compared too), in both line modes, and with shadows and the specular band.
+# computes, is compared too), in the three line modes (classic, robust, ink), and with shadows
+# and the specular band.
 #
 # Usage: scripts/compare-frames.sh [X86_BUILD_DIR [AARCH64_BUILD_DIR]]   (default: build, none)
 # Environment: TOONRAY_COMPARE_DIR, where the frames go (default: a temporary directory, removed
@@ -48,6 +49,8 @@ renders=(
   "mixed_classic|tests/data/scene/mixed.obj|--edges classic --shadows --specular"
   "piano_robust|piano|--shadows --specular"
   "piano_classic|piano|--edges classic"
+  "teapot_ink|tests/data/teapot.obj|--edges ink"
+  "piano_ink|piano|--edges ink --shadows"
 )
 
 for i in "${!configs[@]}"; do

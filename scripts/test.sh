@@ -45,7 +45,11 @@ if [ "${TOONRAY_TEST_PORTABILITY:-1}" != 0 ]; then
   # reference is software quad precision on aarch64 and too slow under emulation; and
   # Batch.MemoryStaysFlatOverThousandsOfFrames, which fails under qemu-aarch64: peak RSS grows
   # from 57 to 576 MiB over 2000 frames; whether toonray on aarch64 or the emulator grows is
-  # not yet known, docs/cluster.md).
+  # not yet known, docs/cluster.md). For CI's time, also the three slowest under emulation,
+  # which test no CPU-dependent arithmetic of their own: BatchCli.InterruptStopsCleanlyAndResume-
+  # Completes (227 s: waits for frames to start and stop) and the two ink visibility checks
+  # against brute-force rays (126 and 134 s; the ink frames themselves are compared byte for
+  # byte with x86's in stage (c)).
   cmake --preset aarch64 "${launcher[@]}" >/dev/null
   cmake --build --preset aarch64 --parallel "$(nproc)"
   ctest --preset aarch64 --parallel "$(nproc)"
