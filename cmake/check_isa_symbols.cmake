@@ -21,7 +21,9 @@ foreach(obj ${objects})
     # "ADDRESS TYPE NAME": upper-case types and u, v, w are visible to other objects.
     if(line MATCHES "^[0-9a-fA-F]* ([A-Zuvw]) (.*)$")
       set(sym "${CMAKE_MATCH_2}")
-      if(NOT sym STREQUAL "toonray::accel::kernels_${isa}()")
+      # DW.ref.__gxx_personality_v0 (an unoptimised or sanitizer build's exception-handling
+      # data) is a pointer every object may emit, not code compiled for the ISA.
+      if(NOT sym STREQUAL "toonray::accel::kernels_${isa}()" AND NOT sym MATCHES "^DW\\.ref\\.")
         list(APPEND exported "${CMAKE_MATCH_1} ${sym}")
       endif()
     endif()
