@@ -18,6 +18,8 @@ demo_packages=(
   build-essential cmake ninja-build pkg-config
   # libraries
   libcli11-dev libfmt-dev libtbb-dev libdeflate-dev libpng-dev libfluidsynth-dev
+  # glTF scenes (tinygltf, its JSON and image headers) and multi-layer OpenEXR feature images
+  libtinygltf-dev nlohmann-json3-dev libstb-dev libopenexr-dev
   # media: video encoding and the piano sound
   ffmpeg fluid-soundfont-gm
 )
@@ -34,6 +36,8 @@ test_packages=(
   blender
   # the ink lines' SVG is checked against a real SVG renderer (rsvg-convert)
   librsvg2-bin
+  # Blender's glTF exporter needs numpy; EXR files are read back by a second tool (oiiotool)
+  python3-numpy openimageio-tools
 )
 # Cross building for 64-bit ARM: the libraries toonray and its unit tests link, for arm64.
 aarch64_packages=(
@@ -41,6 +45,9 @@ aarch64_packages=(
   libfmt-dev:arm64 libtbb-dev:arm64 libdeflate-dev:arm64 libpng-dev:arm64
   libfluidsynth-dev:arm64 libgtest-dev:arm64 libgmock-dev:arm64
   libtinyobjloader-dev:arm64  # the OBJ loader tests compare with it
+  libtinygltf-dev:arm64
+  # (no libopenexr-dev:arm64: Debian's OpenEXR headers cannot be installed for two architectures
+  # at once, so the aarch64 build leaves EXR output out)
 )
 
 case "$profile" in
