@@ -323,14 +323,25 @@ private:
         return out;
     }
 
+    // The accessor, with its count checked against its buffer view and the vertex limit before
+    // anything is allocated for it (read_accessor checks the rest).
     const tinygltf::Accessor& accessor_or_fail(int index, const std::string& where) const {
         check_index(index, m_.accessors.size(), where, "accessors");
         const auto& a = m_.accessors[static_cast<std::size_t>(index)];
-        // Checked again, with the buffer, by read_accessor; this keeps the allocation sane.
-        if (a.count > std::min<std::uint64_t>(kMaxIndexable, options_.limits.max_vertices))
+        if (a.bufferView >= 0) {
+            const View view =
+                buffer_view(a.bufferView, fmt::format("accessors[{}].bufferView", index));
+            if (a.count > view.length)
+                fail(fmt::format("accessors[{}].count", index),
+                     fmt::format("{} exceeds the buffer view (bufferViews[{}], {} bytes)", a.count,
+                                 a.bufferView, view.length));
+        }
+        const std::uint64_t limit =
+            std::min<std::uint64_t>(kMaxIndexable, options_.limits.max_vertices);
+        if (a.count > limit)
             throw LimitError(Limit::Vertices,
                              fmt::format("{}: accessors[{}].count: {} is more than the limit of {}",
-                                         file_, index, a.count, options_.limits.max_vertices));
+                                         file_, index, a.count, limit));
         return a;
     }
 
@@ -936,9 +947,11 @@ private:
     mutable std::size_t warning_count_ = 0;
 };
 
+// tinygltf's first error, cut short: it may quote a whole data URI.
 std::string first_line(std::string text) {
     while (!text.empty() && (text.back() == '\n' || text.back() == ' ')) text.pop_back();
     if (auto nl = text.find('\n'); nl != std::string::npos) text.resize(nl);
+    if (text.size() > 240) text = text.substr(0, 200) + "...";
     return text;
 }
 
