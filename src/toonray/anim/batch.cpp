@@ -253,7 +253,17 @@ BatchReport run_batch(const BatchOptions& options, BatchObserver* observer) {
             warnings.push_back(*w);
         if (observer)
             for (const auto& w : warnings) observer->warning(options.first, w);
-        GltfFrames source(animator, options.gltf_fps, options.render, options.output_dir,
+        // Without a camera in the file, one automatic camera for the whole run, framing the
+        // range's first frame (whatever the shard), so that the animation moves in a still frame.
+        FrameOptions render = options.render;
+        if (!render.camera && !animator.has_camera()) {
+            Scene first;
+            std::vector<Light> lights;
+            animator.pose(gltf_frame_time(options.first, options.gltf_fps), render.settings.width,
+                          render.settings.height, first, lights);
+            render.camera = choose_camera(first, render);
+        }
+        GltfFrames source(animator, options.gltf_fps, render, options.output_dir,
                           output_pattern(options));
         return run_frames(source, frames, schedule, observer);
     }

@@ -43,6 +43,8 @@ public:
     [[nodiscard]] std::optional<std::string> aspect_warning(int width, int height) const;
 
     [[nodiscard]] const GltfDocument& document() const { return doc_; }
+    /// Whether the scene has the camera posing gives (else frames need one of their own).
+    [[nodiscard]] bool has_camera() const { return camera_node_ >= 0; }
     /// The last key time of the animations played, seconds (0 without animations).
     [[nodiscard]] double duration() const;
 
