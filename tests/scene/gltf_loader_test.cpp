@@ -169,6 +169,9 @@ TEST(GltfLoader, BadFilesNameTheFileAndJsonPath) {
         {"trunc.glb", glb_text.substr(0, glb_text.size() - 10), "trunc.glb: byte 8: truncated GLB"},
         {"short.glb", glb_text.substr(0, 12), "short.glb: byte 12: truncated GLB"},
         {"json.gltf", "{\"asset\": {\"version\": \"2.0\"", "json.gltf: "},
+        {"draco.gltf", triangle_json(uri, R"(, "extensionsUsed": ["KHR_draco_mesh_compression"],
+                         "extensionsRequired": ["KHR_draco_mesh_compression"])"),
+         "draco.gltf: extensionsRequired[0]: KHR_draco_mesh_compression is not supported"},
         {"mesh.gltf", triangle_json(uri, "", R"([{"mesh": 3}])"),
          "mesh.gltf: nodes[0].mesh: meshes 3 does not exist (1 meshes)"},
     };

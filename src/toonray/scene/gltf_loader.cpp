@@ -169,6 +169,7 @@ public:
 
     GltfDocument read() {
         doc_.file = file_;
+        check_required_extensions();
         read_nodes();
         read_materials();
         read_meshes();
@@ -348,6 +349,20 @@ private:
     static void finite_or(std::vector<Vec3f>& values, const std::string&) {
         for (auto& v : values)
             if (!is_finite(v)) v = Vec3f(0.0f);
+    }
+
+    // Extensions a file needs to be read right. The ones toonray ignores only change what
+    // toon shading does not use (PBR material details, texture transforms).
+    void check_required_extensions() const {
+        for (std::size_t i = 0; i < m_.extensionsRequired.size(); ++i) {
+            const std::string& name = m_.extensionsRequired[i];
+            const bool known = name == "KHR_lights_punctual" || name == "KHR_mesh_quantization" ||
+                               name == "KHR_texture_transform" ||
+                               name.rfind("KHR_materials_", 0) == 0;
+            if (!known)
+                fail(fmt::format("extensionsRequired[{}]", i),
+                     fmt::format("{} is not supported", name));
+        }
     }
 
     void read_nodes() {
