@@ -5,7 +5,9 @@
 #include <cmath>
 
 #include "toonray/anim/gltf_frames.h"
+#include "scene/gltf_test_files.h"
 #include "toonray/frame/frame_renderer.h"
+#include "toonray/io/png.h"
 #include "support/test_support.h"
 
 namespace toonray {
@@ -243,6 +245,59 @@ TEST(GltfAnimation, MovingNodesRefitTheBvh) {
         EXPECT_EQ(renderer.accel().refitted(), frame > 0) << frame;
     }
     EXPECT_DOUBLE_EQ(gltf_frame_time(1, 24.0), 1.0 / 24.0);
+}
+
+}  // namespace
+}  // namespace toonray
+
+namespace toonray {
+namespace {
+
+// A quad facing +z, seen by a glTF camera, textured red over blue (glTF texture coordinates
+// start at the image's top left).
+std::string textured_quad(const std::string& image) {
+    std::vector<std::uint8_t> bin;
+    gltf_test::put<float>(bin, {-1, 1, 0, 1, 1, 0, 1, -1, 0, -1, -1, 0});  // 48 bytes
+    gltf_test::put<float>(bin, {0, 0, 1, 0, 1, 1, 0, 1});                  // 32 at 48
+    gltf_test::put<std::uint16_t>(bin, {0, 2, 1, 0, 3, 2});                // 12 at 80
+    return R"({"asset": {"version": "2.0"}, "scenes": [{"nodes": [0, 1]}],
+  "nodes": [{"mesh": 0, "name": "quad"}, {"camera": 0, "translation": [0, 0, 3]}],
+  "cameras": [{"type": "perspective", "perspective": {"yfov": 0.8, "znear": 0.1}}],
+  "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "TEXCOORD_0": 1}, "indices": 2,
+                              "material": 0}]}],
+  "materials": [{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}],
+  "textures": [{"source": 0}], "images": [{"uri": ")" +
+           image + R"("}],
+  "accessors": [{"bufferView": 0, "componentType": 5126, "count": 4, "type": "VEC3"},
+                {"bufferView": 1, "componentType": 5126, "count": 4, "type": "VEC2"},
+                {"bufferView": 2, "componentType": 5123, "count": 6, "type": "SCALAR"}],
+  "bufferViews": [{"buffer": 0, "byteLength": 48}, {"buffer": 0, "byteOffset": 48, "byteLength": 32},
+                  {"buffer": 0, "byteOffset": 80, "byteLength": 12}],
+  "buffers": [{"byteLength": 92, "uri": ")" +
+           gltf_test::data_uri(bin) + R"("}]})";
+}
+
+TEST(GltfAnimation, TexturesAreRightWayUp) {
+    test_support::TempDir dir("gltf_texture");
+    for (const char* image : {"red_over_blue.png", "red_over_blue.jpg"}) {
+        std::filesystem::copy_file(kSamples + image, dir / image);
+        Warnings warnings;
+        const GltfAnimator animator(
+            load_gltf(dir.write("quad.gltf", textured_quad(image)), warnings), {});
+        EXPECT_TRUE(warnings.empty()) << warnings.front();
+        Scene scene;
+        std::vector<Light> lights;
+        animator.pose(0.0, 64, 64, scene, lights);
+        ASSERT_TRUE(scene.materials[1].kd_image) << image;
+        FrameOptions options;
+        options.settings.width = options.settings.height = 64;
+        FrameRenderer renderer;
+        renderer.render(scene, choose_camera(scene, options), dir / "quad.png", options, warnings);
+        const DecodedPng png = read_png(dir / "quad.png");
+        const Rgb8 top = png.rgb(32, 24), bottom = png.rgb(32, 40);
+        EXPECT_GT(top[0], top[2] + 60) << image;
+        EXPECT_GT(bottom[2], bottom[0] + 60) << image;
+    }
 }
 
 }  // namespace
