@@ -346,7 +346,9 @@ private:
         return a;
     }
 
-    static void finite_or(std::vector<Vec3f>& values, const std::string&) {
+    // Normals and morph displacements that are not finite count as zero (a zero normal shades
+    // with the geometric one).
+    static void zero_non_finite(std::vector<Vec3f>& values) {
         for (auto& v : values)
             if (!is_finite(v)) v = Vec3f(0.0f);
     }
@@ -615,7 +617,7 @@ private:
         if (int a = attribute("NORMAL"); a >= 0) {
             prim.normals = read_vec3(a, at + ".attributes.NORMAL");
             same_count(prim.normals.size(), at + ".attributes.NORMAL");
-            finite_or(prim.normals, at);
+            zero_non_finite(prim.normals);
         }
         if (int a = attribute("TEXCOORD_0"); a >= 0) {
             const std::string where = at + ".attributes.TEXCOORD_0";
@@ -664,7 +666,7 @@ private:
                 if (name == "POSITION" || name == "NORMAL") {
                     auto values = read_vec3(index, where);
                     same_count(values.size(), where);
-                    finite_or(values, where);
+                    zero_non_finite(values);
                     (name == "POSITION" ? target.positions : target.normals) = std::move(values);
                 }
             }
