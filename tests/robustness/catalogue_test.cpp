@@ -150,6 +150,9 @@ std::vector<BadInput> catalogue() {
         {"GltfTruncatedGlb", kRender + "gltf_truncated.glb" + kTo,
          "{data}/gltf_truncated.glb: byte 8: truncated GLB: the header says 540 bytes, the file "
          "has 520"},
+        {"GltfZerosOverMemory", kRender + "gltf_zeros.gltf" + kTo + " --max-memory 512M",
+         "{data}/gltf_zeros.gltf: accessors[0] (90000000 values without a buffer view) needs "
+         "about 5.4 GiB of memory, more than the limit of 512 MiB (--max-memory raises it)"},
         {"GltfTooManyVertices", kRender + "gltf_triangle.gltf" + kTo + " --max-vertices 2",
          "{data}/gltf_triangle.gltf: accessors[0].count: 3 is more than the limit of 2 "
          "(--max-vertices raises it)"},

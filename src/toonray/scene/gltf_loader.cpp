@@ -339,6 +339,10 @@ private:
         }
         const std::uint64_t limit =
             std::min<std::uint64_t>(kMaxIndexable, options_.limits.max_vertices);
+        if (a.bufferView < 0 && a.count <= limit)  // zeros (or sparse values), not in the file
+            check_memory(add_saturated(options_.limits.reserved_memory, mul_saturated(a.count, 64)),
+                         fmt::format("{}: accessors[{}] ({} values without a buffer view)", file_,
+                                     index, a.count));
         if (a.count > limit)
             throw LimitError(Limit::Vertices,
                              fmt::format("{}: accessors[{}].count: {} is more than the limit of {}",
