@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
 
 #include "toonray/anim/gltf_frames.h"
 #include "scene/gltf_test_files.h"
@@ -279,8 +280,16 @@ std::string textured_quad(const std::string& image) {
 
 TEST(GltfAnimation, TexturesAreRightWayUp) {
     test_support::TempDir dir("gltf_texture");
-    for (const char* image : {"red_over_blue.png", "red_over_blue.jpg"}) {
-        std::filesystem::copy_file(kSamples + image, dir / image);
+    // An external PNG, an external JPEG, and the PNG embedded as a data URI.
+    std::ifstream png_file(kSamples + "red_over_blue.png", std::ios::binary);
+    const std::string png_bytes((std::istreambuf_iterator<char>(png_file)), {});
+    const std::string embedded =
+        "data:image/png;base64," +
+        gltf_test::base64(std::vector<std::uint8_t>(png_bytes.begin(), png_bytes.end()));
+    for (const std::string& image :
+         {std::string("red_over_blue.png"), std::string("red_over_blue.jpg"), embedded}) {
+        const std::string label = image.substr(0, 40);
+        if (image.rfind("data:", 0) != 0) std::filesystem::copy_file(kSamples + image, dir / image);
         Warnings warnings;
         const GltfAnimator animator(
             load_gltf(dir.write("quad.gltf", textured_quad(image)), warnings), {});
@@ -288,15 +297,15 @@ TEST(GltfAnimation, TexturesAreRightWayUp) {
         Scene scene;
         std::vector<Light> lights;
         animator.pose(0.0, 64, 64, scene, lights);
-        ASSERT_TRUE(scene.materials[1].kd_image) << image;
+        ASSERT_TRUE(scene.materials[1].kd_image) << label;
         FrameOptions options;
         options.settings.width = options.settings.height = 64;
         FrameRenderer renderer;
         renderer.render(scene, choose_camera(scene, options), dir / "quad.png", options, warnings);
         const DecodedPng png = read_png(dir / "quad.png");
         const Rgb8 top = png.rgb(32, 24), bottom = png.rgb(32, 40);
-        EXPECT_GT(top[0], top[2] + 60) << image;
-        EXPECT_GT(bottom[2], bottom[0] + 60) << image;
+        EXPECT_GT(top[0], top[2] + 60) << label;
+        EXPECT_GT(bottom[2], bottom[0] + 60) << label;
     }
 }
 
