@@ -309,5 +309,47 @@ TEST(GltfAnimation, TexturesAreRightWayUp) {
     }
 }
 
+TEST(GltfAnimation, VertexColoursMultiplyTheMaterial) {
+    // A quad facing +z: red corners at the top, blue at the bottom, on a material of Kd 0.5.
+    GltfDocument doc;
+    doc.file = "colours.gltf";
+    GltfNode quad;
+    quad.mesh = 0;
+    GltfNode camera;
+    camera.camera = 0;
+    camera.translation = {0, 0, 3};
+    doc.nodes = {quad, camera};
+    doc.roots = {0, 1};
+    doc.cameras.push_back({"cam", 0.8f, 0.0f});
+    GltfPrimitive prim;
+    prim.positions = {{-1, 1, 0}, {1, 1, 0}, {1, -1, 0}, {-1, -1, 0}};
+    prim.colours = {{1, 0, 0}, {1, 0, 0}, {0, 0, 1}, {0, 0, 1}};
+    prim.indices = {0, 2, 1, 0, 3, 2};
+    prim.material = 1;
+    doc.meshes.push_back({"quad", {prim}, {}});
+    Material half("half");
+    half.kd = Vec3f(0.5f);
+    doc.materials.push_back(half);
+    const GltfAnimator animator(std::move(doc), {});
+    Scene scene;
+    std::vector<Light> lights;
+    animator.pose(0.0, 64, 64, scene, lights);
+    ASSERT_EQ(scene.colours.size(), scene.positions.size());
+    FrameOptions options;
+    options.settings.width = options.settings.height = 64;
+    test_support::TempDir dir("gltf_colours");
+    FrameRenderer renderer;
+    Warnings warnings;
+    renderer.render(scene, choose_camera(scene, options), dir / "quad.png", options, warnings);
+    const DecodedPng png = read_png(dir / "quad.png");
+    const Rgb8 top = png.rgb(32, 12), bottom = png.rgb(32, 52);
+    EXPECT_GT(top[0], 60);  // 0.5 x red x the lit band
+    EXPECT_LT(top[0], 160);
+    EXPECT_EQ(top[1], 0);
+    EXPECT_LT(top[2], 30);
+    EXPECT_GT(bottom[2], 60);
+    EXPECT_LT(bottom[0], 30);
+}
+
 }  // namespace
 }  // namespace toonray
