@@ -2,6 +2,7 @@
 #include <string>
 
 #include "commands.h"
+#include "gltf_args.h"
 #include "hints.h"
 #include "toonray/anim/batch.h"
 #include "toonray/anim/progress.h"
@@ -17,11 +18,13 @@ struct BatchArgs {
     int jobs = 0;
     bool resume = false, fail_fast = false, quiet = false;
     RenderArgs render;
+    GltfArgs gltf;
 
     void add_to(CLI::App& app) {
         app.add_option("name", name,
                        "Animation name: frame N is read from NAME_NNNNNN.obj, "
-                       "NAME_NNNN.obj, NAMEN.obj or NAME_N.obj, the first that exists")
+                       "NAME_NNNN.obj, NAMEN.obj or NAME_N.obj, the first that exists; or a "
+                       ".gltf/.glb file, posed at N/fps seconds")
             ->required();
         app.add_option("first", first, "First frame number")
             ->required()
@@ -62,6 +65,8 @@ int run_batch(const BatchArgs& args, const CLI::App& command) {
     options.jobs = args.jobs;
     options.resume = args.resume;
     options.fail_fast = args.fail_fast;
+    options.gltf = args.gltf.pose();
+    options.gltf_fps = args.gltf.fps;
     if (!args.shard.empty()) {
         options.shard = with_flag("--shard", [&] { return parse_shard(args.shard); });
     } else if (auto slurm = shard_from_environment()) {
@@ -86,6 +91,7 @@ Subcommand add_batch_command(CLI::App& app, LimitArgs& limit_args) {
         "Render numbered frames NAME FIRST LAST to a PNG sequence (all render options apply)");
     args->add_to(*batch);
     args->render.add_to(*batch);
+    args->gltf.add_to(*batch, false);
     limit_args.add_to(*batch);
     return {batch, [args, batch] { return run_batch(*args, *batch); }};
 }

@@ -2,10 +2,14 @@
 #include <string>
 
 #include "commands.h"
+#include "gltf_args.h"
 #include "toonray/anim/batch.h"
+#include "toonray/anim/gltf_frames.h"
 #include "toonray/core/error.h"
 #include "toonray/core/limits.h"
+#include "toonray/core/saturating.h"
 #include "toonray/frame/frame_renderer.h"
+#include "toonray/scene/gltf_loader.h"
 #include "toonray/scene/obj_loader.h"
 
 namespace toonray::cli {
@@ -15,7 +19,26 @@ struct RenderCommandArgs {
     RenderArgs render;
     std::string input, output, svg;
     bool svg_hidden = false;
+    GltfArgs gltf;
 };
+
+// A glTF scene posed at the time asked for, lit by its own lights unless lights are given.
+void render_gltf(const RenderCommandArgs& args, const FrameOptions& options, Warnings& warnings) {
+    GltfDocument document = load_gltf(args.input, warnings);
+    check_memory(
+        add_saturated(limits().reserved_memory, scene_bytes(document.vertices, document.triangles)),
+        args.input);
+    const GltfAnimator animator(std::move(document), args.gltf.pose());
+    if (auto w = animator.aspect_warning(options.settings.width, options.settings.height))
+        warnings.push_back(*w);
+    Scene scene;
+    std::vector<Light> lights;
+    animator.pose(args.gltf.seconds(), options.settings.width, options.settings.height, scene,
+                  lights);
+    const FrameOptions lit = with_gltf_lights(options, lights);
+    FrameRenderer renderer;
+    renderer.render(scene, choose_camera(scene, lit), args.output, lit, warnings);
+}
 
 int run_render(const RenderCommandArgs& args) {
     FrameOptions options = args.render.resolve();
@@ -32,6 +55,13 @@ int run_render(const RenderCommandArgs& args) {
         set_limits(l);
     }
     Warnings warnings;
+    if (is_gltf_path(args.input)) {
+        render_gltf(args, options, warnings);
+        print_warnings(warnings);
+        return 0;
+    }
+    if (args.gltf.given())
+        throw Error("--animation, --camera-node, --time and --frame need a glTF scene");
     Scene scene;
     load_obj(args.input, scene, warnings);
     FrameRenderer renderer;
@@ -44,8 +74,10 @@ int run_render(const RenderCommandArgs& args) {
 
 Subcommand add_render_command(CLI::App& app, LimitArgs& limit_args) {
     auto args = std::make_shared<RenderCommandArgs>();
-    CLI::App* render = app.add_subcommand("render", "Render one OBJ scene to a PNG image");
-    render->add_option("scene", args->input, "OBJ file (with its camera block, if any)")
+    CLI::App* render = app.add_subcommand("render", "Render one OBJ or glTF scene to a PNG image");
+    render
+        ->add_option("scene", args->input,
+                     "OBJ file (with its camera block, if any), or glTF (.gltf, .glb)")
         ->required()
         ->check(CLI::ExistingFile);
     render->add_option("-o,--output", args->output, "Output PNG file")->required();
@@ -56,6 +88,7 @@ Subcommand add_render_command(CLI::App& app, LimitArgs& limit_args) {
         "grouped by type (silhouette, border, crease, material, intersection)");
     render->add_flag("--svg-hidden", args->svg_hidden,
                      "With --svg: also write the hidden lines, in a layer of their own");
+    args->gltf.add_to(*render, true);
     limit_args.add_to(*render);
     return {render, [args] { return run_render(*args); }};
 }

@@ -138,3 +138,24 @@ def png(width, height, colour_type, rows):
 put("png", "rgb.png", png(3, 2, 2, [bytes([255, 0, 0, 0, 255, 0, 0, 0, 255])] * 2))
 put("png", "gray.png", png(4, 1, 0, [bytes([0, 64, 128, 255])]))
 put("png", "rgba.png", png(1, 1, 6, [bytes([1, 2, 3, 4])]))
+
+
+# --- glTF: the Khronos samples as .gltf text; for fuzz_glb as "JSON\nBIN\nbinary" (the target
+# wraps that in a GLB header) and one real GLB ---
+import base64, json as json_module
+
+for name in ("Box", "BoxAnimated", "RiggedSimple", "SimpleMorph", "SimpleSkin"):
+    text = read("tests", "data", "gltf", name + ".gltf")
+    put("gltf", name + ".gltf", text)
+    doc = json_module.loads(text)
+    if len(doc["buffers"]) != 1:
+        continue
+    uri = doc["buffers"][0].pop("uri")
+    binary = base64.b64decode(uri.split(",", 1)[1])
+    compact = json_module.dumps(doc, separators=(",", ":")).encode()
+    put("glb", name + ".txt", compact + b"\nBIN\n" + binary)
+    if name == "Box":
+        j = compact + b" " * (-len(compact) % 4)
+        b = binary + b"\0" * (-len(binary) % 4)
+        put("glb", "Box.glb", b"glTF" + struct.pack("<II", 2, 28 + len(j) + len(b)) +
+            struct.pack("<I", len(j)) + b"JSON" + j + struct.pack("<I", len(b)) + b"BIN\0" + b)

@@ -134,6 +134,28 @@ std::vector<BadInput> catalogue() {
          "batch keys 1 4 --input {data} --output {out} --size 1024x1024 --jobs 4 --max-memory 600M",
          "4 frames at once (a 1024x1024 frame each) needs about 773 MiB of memory, more than the limit of 600 MiB "
          "(--max-memory raises it, or render fewer frames at once with --jobs)"},
+        // --- glTF ---
+        {"GltfCountPastBufferView", kRender + "gltf_huge_count.gltf" + kTo,
+         "{data}/gltf_huge_count.gltf: accessors[0].count: 4294967295 exceeds the buffer view "
+         "(bufferViews[0], 36 bytes)"},
+        {"GltfIndexOutOfRange", kRender + "gltf_index.gltf" + kTo,
+         "{data}/gltf_index.gltf: meshes[0].primitives[0].indices: index 9 at element 2 is out of "
+         "range (3 vertices)"},
+        {"GltfCyclicNodes", kRender + "gltf_cycle.gltf" + kTo,
+         "{data}/gltf_cycle.gltf: nodes[2].children: the node hierarchy has a cycle through "
+         "nodes[1]"},
+        {"GltfBase64Garbage", kRender + "gltf_base64.gltf" + kTo,
+         "{data}/gltf_base64.gltf: Failed to decode 'uri' : "
+         "data:application/octet-stream;base64,@@@@not base64@@@@ in Buffer"},
+        {"GltfTruncatedGlb", kRender + "gltf_truncated.glb" + kTo,
+         "{data}/gltf_truncated.glb: byte 8: truncated GLB: the header says 540 bytes, the file "
+         "has 520"},
+        {"GltfZerosOverMemory", kRender + "gltf_zeros.gltf" + kTo + " --max-memory 512M",
+         "{data}/gltf_zeros.gltf: accessors[0] (90000000 values without a buffer view) needs "
+         "about 5.4 GiB of memory, more than the limit of 512 MiB (--max-memory raises it)"},
+        {"GltfTooManyVertices", kRender + "gltf_triangle.gltf" + kTo + " --max-vertices 2",
+         "{data}/gltf_triangle.gltf: accessors[0].count: 3 is more than the limit of 2 "
+         "(--max-vertices raises it)"},
     };
 }
 

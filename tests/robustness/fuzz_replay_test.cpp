@@ -24,6 +24,8 @@ int toonray_fuzz_options(const std::uint8_t*, std::size_t);
 int toonray_fuzz_png(const std::uint8_t*, std::size_t);
 int toonray_fuzz_render(const std::uint8_t*, std::size_t);
 int toonray_fuzz_shading(const std::uint8_t*, std::size_t);
+int toonray_fuzz_gltf(const std::uint8_t*, std::size_t);
+int toonray_fuzz_glb(const std::uint8_t*, std::size_t);
 int toonray_fuzz_init_png(int*, char***);
 }
 
@@ -80,5 +82,7 @@ INSTANTIATE_TEST_SUITE_P(Targets, FuzzReplay,
                                            Target{"options", toonray_fuzz_options},
                                            Target{"png", toonray_fuzz_png, toonray_fuzz_init_png},
                                            Target{"render", toonray_fuzz_render},
-                                           Target{"shading", toonray_fuzz_shading}),
+                                           Target{"shading", toonray_fuzz_shading},
+                                           Target{"gltf", toonray_fuzz_gltf},
+                                           Target{"glb", toonray_fuzz_glb}),
                          [](const auto& info) { return std::string(info.param.name); });

@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <exception>
 #include <fmt/format.h>
@@ -9,7 +10,10 @@
 #include <memory>
 
 #include "toonray/core/error.h"
+#include "toonray/anim/gltf_frames.h"
 #include "toonray/core/limits.h"
+#include "toonray/core/saturating.h"
+#include "toonray/scene/gltf_loader.h"
 #include "toonray/scene/obj_loader.h"
 
 namespace toonray {
@@ -30,7 +34,10 @@ bool parse_int(const std::string& s, int& out) {
 FramePattern output_pattern(const BatchOptions& options) {
     if (options.output_pattern) return FramePattern(*options.output_pattern);
     std::string escaped;
-    for (char c : options.name) {
+    const std::string name = is_gltf_path(options.name)
+                                 ? std::filesystem::path(options.name).stem().string()
+                                 : options.name;
+    for (char c : name) {
         if (c == '%') escaped.push_back('%');
         escaped.push_back(c);
     }
@@ -220,12 +227,47 @@ BatchReport run_batch(const BatchOptions& options, BatchObserver* observer) {
     }
     std::vector<int> frames = shard_frames(options.first, options.last, options.shard);
     const FramePlan plan = plan_frame_jobs(options.render, options.jobs, frames.size());
-    ObjFrames source(options, plan);
     ScheduleOptions schedule;
     schedule.jobs = plan.jobs;
     schedule.resume = options.resume;
     schedule.fail_fast = options.fail_fast;
     schedule.cancel = options.cancel;
+    if (is_gltf_path(options.name) && !options.input_pattern) {
+        if (!(options.gltf_fps > 0.0) || !std::isfinite(options.gltf_fps))
+            throw Error(fmt::format("fps {}: must be positive", options.gltf_fps));
+        std::filesystem::path file = options.name;
+        if (!std::filesystem::exists(file) && std::filesystem::exists(options.input_dir / file))
+            file = options.input_dir / file;
+        GltfOptions gltf;
+        gltf.limits.reserved_memory = static_cast<std::uint64_t>(plan.jobs) * plan.frame_bytes;
+        Warnings warnings;
+        GltfDocument document = load_gltf(file, warnings, gltf);
+        // Each job poses its own scene.
+        check_memory(add_saturated(gltf.limits.reserved_memory,
+                                   mul_saturated(scene_bytes(document.vertices, document.triangles),
+                                                 static_cast<std::uint64_t>(plan.jobs))),
+                     fmt::format("{} frames of {} at once", plan.jobs, file.string()));
+        const GltfAnimator animator(std::move(document), options.gltf);
+        if (auto w = animator.aspect_warning(options.render.settings.width,
+                                             options.render.settings.height))
+            warnings.push_back(*w);
+        if (observer)
+            for (const auto& w : warnings) observer->warning(options.first, w);
+        // Without a camera in the file, one automatic camera for the whole run, framing the
+        // range's first frame (whatever the shard), so that the animation moves in a still frame.
+        FrameOptions render = options.render;
+        if (!render.camera && !animator.has_camera()) {
+            Scene first;
+            std::vector<Light> lights;
+            animator.pose(gltf_frame_time(options.first, options.gltf_fps), render.settings.width,
+                          render.settings.height, first, lights);
+            render.camera = choose_camera(first, render);
+        }
+        GltfFrames source(animator, options.gltf_fps, render, options.output_dir,
+                          output_pattern(options));
+        return run_frames(source, frames, schedule, observer);
+    }
+    ObjFrames source(options, plan);
     return run_frames(source, frames, schedule, observer);
 }
 

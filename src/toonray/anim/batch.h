@@ -9,6 +9,7 @@
 
 #include "toonray/anim/frame_pattern.h"
 #include "toonray/anim/frame_scheduler.h"
+#include "toonray/anim/gltf_animation.h"
 #include "toonray/frame/frame_renderer.h"
 
 namespace toonray {
@@ -34,7 +35,9 @@ std::optional<Shard> shard_from_environment();
 std::vector<int> shard_frames(int first, int last, const Shard& shard);
 
 struct BatchOptions {
-    std::string name;  ///< animation name, e.g. "keys"
+    /// Animation name, e.g. "keys"; or a .gltf/.glb file, whose frame N is the file posed at
+    /// N / gltf_fps seconds (docs/gltf.md)
+    std::string name;
     int first = 1, last = 1;
     std::filesystem::path input_dir = ".";
     std::filesystem::path output_dir = ".";
@@ -46,6 +49,8 @@ struct BatchOptions {
     bool fail_fast = false;  ///< stop at the first failed frame
     Shard shard;
     const std::atomic<bool>* cancel = nullptr;  ///< set (e.g. by SIGINT) to stop cleanly
+    GltfPoseOptions gltf;                       ///< for a glTF file: the animation and camera
+    double gltf_fps = 24.0;                     ///< for a glTF file: frames per second
 };
 
 /// Renders the frames. Frames that fail are reported and the rest go on (unless fail_fast).

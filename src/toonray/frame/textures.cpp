@@ -9,6 +9,10 @@ namespace toonray {
 const TextureSet& TextureCache::load(const Scene& scene, Warnings& warnings) {
     textures_.assign(scene.materials.size(), nullptr);
     for (std::size_t m = 0; m < scene.materials.size(); ++m) {
+        if (scene.materials[m].kd_image) {
+            textures_[m] = scene.materials[m].kd_image;
+            continue;
+        }
         const std::string& path = scene.materials[m].map_kd;
         if (path.empty()) continue;
         if (auto it = decoded_.find(path); it != decoded_.end()) {

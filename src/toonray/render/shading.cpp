@@ -132,6 +132,11 @@ namespace {
     }
     // With one unit light this is max(0, l.n): the same band as the seed's int(l.n * 16).
     Vec3f kd = material.kd;
+    if (!scene.colours.empty()) {
+        const auto& tri = scene.tri_positions[hit.prim];
+        kd = kd * (scene.colours[tri[0]] * (1.0f - hit.u - hit.v) + scene.colours[tri[1]] * hit.u +
+                   scene.colours[tri[2]] * hit.v);
+    }
     if (texture) {
         const auto& tt = scene.tri_texcoords[hit.prim];
         if (tt[0] != kNoIndex && tt[1] != kNoIndex && tt[2] != kNoIndex) {
@@ -154,7 +159,7 @@ namespace {
 const Light* plain_point_light(const ShadingContext& ctx) {
     const ShadingSettings& s = ctx.settings;
     const bool plain = ctx.lights.size() == 1 && ctx.lights[0].kind == Light::Kind::Point &&
-                       !s.shadows && !s.specular && !(s.rim > 0.0f);
+                       !s.shadows && !s.specular && !(s.rim > 0.0f) && ctx.scene.colours.empty();
     return plain ? &ctx.lights[0] : nullptr;
 }
 

@@ -119,7 +119,7 @@ inline const ImageRgb8* material_texture(const ShadingContext& ctx, std::uint32_
 }
 
 /// The frame's one point light when its shading is the seed's plain setup (one point light; no
-/// shadows, specular or rim band), else null. Then shade_plain gives shade_hit's colour for every
+/// shadows, specular or rim band; no vertex colours), else null. Then shade_plain gives shade_hit's colour for every
 /// hit on an untextured material; the renderer checks this once per tile, not per sample.
 const Light* plain_point_light(const ShadingContext& ctx);
 

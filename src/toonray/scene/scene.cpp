@@ -17,6 +17,7 @@ void Scene::clear() {
     positions.clear();
     normals.clear();
     texcoords.clear();
+    colours.clear();
     tri_positions.clear();
     tri_normals.clear();
     tri_texcoords.clear();

@@ -3,12 +3,14 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "toonray/core/bbox.h"
+#include "toonray/core/image.h"
 #include "toonray/core/index.h"
 #include "toonray/core/math.h"
 #include "toonray/scene/camera.h"
@@ -26,6 +28,9 @@ struct Material {
     float d = 1.0f;
     int illum = 2;
     std::string map_kd;  ///< texture path as written in the MTL, resolved relative to it
+    /// A texture the loader decoded itself (glTF images, which may sit inside the file); used
+    /// instead of map_kd. v = 0 at the bottom, as OBJ texture coordinates have it.
+    std::shared_ptr<const ImageRgb8> kd_image;
 };
 
 /// Triangles with per-corner indices into shared attribute arrays. Material 0 is always the
@@ -34,6 +39,9 @@ struct Scene {
     std::vector<Vec3f> positions;
     std::vector<Vec3f> normals;
     std::vector<Vec2f> texcoords;
+    /// Vertex colours by position index (glTF COLOR_0), multiplying Kd; empty when the scene
+    /// has none, else as long as `positions`.
+    std::vector<Vec3f> colours;
 
     std::vector<std::array<std::uint32_t, 3>> tri_positions;
     std::vector<std::array<std::uint32_t, 3>> tri_normals;    ///< kNoIndex where a corner has none

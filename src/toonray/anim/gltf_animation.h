@@ -1,0 +1,57 @@
+#pragma once
+/// A glTF document posed at a time: its animations (translation, rotation, scale and morph
+/// weight channels; LINEAR with slerp for rotations, STEP, CUBICSPLINE) applied to the node
+/// hierarchy, skins (linear blend skinning) and morph targets evaluated, and the result as a
+/// Scene, a camera and toon lights. docs/gltf.md has the rules.
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "toonray/core/error.h"
+#include "toonray/render/shading.h"
+#include "toonray/scene/gltf_loader.h"
+#include "toonray/scene/scene.h"
+
+namespace toonray {
+
+struct GltfPoseOptions {
+    /// The animation played, by name or index; nullopt plays all of them at once (as Blender
+    /// exports one animation per object).
+    std::optional<std::string> animation;
+    /// The camera: the node of this name; nullopt takes the scene's first camera node in
+    /// depth-first order.
+    std::optional<std::string> camera_node;
+};
+
+/// The time of frame `frame` at `fps` frames per second: frame / fps seconds (frame 0 at 0 s,
+/// as Blender's glTF exporter writes frame f of a scene starting at frame 0).
+[[nodiscard]] double gltf_frame_time(int frame, double fps);
+
+class GltfAnimator {
+public:
+    /// Throws Error naming the file when the animation or camera node asked for does not exist.
+    GltfAnimator(GltfDocument document, const GltfPoseOptions& options);
+
+    /// The scene at `seconds` (clamped to each sampler's keys), its camera for a
+    /// `width` x `height` image (scene.camera; unset when the file has no camera), and the
+    /// file's lights, in toon units, in `lights` (empty when the file has none).
+    void pose(double seconds, int width, int height, Scene& scene,
+              std::vector<Light>& lights) const;
+
+    /// A warning when the camera's aspect ratio differs from the image's, else nothing.
+    [[nodiscard]] std::optional<std::string> aspect_warning(int width, int height) const;
+
+    [[nodiscard]] const GltfDocument& document() const { return doc_; }
+    /// Whether the scene has the camera posing gives (else frames need one of their own).
+    [[nodiscard]] bool has_camera() const { return camera_node_ >= 0; }
+    /// The last key time of the animations played, seconds (0 without animations).
+    [[nodiscard]] double duration() const;
+
+private:
+    GltfDocument doc_;
+    std::vector<int> animations_;  ///< played
+    int camera_node_ = -1;
+};
+
+}  // namespace toonray
