@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <numbers>
 #include <random>
+#include <utility>
 #include <vector>
 
 #include "toonray/accel/triangle_accel.h"
@@ -41,6 +42,30 @@ inline void add_box(Scene& s, const Vec3f& lo, const Vec3f& hi, std::uint32_t ob
     add_quad(s, c(2), c(6), c(7), c(3), 0, object);  // y = hi
     add_quad(s, c(0), c(4), c(6), c(2), 0, object);  // x = lo
     add_quad(s, c(1), c(3), c(7), c(5), 0, object);  // x = hi
+}
+
+/// A raised panel in the plane z = 0 facing +z, `half_x` by `half_y`, moulded by `profile`:
+/// (inset from the outer edge, height) pairs from the outer edge inward. Consecutive pairs make
+/// a ring of four mitred trapezoids around the panel, the last pair a flat field in the middle.
+/// Corners are computed from the same expressions, so rings share positions bit for bit.
+inline void add_moulded_panel(Scene& s, float half_x, float half_y,
+                              const std::vector<std::pair<float, float>>& profile,
+                              std::uint32_t object = 0) {
+    // Corner i (counter-clockwise from (-x, -y)) of the rectangle at `inset`, at `height`.
+    auto corner = [&](int i, float inset, float height) {
+        const float x = half_x - inset, y = half_y - inset;
+        const float sx = (i == 1 || i == 2) ? x : -x, sy = i >= 2 ? y : -y;
+        return Vec3f(sx, sy, height);
+    };
+    for (std::size_t k = 0; k + 1 < profile.size(); ++k) {
+        const auto [d0, h0] = profile[k];
+        const auto [d1, h1] = profile[k + 1];
+        for (int i = 0; i < 4; ++i)
+            add_quad(s, corner(i, d0, h0), corner((i + 1) % 4, d0, h0), corner((i + 1) % 4, d1, h1),
+                     corner(i, d1, h1), 0, object);
+    }
+    const auto [d, h] = profile.back();
+    add_quad(s, corner(0, d, h), corner(1, d, h), corner(2, d, h), corner(3, d, h), 0, object);
 }
 
 /// A UV sphere with shared vertices and unit vertex normals.
