@@ -60,6 +60,10 @@ struct FeatureEdgeSettings {
     /// Smooth contours (Hertzmann & Zorin 2000) on triangles with a normal at every corner,
     /// instead of polygonal silhouettes on the edges where shading is smooth.
     bool smooth_contours = true;
+    /// Also the intersection lines on a triangle turned away from the eye on a closed solid
+    /// (FeatureSegment::certainly_hidden). Without them the visible lines are the same, and
+    /// finding the intersection lines skips those triangles.
+    bool certainly_hidden = true;
 };
 
 /// Vertices welded by exact position within each object: two triangle corners share a welded
