@@ -1,0 +1,115 @@
+// The ink lines on the demo's piano, posed in memory as `toonray piano` poses it: few specks
+// on frames 30 and 150, an SVG that a real SVG renderer draws like the PNG, and strokes that
+// change smoothly while the camera orbits.
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "ink/ink_scenes.h"
+#include "ink/svg_compare.h"
+#include "support/test_support.h"
+#include "toonray/anim/piano_movie.h"
+#include "toonray/ink/ink.h"
+#include "toonray/piano/piano_animation.h"
+#include "toonray/piano/piano_model.h"
+
+namespace toonray {
+namespace {
+
+// The demo's piano at frame `frame` of `toonray piano` (24 fps from t = 0), with the camera of
+// the demo's path; the same scene `toonray piano --export-obj` writes, before the OBJ rounds it.
+struct PianoFrame {
+    Scene scene;
+    CameraSpec camera;
+    TriangleAccel accel;
+
+    explicit PianoFrame(int frame) {
+        const Score score = load_demo_score();
+        const CameraPath path = load_demo_camera_path();
+        const PianoPlayback playback(score);
+        PianoOptions options;
+        options.hole_capacity = std::max<std::uint32_t>(playback.hole_capacity(), 1);
+        const PianoModel model = build_piano(options);
+        scene = model.scene;
+        const double t = (frame - 1) / 24.0;
+        pose_piano(model, playback.pose_at(t), &playback.roll(), scene);
+        camera = path.camera(t);
+        accel.build(scene.positions, scene.tri_positions);
+    }
+};
+
+int ink_specks(const PianoFrame& piano, int w, int h, ink::InkLines& lines) {
+    ink::draw_ink_lines(piano.scene, piano.accel, piano.camera, w, h, {}, 0, lines);
+    ImageGray8 gray;
+    ink::coverage_to_gray(lines.coverage, gray);
+    return test_support::count_specks(gray);
+}
+
+// Specks (8-connected groups of at most 12 pixels darker than 8%) in the ink lines of the
+// frames where the robust lines show hundreds (575 and 660 in `_edges.png`).
+TEST(InkPiano, FewSpecksOnFrames30And150) {
+    for (int frame : {30, 150}) {
+        const PianoFrame piano(frame);
+        ink::InkLines lines;
+        EXPECT_LE(ink_specks(piano, 1280, 720, lines), 30) << "frame " << frame;
+        EXPECT_GT(lines.strokes.size(), 500u) << "frame " << frame;
+    }
+}
+
+TEST(InkPiano, RsvgDrawsTheSvgLikeThePng) {
+    const PianoFrame piano(30);
+    const int w = 1280, h = 720;
+    ink::InkLines lines;
+    ink::draw_ink_lines(piano.scene, piano.accel, piano.camera, w, h, {}, 0, lines);
+    test_support::TempDir dir("ink_piano_rsvg");
+    test_support::expect_rsvg_draws_like_coverage(
+        lines.strokes, lines.coverage, ink::stroke_thickness(2.0f, h), dir.path, "piano", 20000);
+}
+
+// The largest deviation of a frame's value from the mean of its two neighbours, relative to
+// that mean.
+double worst_deviation(const std::vector<double>& values) {
+    double worst = 0;
+    for (std::size_t i = 1; i + 1 < values.size(); ++i) {
+        const double mean = 0.5 * (values[i - 1] + values[i + 1]);
+        worst = std::max(worst, std::abs(values[i] - mean) / mean);
+    }
+    return worst;
+}
+
+// A slow orbit around piano frame 30, half a degree per frame for 24 frames about the vertical
+// through the gaze point: the number of visible strokes and their total length change
+// smoothly, no frame more than 2% away from the mean of its neighbours.
+TEST(InkPiano, StrokesChangeSmoothlyInASlowOrbit) {
+    const PianoFrame piano(30);
+    const int w = 1280, h = 720;
+    const CameraSpec start = piano.camera;
+    std::vector<double> counts, lengths;
+    ink::InkLines lines;
+    for (int frame = 0; frame < 24; ++frame) {
+        const float a = 0.5f * static_cast<float>(frame) * std::numbers::pi_v<float> / 180.0f;
+        const Vec3f d = start.eye - start.gaze;
+        auto turn = [&](const Vec3f& v) {
+            return Vec3f(v.x * std::cos(a) - v.z * std::sin(a), v.y,
+                         v.x * std::sin(a) + v.z * std::cos(a));
+        };
+        const CameraSpec camera{start.gaze + turn(d), start.gaze, turn(start.up)};
+        ink::draw_ink_lines(piano.scene, piano.accel, camera, w, h, {}, 0, lines);
+        double count = 0, length = 0;
+        for (const ink::Stroke& s : lines.strokes)
+            if (s.visible) {
+                ++count;
+                length += ink::polyline_length(s.points);
+            }
+        counts.push_back(count);
+        lengths.push_back(length);
+    }
+    EXPECT_GT(counts.front(), 500.0);
+    EXPECT_LE(worst_deviation(counts), 0.02);
+    EXPECT_LE(worst_deviation(lengths), 0.02);
+}
+
+}  // namespace
+}  // namespace toonray
