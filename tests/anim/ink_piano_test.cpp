@@ -7,6 +7,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "ink/ink_orbit.h"
 #include "ink/ink_scenes.h"
 #include "ink/svg_compare.h"
 #include "support/test_support.h"
@@ -68,47 +69,17 @@ TEST(InkPiano, RsvgDrawsTheSvgLikeThePng) {
         lines.strokes, lines.coverage, ink::stroke_thickness(2.0f, h), dir.path, "piano", 20000);
 }
 
-// The largest deviation of a frame's value from the mean of its two neighbours, relative to
-// that mean.
-double worst_deviation(const std::vector<double>& values) {
-    double worst = 0;
-    for (std::size_t i = 1; i + 1 < values.size(); ++i) {
-        const double mean = 0.5 * (values[i - 1] + values[i + 1]);
-        worst = std::max(worst, std::abs(values[i] - mean) / mean);
-    }
-    return worst;
-}
-
 // A slow orbit around piano frame 30, half a degree per frame for 24 frames about the vertical
 // through the gaze point: the number of visible strokes and their total length change
 // smoothly, no frame more than 2% away from the mean of its neighbours.
 TEST(InkPiano, StrokesChangeSmoothlyInASlowOrbit) {
     const PianoFrame piano(30);
     const int w = 1280, h = 720;
-    const CameraSpec start = piano.camera;
-    std::vector<double> counts, lengths;
-    ink::InkLines lines;
-    for (int frame = 0; frame < 24; ++frame) {
-        const float a = 0.5f * static_cast<float>(frame) * std::numbers::pi_v<float> / 180.0f;
-        const Vec3f d = start.eye - start.gaze;
-        auto turn = [&](const Vec3f& v) {
-            return Vec3f(v.x * std::cos(a) - v.z * std::sin(a), v.y,
-                         v.x * std::sin(a) + v.z * std::cos(a));
-        };
-        const CameraSpec camera{start.gaze + turn(d), start.gaze, turn(start.up)};
-        ink::draw_ink_lines(piano.scene, piano.accel, camera, w, h, {}, 0, lines);
-        double count = 0, length = 0;
-        for (const ink::Stroke& s : lines.strokes)
-            if (s.visible) {
-                ++count;
-                length += ink::polyline_length(s.points);
-            }
-        counts.push_back(count);
-        lengths.push_back(length);
-    }
-    EXPECT_GT(counts.front(), 500.0);
-    EXPECT_LE(worst_deviation(counts), 0.02);
-    EXPECT_LE(worst_deviation(lengths), 0.02);
+    const auto series =
+        test_support::orbit_strokes(piano.scene, piano.accel, piano.camera, w, h, 24, 0.5f);
+    EXPECT_GT(series.counts.front(), 500.0);
+    EXPECT_LE(test_support::worst_deviation(series.counts), 0.02);
+    EXPECT_LE(test_support::worst_deviation(series.lengths), 0.02);
 }
 
 }  // namespace

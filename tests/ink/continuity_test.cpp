@@ -6,6 +6,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "ink/ink_orbit.h"
 #include "ink/ink_scenes.h"
 #include "toonray/ink/ink.h"
 #include "toonray/scene/obj_loader.h"
@@ -103,17 +104,6 @@ TEST(InkMouldings, EveryCreaseIsDrawnAlongItsProjectedLength) {
     EXPECT_GE(total_drawn, 0.99 * total_visible);
 }
 
-// The largest deviation of a frame's value from the mean of its two neighbours, relative to
-// that mean.
-double worst_deviation(const std::vector<double>& values) {
-    double worst = 0;
-    for (std::size_t i = 1; i + 1 < values.size(); ++i) {
-        const double mean = 0.5 * (values[i - 1] + values[i + 1]);
-        worst = std::max(worst, std::abs(values[i] - mean) / mean);
-    }
-    return worst;
-}
-
 // A slow orbit around the teapot, half a degree per frame for 24 frames: the total length of
 // the visible strokes changes smoothly, no frame more than 2% away from the mean of its
 // neighbours. Their number is checked on the piano (tests/anim/ink_piano_test.cpp), where a
@@ -130,27 +120,10 @@ TEST(InkOrbit, StrokeLengthChangesSmoothlyAroundTheTeapot) {
     for (const auto& t : scene.tri_positions)
         for (std::uint32_t v : t) used.push_back(scene.positions[v]);
     const CameraSpec start = auto_camera(used, w, h);
-    std::vector<double> counts, lengths;
-    ink::InkLines lines;
-    for (int frame = 0; frame < 24; ++frame) {
-        // The eye turns about the vertical through the gaze point.
-        const float a = 0.5f * static_cast<float>(frame) * std::numbers::pi_v<float> / 180.0f;
-        const Vec3f d = start.eye - start.gaze;
-        const Vec3f eye = start.gaze + Vec3f(d.x * std::cos(a) - d.z * std::sin(a), d.y,
-                                             d.x * std::sin(a) + d.z * std::cos(a));
-        ink::draw_ink_lines(scene, accel, look_at(eye, start.gaze, start.up), w, h, {}, 0, lines);
-        double count = 0, length = 0;
-        for (const ink::Stroke& s : lines.strokes)
-            if (s.visible) {
-                ++count;
-                length += ink::polyline_length(s.points);
-            }
-        counts.push_back(count);
-        lengths.push_back(length);
-    }
-    EXPECT_GT(counts.front(), 20.0);
-    EXPECT_GT(lengths.front(), 4000.0);
-    EXPECT_LE(worst_deviation(lengths), 0.02);
+    const auto series = test_support::orbit_strokes(scene, accel, start, w, h, 24, 0.5f);
+    EXPECT_GT(series.counts.front(), 20.0);
+    EXPECT_GT(series.lengths.front(), 4000.0);
+    EXPECT_LE(test_support::worst_deviation(series.lengths), 0.02);
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 /// Scenes built in code for the ink tests, a brute-force occluder count to check the
 /// accelerated one against, and the speck count of a line image.
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <numbers>
@@ -12,6 +13,7 @@
 #include "toonray/accel/triangle_accel.h"
 #include "toonray/core/image.h"
 #include "toonray/ink/visibility.h"
+#include "toonray/scene/camera.h"
 #include "toonray/scene/scene.h"
 
 namespace toonray::test_support {
@@ -137,6 +139,27 @@ inline int brute_force_occluders(const Scene& s, const Vec3f& point, const Vec3f
             ++count;
     }
     return std::min(count, settings.max_invisibility);
+}
+
+/// `camera` turned by `degrees` about the vertical (y) through its gaze point.
+inline CameraSpec orbit_camera(const CameraSpec& camera, float degrees) {
+    const float a = degrees * std::numbers::pi_v<float> / 180.0f;
+    auto turn = [&](const Vec3f& v) {
+        return Vec3f(v.x * std::cos(a) - v.z * std::sin(a), v.y,
+                     v.x * std::sin(a) + v.z * std::cos(a));
+    };
+    return {camera.gaze + turn(camera.eye - camera.gaze), camera.gaze, turn(camera.up)};
+}
+
+/// The largest deviation of a value in a sequence from the mean of its two neighbours,
+/// relative to that mean.
+inline double worst_deviation(const std::vector<double>& values) {
+    double worst = 0;
+    for (std::size_t i = 1; i + 1 < values.size(); ++i) {
+        const double mean = 0.5 * (values[i - 1] + values[i + 1]);
+        worst = std::max(worst, std::abs(values[i] - mean) / mean);
+    }
+    return worst;
 }
 
 /// Specks: 8-connected groups of at most `max_size` pixels darker than `threshold` (8% of
