@@ -348,14 +348,17 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
 
     // Intersection lines: each triangle against the triangles whose boxes overlap its own.
     if (settings.intersections && !bvh.nodes.empty()) {
-        std::vector<BBox> boxes(n);
-        for (std::size_t t = 0; t < n; ++t)
-            for (const Vec3f& p : corners(scene, t)) boxes[t].extend(p);
-        // Each corner's canonical position (equal for equal coordinates, across objects).
-        std::vector<std::array<std::uint32_t, 3>> tri_position(n);
-        for (std::size_t t = 0; t < n; ++t)
+        // Boxes and corner positions (canonical: equal for equal coordinates, across objects)
+        // in the BVH's primitive order, so that a leaf's triangles are read together.
+        const std::size_t prims = bvh.prim_indices.size();
+        std::vector<BBox> boxes(prims);
+        std::vector<std::array<std::uint32_t, 3>> tri_position(prims);
+        for (std::size_t i = 0; i < prims; ++i) {
+            const std::uint32_t t = bvh.prim_indices[i];
+            for (const Vec3f& p : corners(scene, t)) boxes[i].extend(p);
             for (int k = 0; k < 3; ++k)
-                tri_position[t][k] = mesh.vertex_position[mesh.tri_vertices[t][k]];
+                tri_position[i][k] = mesh.vertex_position[mesh.tri_vertices[t][k]];
+        }
         auto overlap = [](const BBox& a, const BBox& b) {
             return !(a.lo.x > b.hi.x || a.hi.x < b.lo.x || a.lo.y > b.hi.y || a.hi.y < b.lo.y ||
                      a.lo.z > b.hi.z || a.hi.z < b.lo.z);
@@ -367,16 +370,18 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
         // the threads; the segments are sorted by triangle pair at the end.
         // Without hidden lines, triangles turned away from the eye on closed solids take no
         // part, and neither do nodes holding only such triangles.
-        auto live = [&](std::uint32_t t) {
-            return usable(t) && (settings.certainly_hidden || !turned_away[t]);
-        };
+        std::vector<std::uint8_t> live(prims);
+        for (std::size_t i = 0; i < prims; ++i) {
+            const std::uint32_t t = bvh.prim_indices[i];
+            live[i] = usable(t) && (settings.certainly_hidden || !turned_away[t]);
+        }
         std::vector<std::uint8_t> node_live(bvh.nodes.size(), 0);
         auto mark_live = [&](auto&& self, std::uint32_t i) -> bool {
             const BvhNode& node = bvh.nodes[i];
             bool any = false;
             if (node.is_leaf()) {
                 for (std::uint32_t k = node.first; k < node.first + node.count; ++k)
-                    any = any || live(bvh.prim_indices[k]);
+                    any = any || live[k];
             } else {
                 const bool left = self(self, node.first);
                 any = self(self, node.first + 1) || left;
@@ -385,14 +390,16 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
             return any;
         };
         mark_live(mark_live, 0);
-        auto test_pair = [&](std::uint32_t t, std::uint32_t u, std::vector<FeatureSegment>& out) {
-            if (u < t) std::swap(t, u);
-            if (!overlap(boxes[u], boxes[t]) || !live(t) || !live(u)) return;
+        // Tests the triangles in primitive slots i and j.
+        auto test_pair = [&](std::uint32_t i, std::uint32_t j, std::vector<FeatureSegment>& out) {
+            if (!live[i] || !live[j] || !overlap(boxes[i], boxes[j])) return;
             // Triangles sharing a corner position (in any object) touch there: no line.
-            const auto& pa = tri_position[t];
-            const auto& pb = tri_position[u];
+            const auto& pa = tri_position[i];
+            const auto& pb = tri_position[j];
             for (std::uint32_t a_corner : pa)
                 if (a_corner == pb[0] || a_corner == pb[1] || a_corner == pb[2]) return;
+            std::uint32_t t = bvh.prim_indices[i], u = bvh.prim_indices[j];
+            if (u < t) std::swap(t, u);
             TriangleCrossing c;
             if (!intersect_triangles(corners(scene, t), corners(scene, u), c)) return;
             FeatureSegment seg;
@@ -422,7 +429,7 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
                 if (a.is_leaf()) {
                     for (std::uint32_t i = a.first; i < a.first + a.count; ++i)
                         for (std::uint32_t j = i + 1; j < a.first + a.count; ++j)
-                            test_pair(bvh.prim_indices[i], bvh.prim_indices[j], out);
+                            test_pair(i, j, out);
                 } else {
                     next.push_back({a.first, a.first});
                     next.push_back({a.first + 1, a.first + 1});
@@ -434,7 +441,7 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
             if (a.is_leaf() && b.is_leaf()) {
                 for (std::uint32_t i = a.first; i < a.first + a.count; ++i)
                     for (std::uint32_t j = b.first; j < b.first + b.count; ++j)
-                        test_pair(bvh.prim_indices[i], bvh.prim_indices[j], out);
+                        test_pair(i, j, out);
                 return;
             }
             // Open the inner node with the larger box (or the only inner one).
