@@ -82,5 +82,51 @@ TEST(InkPiano, StrokesChangeSmoothlyInASlowOrbit) {
     EXPECT_LE(test_support::worst_deviation(series.lengths), 0.02);
 }
 
+// Intersection lines kept from the previous frame for the triangles that did not move give
+// the same segments and the same lines as a frame drawn from scratch, with and without hidden
+// lines, after a previous frame seen from another camera.
+TEST(InkPiano, IntersectionLinesKeptAcrossFramesAreTheSame) {
+    const PianoFrame previous(29), frame(30);
+    // The keys moved between the two frames, most of the piano did not.
+    std::size_t moved = 0;
+    for (std::size_t t = 0; t < frame.scene.triangle_count(); ++t)
+        for (int k = 0; k < 3; ++k)
+            if (!(frame.scene.positions[frame.scene.tri_positions[t][k]] ==
+                  previous.scene.positions[previous.scene.tri_positions[t][k]])) {
+                ++moved;
+                break;
+            }
+    EXPECT_GT(moved, 100u);
+    EXPECT_LT(moved, frame.scene.triangle_count() / 4);
+    for (bool hidden : {false, true}) {
+        ink::InkSettings settings;
+        settings.chain.hidden = hidden;
+        ink::InkLines warm, cold;
+        // The previous frame from elsewhere, and with the other choice of hidden lines (which
+        // decides the triangles that take part).
+        const CameraSpec elsewhere = test_support::orbit_camera(frame.camera, 20.0f);
+        ink::InkSettings before = settings;
+        before.chain.hidden = !hidden;
+        ink::draw_ink_lines(previous.scene, previous.accel, elsewhere, 640, 360, before, 0, warm);
+        ink::draw_ink_lines(frame.scene, frame.accel, frame.camera, 640, 360, settings, 0, warm);
+        ink::draw_ink_lines(frame.scene, frame.accel, frame.camera, 640, 360, settings, 0, cold);
+        ASSERT_EQ(warm.segments.size(), cold.segments.size());
+        int intersections = 0;
+        for (std::size_t i = 0; i < cold.segments.size(); ++i) {
+            const ink::FeatureSegment &a = warm.segments[i], &b = cold.segments[i];
+            ASSERT_TRUE(a.p0 == b.p0 && a.p1 == b.p1 && a.key0 == b.key0 && a.key1 == b.key1 &&
+                        a.type == b.type && a.faces == b.faces && a.smooth == b.smooth &&
+                        a.certainly_hidden == b.certainly_hidden)
+                << "segment " << i;
+            intersections += b.type == ink::EdgeType::Intersection;
+        }
+        EXPECT_GT(intersections, 500);
+        ASSERT_EQ(warm.coverage.size(), cold.coverage.size());
+        for (std::size_t i = 0; i < cold.coverage.size(); ++i)
+            ASSERT_EQ(warm.coverage.data()[i], cold.coverage.data()[i]);
+        EXPECT_EQ(warm.intersections.crossings.size(), cold.intersections.crossings.size());
+    }
+}
+
 }  // namespace
 }  // namespace toonray

@@ -179,7 +179,8 @@ bool intersect_triangles(const std::array<Vec3f, 3>& a, const std::array<Vec3f, 
 
 std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedMesh& mesh,
                                                const Bvh& bvh, const Vec3f& eye,
-                                               const FeatureEdgeSettings& settings, int threads) {
+                                               const FeatureEdgeSettings& settings, int threads,
+                                               IntersectionCache* cache) {
     const std::size_t n = scene.triangle_count();
     std::vector<Vec3f> normal(n);
     for (std::size_t t = 0; t < n; ++t) normal[t] = face_normal(scene, t);
@@ -370,59 +371,69 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
         // the threads; the segments are sorted by triangle pair at the end.
         // Without hidden lines, triangles turned away from the eye on closed solids take no
         // part, and neither do nodes holding only such triangles.
-        std::vector<std::uint8_t> live(prims);
-        for (std::size_t i = 0; i < prims; ++i) {
-            const std::uint32_t t = bvh.prim_indices[i];
-            live[i] = usable(t) && (settings.certainly_hidden || !turned_away[t]);
+        // Triangles that take part: usable ones, and without hidden lines only those not turned
+        // away from the eye on a closed solid.
+        std::vector<std::uint8_t> live_triangle(n);
+        for (std::size_t t = 0; t < n; ++t)
+            live_triangle[t] = usable(t) && (settings.certainly_hidden || !turned_away[t]);
+        // With a cache, a pair is tested only if one of its triangles is stale: its corners
+        // changed since the cache's frame, or it did not take part then.
+        std::vector<std::uint8_t> stale;
+        if (cache) {
+            const bool same_count = cache->corners.size() == n && cache->tested.size() == n;
+            auto same = [](const Vec3f& a, const Vec3f& b) {
+                return std::bit_cast<std::array<std::uint32_t, 3>>(a) ==
+                       std::bit_cast<std::array<std::uint32_t, 3>>(b);
+            };
+            stale.assign(n, 1);
+            if (same_count)
+                for (std::size_t t = 0; t < n; ++t) {
+                    const auto now = corners(scene, t);
+                    stale[t] = !cache->tested[t] ||
+                               !std::equal(now.begin(), now.end(), cache->corners[t].begin(), same);
+                }
         }
-        std::vector<std::uint8_t> node_live(bvh.nodes.size(), 0);
-        auto mark_live = [&](auto&& self, std::uint32_t i) -> bool {
+        std::vector<std::uint8_t> live(prims);
+        for (std::size_t i = 0; i < prims; ++i) live[i] = live_triangle[bvh.prim_indices[i]];
+        // Per node: whether it holds a live triangle, and (with a cache) a stale one.
+        std::vector<std::uint8_t> node_live(bvh.nodes.size(), 0), node_stale(bvh.nodes.size(), 0);
+        auto mark = [&](auto&& self, std::uint32_t i) -> void {
             const BvhNode& node = bvh.nodes[i];
-            bool any = false;
             if (node.is_leaf()) {
-                for (std::uint32_t k = node.first; k < node.first + node.count; ++k)
-                    any = any || live[k];
-            } else {
-                const bool left = self(self, node.first);
-                any = self(self, node.first + 1) || left;
+                for (std::uint32_t k = node.first; k < node.first + node.count; ++k) {
+                    node_live[i] |= live[k];
+                    node_stale[i] |= !cache || stale[bvh.prim_indices[k]];
+                }
+                return;
             }
-            node_live[i] = any;
-            return any;
+            self(self, node.first);
+            self(self, node.first + 1);
+            node_live[i] = node_live[node.first] | node_live[node.first + 1];
+            node_stale[i] = node_stale[node.first] | node_stale[node.first + 1];
         };
-        mark_live(mark_live, 0);
+        mark(mark, 0);
         // Tests the triangles in primitive slots i and j.
-        auto test_pair = [&](std::uint32_t i, std::uint32_t j, std::vector<FeatureSegment>& out) {
+        auto test_pair = [&](std::uint32_t i, std::uint32_t j, std::vector<PairCrossing>& out) {
             if (!live[i] || !live[j] || !overlap(boxes[i], boxes[j])) return;
+            std::uint32_t t = bvh.prim_indices[i], u = bvh.prim_indices[j];
+            if (cache && !stale[t] && !stale[u]) return;  // the cache has it
             // Triangles sharing a corner position (in any object) touch there: no line.
             const auto& pa = tri_position[i];
             const auto& pb = tri_position[j];
             for (std::uint32_t a_corner : pa)
                 if (a_corner == pb[0] || a_corner == pb[1] || a_corner == pb[2]) return;
-            std::uint32_t t = bvh.prim_indices[i], u = bvh.prim_indices[j];
             if (u < t) std::swap(t, u);
-            TriangleCrossing c;
-            if (!intersect_triangles(corners(scene, t), corners(scene, u), c)) return;
-            FeatureSegment seg;
-            seg.type = EdgeType::Intersection;
-            seg.p0 = c.p[0];
-            seg.p1 = c.p[1];
-            seg.faces = {t, u};
-            seg.certainly_hidden = turned_away[t] || turned_away[u];
-            for (int e = 0; e < 2; ++e) {
-                const std::uint32_t on = c.on_b[e] ? u : t, other = c.on_b[e] ? t : u;
-                std::uint32_t w0 = mesh.tri_vertices[on][c.edge[e][0]],
-                              w1 = mesh.tri_vertices[on][c.edge[e][1]];
-                if (w1 < w0) std::swap(w0, w1);
-                (e == 0 ? seg.key0 : seg.key1) = {w0, w1, other};
-            }
-            out.push_back(seg);
+            PairCrossing found{t, u, {}};
+            if (intersect_triangles(corners(scene, t), corners(scene, u), found.crossing))
+                out.push_back(found);
         };
         using NodePair = std::pair<std::uint32_t, std::uint32_t>;
         // Opens one node pair: tests the triangles of two leaves (or of one leaf with itself),
         // or pushes the child pairs whose boxes may overlap.
         auto expand = [&](NodePair pair, std::vector<NodePair>& next,
-                          std::vector<FeatureSegment>& out) {
+                          std::vector<PairCrossing>& out) {
             if (!node_live[pair.first] || !node_live[pair.second]) return;
+            if (!node_stale[pair.first] && !node_stale[pair.second]) return;
             const BvhNode& a = bvh.nodes[pair.first];
             const BvhNode& b = bvh.nodes[pair.second];
             if (pair.first == pair.second) {
@@ -457,7 +468,7 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
                 next.push_back({pair.first, b.first + 1});
             }
         };
-        std::vector<FeatureSegment> found;
+        std::vector<PairCrossing> found;
         std::vector<NodePair> tasks{{0u, 0u}}, next;
         const std::size_t wanted_tasks = 256;
         while (!tasks.empty() && tasks.size() < wanted_tasks) {
@@ -465,9 +476,9 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
             for (const NodePair& pair : tasks) expand(pair, next, found);
             tasks.swap(next);
         }
-        auto deeper = gather_chunks<FeatureSegment>(
+        auto deeper = gather_chunks<PairCrossing>(
             static_cast<int>(tasks.size()), 4, threads,
-            [&](int i0, int i1, std::vector<FeatureSegment>& out) {
+            [&](int i0, int i1, std::vector<PairCrossing>& out) {
                 std::vector<NodePair> stack, pushed;
                 for (int i = i0; i < i1; ++i) {
                     stack.assign(1, tasks[static_cast<std::size_t>(i)]);
@@ -481,11 +492,40 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
                 }
             });
         found.insert(found.end(), deeper.begin(), deeper.end());
+        if (cache) {
+            // The cache's crossings of triangles that are not stale and take part now; then
+            // the cache is this frame's.
+            for (const PairCrossing& c : cache->crossings)
+                if (!stale[c.t] && !stale[c.u] && live_triangle[c.t] && live_triangle[c.u])
+                    found.push_back(c);
+            cache->corners.resize(n);
+            for (std::size_t t = 0; t < n; ++t) cache->corners[t] = corners(scene, t);
+            cache->tested = live_triangle;
+        }
         // In the order of the triangle pairs, whatever the tree.
-        std::sort(found.begin(), found.end(), [](const FeatureSegment& x, const FeatureSegment& y) {
-            return x.faces < y.faces;
+        std::sort(found.begin(), found.end(), [](const PairCrossing& x, const PairCrossing& y) {
+            return std::tie(x.t, x.u) < std::tie(y.t, y.u);
         });
-        segments.insert(segments.end(), found.begin(), found.end());
+        for (const PairCrossing& pc : found) {
+            const std::uint32_t t = pc.t, u = pc.u;
+            const TriangleCrossing& c = pc.crossing;
+            FeatureSegment seg;
+            seg.type = EdgeType::Intersection;
+            seg.p0 = c.p[0];
+            seg.p1 = c.p[1];
+            seg.faces = {t, u};
+            seg.certainly_hidden = turned_away[t] || turned_away[u];
+            if (seg.certainly_hidden && !settings.certainly_hidden) continue;
+            for (int e = 0; e < 2; ++e) {
+                const std::uint32_t on = c.on_b[e] ? u : t, other = c.on_b[e] ? t : u;
+                std::uint32_t w0 = mesh.tri_vertices[on][c.edge[e][0]],
+                              w1 = mesh.tri_vertices[on][c.edge[e][1]];
+                if (w1 < w0) std::swap(w0, w1);
+                (e == 0 ? seg.key0 : seg.key1) = {w0, w1, other};
+            }
+            segments.push_back(seg);
+        }
+        if (cache) cache->crossings = std::move(found);
     }
     return segments;
 }
