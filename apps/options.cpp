@@ -45,9 +45,9 @@ void RenderArgs::add_to(CLI::App& app) {
         ->capture_default_str();
     app.add_option(
            "--edges", edges,
-           "Line mode: robust (supersampled, plane-aware, resolution-independent lines), "
-           "classic (the seed's Sobel pipeline, exactly) or ink (lines found on the geometry, "
-           "with ray-traced visibility, drawn as exact strokes; render --svg writes them)")
+           "Line mode: ink (lines found on the geometry, with ray-traced visibility, drawn as "
+           "exact strokes; render --svg writes them), robust (supersampled, plane-aware lines "
+           "found between samples) or classic (the seed's Sobel pipeline, exactly)")
         ->check(CLI::IsMember({"robust", "classic", "ink"}))
         ->capture_default_str();
     app.add_option(

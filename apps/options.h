@@ -25,7 +25,7 @@ struct RenderArgs {
     float rim = 0.0f;
     std::string camera;
     std::string background = "1,1,1";
-    std::string edges = "robust";
+    std::string edges = "ink";  // the fewest specks and whole creases (docs/lines.md)
     float depth_threshold = 8.0f;
     float normal_threshold = 4.0f;
     std::string lines = "all";

@@ -5,7 +5,10 @@
 // most 12 pixels darker than 8% luminance) in the ink line image and in the robust `_edges`
 // image, and with --out writes both, the ink lines over the cel colours, and the SVG.
 //
-// Usage: toonray_ink_bench [--repeats N] [--size WxH] [--out DIR] [--quick] scene.obj ...
+// Usage: toonray_ink_bench [--repeats N] [--size WxH] [--out DIR] [--quick] [--previous PREV.obj]
+//        scene.obj ...
+// With --previous, each scene is also timed as the next frame of an animation after PREV.obj
+// (ink at 1 sample, the intersection lines of unmoved triangles kept from PREV.obj).
 // With no scenes: tests/data/teapot.obj. --quick runs each stage once and checks that the
 // ink lines do not depend on the thread count (CTest: ink_bench_quick).
 
@@ -76,6 +79,7 @@ struct Options {
     int width = 1280, height = 720;
     bool quick = false;
     std::optional<fs::path> out;
+    std::optional<fs::path> previous;  ///< a frame drawn before each scene, as in an animation
     std::vector<fs::path> scenes;
 };
 
@@ -85,6 +89,7 @@ int run(const Options& options) {
         "ink 1 sample / classic | ink: edges | visibility | chaining | drawing | specks robust / ink |\n");
     fmt::print("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
     int failures = 0;
+    std::vector<std::string> animation_rows;
     for (const fs::path& path : options.scenes) {
         Scene scene;
         Warnings warnings;
@@ -100,6 +105,16 @@ int run(const Options& options) {
         // Whole frames on one thread: trace, shade, lines, compose.
         // Whole frames on one thread: trace, shade, lines, compose. Then once more with the
         // feature images, which the speck counts and --out read.
+        // Before each ink frame the renderer draws a one-triangle scene, untimed: a renderer
+        // keeps the last frame's intersection lines, which would make repeats of one frame
+        // unfairly cheap (the animation table below measures that reuse between consecutive
+        // frames), while its buffers stay allocated as for the other modes.
+        Scene flush;
+        for (const Vec3f& p : {Vec3f(0, 0, -1e3f), Vec3f(1, 0, -1e3f), Vec3f(0, 1, -1e3f)})
+            flush.positions.push_back(p);
+        flush.add_triangle({0, 1, 2}, 0, 0);
+        TriangleAccel flush_accel;
+        flush_accel.build(flush.positions, flush.tri_positions);
         auto time_frame = [&](EdgeMode mode, Renderer& renderer,
                               int samples = RenderSettings{}.samples) {
             RenderSettings settings = file_options.settings;
@@ -108,6 +123,7 @@ int run(const Options& options) {
             settings.threads = 1;
             std::vector<double> t;
             for (int i = 0; i <= repeats; ++i) {
+                if (mode == EdgeMode::Ink) renderer.render(flush, flush_accel, camera, settings);
                 const auto start = Clock::now();
                 renderer.render(scene, accel, camera, settings);
                 if (i > 0 || repeats == 0)
@@ -127,6 +143,7 @@ int run(const Options& options) {
         ink::InkLines lines;
         std::vector<double> edges, visibility, chaining, drawing, total;
         for (int i = 0; i <= repeats; ++i) {
+            lines.intersections = {};  // one frame on its own
             ink::draw_ink_lines(scene, accel, camera, options.width, options.height, {}, 1, lines);
             if (i == 0 && repeats > 0) continue;
             edges.push_back(lines.timings.edges);
@@ -157,6 +174,44 @@ int run(const Options& options) {
                    ms(ink_s), ms(ink1_s), ink1_s / classic_s, ms(median(edges)),
                    ms(median(visibility)), ms(median(chaining)), ms(median(drawing)), robust_specks,
                    ink_specks);
+        if (options.previous) {
+            // As in an animation: the previous frame first, untimed, then this one with what
+            // the previous left (the intersection lines of the triangles that did not move).
+            Scene before;
+            Warnings before_warnings;
+            load_obj(*options.previous, before, before_warnings);
+            TriangleAccel before_accel;
+            before_accel.build(before.positions, before.tri_positions);
+            const CameraSpec before_camera = choose_camera(before, file_options);
+            std::vector<double> frame_t, edges_t, visibility_t, chaining_t, drawing_t;
+            RenderSettings settings = file_options.settings;
+            settings.edges = EdgeMode::Ink;
+            settings.samples = 1;
+            settings.threads = 1;
+            Renderer renderer;
+            ink::InkLines animated;
+            for (int i = 0; i <= repeats; ++i) {
+                renderer.render(before, before_accel, before_camera, settings);
+                auto start = Clock::now();
+                renderer.render(scene, accel, camera, settings);
+                const double frame_s = std::chrono::duration<double>(Clock::now() - start).count();
+                ink::draw_ink_lines(before, before_accel, before_camera, options.width,
+                                    options.height, {}, 1, animated);
+                ink::draw_ink_lines(scene, accel, camera, options.width, options.height, {}, 1,
+                                    animated);
+                if (i == 0 && repeats > 0) continue;
+                frame_t.push_back(frame_s);
+                edges_t.push_back(animated.timings.edges);
+                visibility_t.push_back(animated.timings.visibility);
+                chaining_t.push_back(animated.timings.chaining);
+                drawing_t.push_back(animated.timings.drawing);
+            }
+            animation_rows.push_back(fmt::format(
+                "| {} after {} | {} | {:.2f} | {} | {} | {} | {} |", path.filename().string(),
+                options.previous->filename().string(), ms(median(frame_t)),
+                median(frame_t) / classic_s, ms(median(edges_t)), ms(median(visibility_t)),
+                ms(median(chaining_t)), ms(median(drawing_t))));
+        }
         if (options.out) {
             fs::create_directories(*options.out);
             const std::string stem = path.stem().string();
@@ -175,6 +230,12 @@ int run(const Options& options) {
                 *options.out / (stem + "_ink.svg"),
                 std::span(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()));
         }
+    }
+    if (!animation_rows.empty()) {
+        fmt::print(
+            "\n| frame in an animation | ink frame, 1 sample | / classic | ink: edges | "
+            "visibility | chaining | drawing |\n|---|---:|---:|---:|---:|---:|---:|\n");
+        for (const std::string& row : animation_rows) fmt::print("{}\n", row);
     }
     return failures ? 1 : 0;
 }
@@ -201,6 +262,7 @@ int main(int argc, char** argv) {
                 options.height = std::stoi(v.substr(x + 1));
             } else if (arg == "--out") options.out = value();
             else if (arg == "--quick") options.quick = true;
+            else if (arg == "--previous") options.previous = value();
             else if (!arg.empty() && arg[0] == '-') throw toonray::Error("unknown option " + arg);
             else options.scenes.emplace_back(arg);
         }

@@ -41,13 +41,13 @@ fi
 
 # The renders: NAME, scene ("piano" for the build's own piano export), options.
 renders=(
-  "teapot_robust|tests/data/teapot.obj|"
+  "teapot_robust|tests/data/teapot.obj|--edges robust"
   "teapot_classic|tests/data/teapot.obj|--edges classic"
-  "spot_robust|tests/data/spot.obj|"
+  "spot_robust|tests/data/spot.obj|--edges robust"
   "spot_classic|tests/data/spot.obj|--edges classic"
-  "mixed_robust|tests/data/scene/mixed.obj|--shadows --specular --rim 0.3"
+  "mixed_robust|tests/data/scene/mixed.obj|--edges robust --shadows --specular --rim 0.3"
   "mixed_classic|tests/data/scene/mixed.obj|--edges classic --shadows --specular"
-  "piano_robust|piano|--shadows --specular"
+  "piano_robust|piano|--edges robust --shadows --specular"
   "piano_classic|piano|--edges classic"
   "teapot_ink|tests/data/teapot.obj|--edges ink"
   "piano_ink|piano|--edges ink --shadows"

@@ -1,5 +1,8 @@
 #include <gtest/gtest.h>
 
+#include <fstream>
+#include <iterator>
+
 #include "cli/cli_test_util.h"
 #include "toonray/core/image.h"
 #include "toonray/io/png.h"
@@ -21,7 +24,7 @@ TEST(RenderCli, HelpDocumentsEveryOptionAndItsDefault) {
     for (const char* opt :
          {"--lines", "--crease-angle", "--depth-step", "--line-width", "--line-color", "--samples"})
         EXPECT_NE(r.output.find(opt), std::string::npos) << opt;
-    for (const char* def : {"1280x720", "robust", "classic", "=8", "=4"})
+    for (const char* def : {"1280x720", "=ink", "classic", "=8", "=4"})
         EXPECT_NE(r.output.find(def), std::string::npos) << def << "\n" << r.output;
 }
 
@@ -149,9 +152,31 @@ TEST(RenderCli, InkLinesWithSvg) {
     EXPECT_TRUE(fs::exists(dir / "aov" / "t_edges.png"));
     EXPECT_FALSE(fs::exists(dir / "aov" / "t_lines_depth.png"));
     // An SVG needs the ink lines; the message names the flags.
-    r = run_toonray("render " + kData + "/teapot.obj -o " + (dir / "u.png").string() + " --svg " +
-                    (dir / "u.svg").string());
+    r = run_toonray("render " + kData + "/teapot.obj -o " + (dir / "u.png").string() +
+                    " --edges robust --svg " + (dir / "u.svg").string());
     EXPECT_EQ(r.exit_code, 1);
     EXPECT_NE(r.output.find("--svg needs --edges ink"), std::string::npos) << r.output;
     EXPECT_FALSE(fs::exists(dir / "u.png"));
+}
+
+// The ink lines are the default line mode: no --edges draws what --edges ink draws, and
+// writes an SVG.
+TEST(RenderCli, InkLinesAreTheDefault) {
+    TempDir dir("cli_default_lines");
+    auto bytes = [](const fs::path& path) {
+        std::ifstream in(path, std::ios::binary);
+        return std::string(std::istreambuf_iterator<char>(in), {});
+    };
+    const std::string scene = "render " + kData + "/teapot.obj --size 320x180 -o ";
+    CommandResult r = run_toonray(scene + (dir / "default.png").string() + " --svg " +
+                                  (dir / "default.svg").string());
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    r = run_toonray(scene + (dir / "ink.png").string() + " --edges ink");
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    r = run_toonray(scene + (dir / "robust.png").string() + " --edges robust");
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_FALSE(bytes(dir / "default.png").empty());
+    EXPECT_EQ(bytes(dir / "default.png"), bytes(dir / "ink.png"));
+    EXPECT_NE(bytes(dir / "default.png"), bytes(dir / "robust.png"));
+    EXPECT_TRUE(fs::exists(dir / "default.svg"));
 }

@@ -2,15 +2,18 @@
 /// Scenes built in code for the ink tests, a brute-force occluder count to check the
 /// accelerated one against, and the speck count of a line image.
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <numbers>
 #include <random>
+#include <utility>
 #include <vector>
 
 #include "toonray/accel/triangle_accel.h"
 #include "toonray/core/image.h"
 #include "toonray/ink/visibility.h"
+#include "toonray/scene/camera.h"
 #include "toonray/scene/scene.h"
 
 namespace toonray::test_support {
@@ -41,6 +44,30 @@ inline void add_box(Scene& s, const Vec3f& lo, const Vec3f& hi, std::uint32_t ob
     add_quad(s, c(2), c(6), c(7), c(3), 0, object);  // y = hi
     add_quad(s, c(0), c(4), c(6), c(2), 0, object);  // x = lo
     add_quad(s, c(1), c(3), c(7), c(5), 0, object);  // x = hi
+}
+
+/// A raised panel in the plane z = 0 facing +z, `half_x` by `half_y`, moulded by `profile`:
+/// (inset from the outer edge, height) pairs from the outer edge inward. Consecutive pairs make
+/// a ring of four mitred trapezoids around the panel, the last pair a flat field in the middle.
+/// Corners are computed from the same expressions, so rings share positions bit for bit.
+inline void add_moulded_panel(Scene& s, float half_x, float half_y,
+                              const std::vector<std::pair<float, float>>& profile,
+                              std::uint32_t object = 0) {
+    // Corner i (counter-clockwise from (-x, -y)) of the rectangle at `inset`, at `height`.
+    auto corner = [&](int i, float inset, float height) {
+        const float x = half_x - inset, y = half_y - inset;
+        const float sx = (i == 1 || i == 2) ? x : -x, sy = i >= 2 ? y : -y;
+        return Vec3f(sx, sy, height);
+    };
+    for (std::size_t k = 0; k + 1 < profile.size(); ++k) {
+        const auto [d0, h0] = profile[k];
+        const auto [d1, h1] = profile[k + 1];
+        for (int i = 0; i < 4; ++i)
+            add_quad(s, corner(i, d0, h0), corner((i + 1) % 4, d0, h0), corner((i + 1) % 4, d1, h1),
+                     corner(i, d1, h1), 0, object);
+    }
+    const auto [d, h] = profile.back();
+    add_quad(s, corner(0, d, h), corner(1, d, h), corner(2, d, h), corner(3, d, h), 0, object);
 }
 
 /// A UV sphere with shared vertices and unit vertex normals.
@@ -112,6 +139,27 @@ inline int brute_force_occluders(const Scene& s, const Vec3f& point, const Vec3f
             ++count;
     }
     return std::min(count, settings.max_invisibility);
+}
+
+/// `camera` turned by `degrees` about the vertical (y) through its gaze point.
+inline CameraSpec orbit_camera(const CameraSpec& camera, float degrees) {
+    const float a = degrees * std::numbers::pi_v<float> / 180.0f;
+    auto turn = [&](const Vec3f& v) {
+        return Vec3f(v.x * std::cos(a) - v.z * std::sin(a), v.y,
+                     v.x * std::sin(a) + v.z * std::cos(a));
+    };
+    return {camera.gaze + turn(camera.eye - camera.gaze), camera.gaze, turn(camera.up)};
+}
+
+/// The largest deviation of a value in a sequence from the mean of its two neighbours,
+/// relative to that mean.
+inline double worst_deviation(const std::vector<double>& values) {
+    double worst = 0;
+    for (std::size_t i = 1; i + 1 < values.size(); ++i) {
+        const double mean = 0.5 * (values[i - 1] + values[i + 1]);
+        worst = std::max(worst, std::abs(values[i] - mean) / mean);
+    }
+    return worst;
 }
 
 /// Specks: 8-connected groups of at most `max_size` pixels darker than `threshold` (8% of

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "ink/ink_scenes.h"
+#include "ink/svg_compare.h"
 #include "support/test_support.h"
 #include "toonray/ink/svg.h"
 #include "toonray/io/file.h"
@@ -16,12 +17,7 @@
 namespace toonray {
 namespace {
 
-void write_svg(const std::filesystem::path& path, std::span<const ink::Stroke> strokes,
-               const ink::SvgSettings& svg) {
-    const std::string text = ink::svg_text(strokes, svg);
-    write_file_atomic(path,
-                      std::span(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()));
-}
+using test_support::write_svg;
 
 struct Teapot {
     Scene scene;
@@ -37,25 +33,6 @@ struct Teapot {
         camera = auto_camera(used, w, h);
     }
 };
-
-// Share of the line pixels of `a` within 1.5 px of a line pixel of `b`.
-double agreement(const std::vector<bool>& a, const std::vector<bool>& b, int w, int h) {
-    long lines = 0, near = 0;
-    for (int y = 0; y < h; ++y)
-        for (int x = 0; x < w; ++x) {
-            if (!a[static_cast<std::size_t>(y) * w + x]) continue;
-            ++lines;
-            bool found = false;
-            for (int dy = -1; dy <= 1 && !found; ++dy)
-                for (int dx = -1; dx <= 1 && !found; ++dx) {  // 1.5 px: the 8 neighbours
-                    const int nx = x + dx, ny = y + dy;
-                    found = nx >= 0 && ny >= 0 && nx < w && ny < h &&
-                            b[static_cast<std::size_t>(ny) * w + nx];
-                }
-            near += found;
-        }
-    return lines ? static_cast<double>(near) / static_cast<double>(lines) : 0.0;
-}
 
 TEST(InkLines, TeapotHasLinesOfEveryStageAndIsThreadIndependent) {
     const Teapot t(640, 360);
@@ -116,39 +93,13 @@ TEST(InkSvg, ParsesAsXmlWithTheLayersAndGroups) {
 // A real SVG renderer draws the file like toonray's own coverage: at least 90% of each
 // image's line pixels lie within 1.5 px of the other's.
 TEST(InkSvg, RsvgDrawsWhatToonrayDraws) {
-    // A real SVG renderer checks the file; scripts/install-deps.sh installs it for the tests.
-    ASSERT_EQ(std::system("rsvg-convert --version > /dev/null 2>&1"), 0)
-        << "rsvg-convert (Debian librsvg2-bin) is not installed: bash scripts/install-deps.sh all";
     const int w = 1280, h = 720;
     const Teapot t(w, h);
     ink::InkLines lines;
     ink::draw_ink_lines(t.scene, t.accel, t.camera, w, h, {}, 0, lines);
     test_support::TempDir dir("ink_rsvg");
-    ink::SvgSettings svg;
-    svg.width = w;
-    svg.height = h;
-    svg.thickness = ink::stroke_thickness(2.0f, h);
-    write_svg(dir / "teapot.svg", lines.strokes, svg);
-    const std::string convert = "rsvg-convert -b white -o " + (dir / "teapot.png").string() + " " +
-                                (dir / "teapot.svg").string();
-    ASSERT_EQ(std::system(convert.c_str()), 0) << convert;
-    const DecodedPng png = read_png(dir / "teapot.png");
-    ASSERT_EQ(png.width, w);
-    ASSERT_EQ(png.height, h);
-    std::vector<bool> ours(static_cast<std::size_t>(w) * h), theirs(ours.size());
-    long ours_count = 0, theirs_count = 0;
-    for (int y = 0; y < h; ++y)
-        for (int x = 0; x < w; ++x) {
-            const std::size_t i = static_cast<std::size_t>(y) * w + x;
-            ours[i] = lines.coverage(x, y) > 0.5f;
-            theirs[i] = png.rgb(x, y)[0] < 128;
-            ours_count += ours[i];
-            theirs_count += theirs[i];
-        }
-    EXPECT_GT(ours_count, 2000);
-    EXPECT_NEAR(static_cast<double>(theirs_count) / ours_count, 1.0, 0.2);
-    EXPECT_GE(agreement(ours, theirs, w, h), 0.9);
-    EXPECT_GE(agreement(theirs, ours, w, h), 0.9);
+    test_support::expect_rsvg_draws_like_coverage(
+        lines.strokes, lines.coverage, ink::stroke_thickness(2.0f, h), dir.path, "teapot", 2000);
 }
 
 }  // namespace

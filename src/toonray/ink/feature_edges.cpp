@@ -179,7 +179,8 @@ bool intersect_triangles(const std::array<Vec3f, 3>& a, const std::array<Vec3f, 
 
 std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedMesh& mesh,
                                                const Bvh& bvh, const Vec3f& eye,
-                                               const FeatureEdgeSettings& settings, int threads) {
+                                               const FeatureEdgeSettings& settings, int threads,
+                                               IntersectionCache* cache) {
     const std::size_t n = scene.triangle_count();
     std::vector<Vec3f> normal(n);
     for (std::size_t t = 0; t < n; ++t) normal[t] = face_normal(scene, t);
@@ -193,21 +194,28 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
         bool forward;  // lo -> hi in the triangle's winding
         int corner;    // the corner the side starts from in the winding
     };
+    // The sides are gathered vertex by vertex from the triangles around each welded vertex:
+    // at vertex lo, the sides from lo to a higher id, sorted by (hi, triangle). That is the
+    // order of a sort of all sides by (lo, hi, triangle), without sorting them all.
     std::vector<Side> sides;
     sides.reserve(n * 3);
-    for (std::size_t t = 0; t < n; ++t) {
-        if (!usable(t)) continue;
-        const auto& w = mesh.tri_vertices[t];
-        for (int k = 0; k < 3; ++k) {
-            const std::uint32_t u = w[k], v = w[(k + 1) % 3];
-            if (u == v) continue;
-            sides.push_back(
-                {std::min(u, v), std::max(u, v), static_cast<std::uint32_t>(t), u < v, k});
+    for (std::uint32_t lo = 0; lo < mesh.vertex_count(); ++lo) {
+        const std::size_t first = sides.size();
+        for (std::uint32_t r = mesh.ring_offsets[lo]; r < mesh.ring_offsets[lo + 1]; ++r) {
+            const std::uint32_t t = mesh.ring_triangles[r];
+            if (!usable(t)) continue;
+            const auto& w = mesh.tri_vertices[t];
+            for (int k = 0; k < 3; ++k) {
+                const std::uint32_t u = w[k], v = w[(k + 1) % 3];
+                if (u == v || std::min(u, v) != lo) continue;
+                sides.push_back({lo, std::max(u, v), t, u < v, k});
+            }
         }
+        std::sort(sides.begin() + static_cast<std::ptrdiff_t>(first), sides.end(),
+                  [](const Side& a, const Side& b) {
+                      return std::tie(a.hi, a.tri, a.corner) < std::tie(b.hi, b.tri, b.corner);
+                  });
     }
-    std::sort(sides.begin(), sides.end(), [](const Side& a, const Side& b) {
-        return std::tie(a.lo, a.hi, a.tri) < std::tie(b.lo, b.hi, b.tri);
-    });
     const float cos_crease =
         portable::cos(settings.crease_angle * std::numbers::pi_v<float> / 180.0f);
     // Shading is smooth across a side shared by two triangles when both have a normal at every
@@ -256,6 +264,14 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
     for (std::size_t o = 0; o < objects; ++o)
         if (closed[o] && volume[o] != 0.0 && eye_outside(object_box[o]))
             outward[o] = volume[o] > 0.0 ? 1 : -1;
+    // Triangles turned away from the eye on those objects: every point inside them is hidden
+    // by the solid, so an intersection line on one is certainly hidden.
+    std::vector<std::uint8_t> turned_away(n, 0);
+    for (std::size_t t = 0; t < n; ++t) {
+        const int out = outward[scene.tri_object[t]];
+        const float facing = dot(normal[t], eye - scene.positions[scene.tri_positions[t][0]]);
+        turned_away[t] = out != 0 && usable(t) && (out > 0 ? facing < 0 : facing > 0);
+    }
 
     for (std::size_t i = 0; i < sides.size();) {
         std::size_t j = i + 1;
@@ -293,7 +309,7 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
                 emit = true;
             }
         }
-        if (emit) segments.push_back(seg);
+        if (emit && (settings.certainly_hidden || !seg.certainly_hidden)) segments.push_back(seg);
         i = j;
     }
 
@@ -333,85 +349,183 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
 
     // Intersection lines: each triangle against the triangles whose boxes overlap its own.
     if (settings.intersections && !bvh.nodes.empty()) {
-        std::vector<BBox> boxes(n);
-        for (std::size_t t = 0; t < n; ++t)
-            for (const Vec3f& p : corners(scene, t)) boxes[t].extend(p);
-        // Each corner's canonical position (equal for equal coordinates, across objects).
-        std::vector<std::array<std::uint32_t, 3>> tri_position(n);
-        for (std::size_t t = 0; t < n; ++t)
+        // Boxes and corner positions (canonical: equal for equal coordinates, across objects)
+        // in the BVH's primitive order, so that a leaf's triangles are read together.
+        const std::size_t prims = bvh.prim_indices.size();
+        std::vector<BBox> boxes(prims);
+        std::vector<std::array<std::uint32_t, 3>> tri_position(prims);
+        for (std::size_t i = 0; i < prims; ++i) {
+            const std::uint32_t t = bvh.prim_indices[i];
+            for (const Vec3f& p : corners(scene, t)) boxes[i].extend(p);
             for (int k = 0; k < 3; ++k)
-                tri_position[t][k] = mesh.vertex_position[mesh.tri_vertices[t][k]];
+                tri_position[i][k] = mesh.vertex_position[mesh.tri_vertices[t][k]];
+        }
         auto overlap = [](const BBox& a, const BBox& b) {
             return !(a.lo.x > b.hi.x || a.hi.x < b.lo.x || a.lo.y > b.hi.y || a.hi.y < b.lo.y ||
                      a.lo.z > b.hi.z || a.hi.z < b.lo.z);
         };
-        // One BVH query per leaf, with the leaf's box: its triangles are near each other, so
-        // they share most candidates. Each pair is tested once, from its lower triangle, and
-        // the segments are sorted by pair at the end.
-        std::vector<std::uint32_t> leaves;
-        for (std::size_t i = 0; i < bvh.nodes.size(); ++i)
-            if (bvh.nodes[i].is_leaf()) leaves.push_back(static_cast<std::uint32_t>(i));
-        auto found = gather_chunks<FeatureSegment>(
-            static_cast<int>(leaves.size()), 16, threads,
-            [&](int l0, int l1, std::vector<FeatureSegment>& out) {
-                std::vector<std::uint32_t> stack, near;
-                for (int l = l0; l < l1; ++l) {
-                    const BvhNode& leaf = bvh.nodes[leaves[static_cast<std::size_t>(l)]];
-                    near.clear();
-                    stack.assign(1, 0);
+        // Pairs of triangles with overlapping boxes, by traversing the BVH against itself:
+        // a pair of nodes is opened only when their boxes overlap, and a node is paired with
+        // itself once, so each triangle pair is met once, in the leaf pair that holds it.
+        // The node pairs are first expanded breadth-first into enough independent tasks for
+        // the threads; the segments are sorted by triangle pair at the end.
+        // Without hidden lines, triangles turned away from the eye on closed solids take no
+        // part, and neither do nodes holding only such triangles.
+        // Triangles that take part: usable ones, and without hidden lines only those not turned
+        // away from the eye on a closed solid.
+        std::vector<std::uint8_t> live_triangle(n);
+        for (std::size_t t = 0; t < n; ++t)
+            live_triangle[t] = usable(t) && (settings.certainly_hidden || !turned_away[t]);
+        // With a cache, a pair is tested only if one of its triangles is stale: its corners
+        // changed since the cache's frame, or it did not take part then.
+        std::vector<std::uint8_t> stale;
+        if (cache) {
+            const bool same_count = cache->corners.size() == n && cache->tested.size() == n;
+            auto same = [](const Vec3f& a, const Vec3f& b) {
+                return std::bit_cast<std::array<std::uint32_t, 3>>(a) ==
+                       std::bit_cast<std::array<std::uint32_t, 3>>(b);
+            };
+            stale.assign(n, 1);
+            if (same_count)
+                for (std::size_t t = 0; t < n; ++t) {
+                    const auto now = corners(scene, t);
+                    stale[t] = !cache->tested[t] ||
+                               !std::equal(now.begin(), now.end(), cache->corners[t].begin(), same);
+                }
+        }
+        std::vector<std::uint8_t> live(prims);
+        for (std::size_t i = 0; i < prims; ++i) live[i] = live_triangle[bvh.prim_indices[i]];
+        // Per node: whether it holds a live triangle, and (with a cache) a stale one.
+        std::vector<std::uint8_t> node_live(bvh.nodes.size(), 0), node_stale(bvh.nodes.size(), 0);
+        auto mark = [&](auto&& self, std::uint32_t i) -> void {
+            const BvhNode& node = bvh.nodes[i];
+            if (node.is_leaf()) {
+                for (std::uint32_t k = node.first; k < node.first + node.count; ++k) {
+                    node_live[i] |= live[k];
+                    node_stale[i] |= !cache || stale[bvh.prim_indices[k]];
+                }
+                return;
+            }
+            self(self, node.first);
+            self(self, node.first + 1);
+            node_live[i] = node_live[node.first] | node_live[node.first + 1];
+            node_stale[i] = node_stale[node.first] | node_stale[node.first + 1];
+        };
+        mark(mark, 0);
+        // Tests the triangles in primitive slots i and j.
+        auto test_pair = [&](std::uint32_t i, std::uint32_t j, std::vector<PairCrossing>& out) {
+            if (!live[i] || !live[j] || !overlap(boxes[i], boxes[j])) return;
+            std::uint32_t t = bvh.prim_indices[i], u = bvh.prim_indices[j];
+            if (cache && !stale[t] && !stale[u]) return;  // the cache has it
+            // Triangles sharing a corner position (in any object) touch there: no line.
+            const auto& pa = tri_position[i];
+            const auto& pb = tri_position[j];
+            for (std::uint32_t a_corner : pa)
+                if (a_corner == pb[0] || a_corner == pb[1] || a_corner == pb[2]) return;
+            if (u < t) std::swap(t, u);
+            PairCrossing found{t, u, {}};
+            if (intersect_triangles(corners(scene, t), corners(scene, u), found.crossing))
+                out.push_back(found);
+        };
+        using NodePair = std::pair<std::uint32_t, std::uint32_t>;
+        // Opens one node pair: tests the triangles of two leaves (or of one leaf with itself),
+        // or pushes the child pairs whose boxes may overlap.
+        auto expand = [&](NodePair pair, std::vector<NodePair>& next,
+                          std::vector<PairCrossing>& out) {
+            if (!node_live[pair.first] || !node_live[pair.second]) return;
+            if (!node_stale[pair.first] && !node_stale[pair.second]) return;
+            const BvhNode& a = bvh.nodes[pair.first];
+            const BvhNode& b = bvh.nodes[pair.second];
+            if (pair.first == pair.second) {
+                if (a.is_leaf()) {
+                    for (std::uint32_t i = a.first; i < a.first + a.count; ++i)
+                        for (std::uint32_t j = i + 1; j < a.first + a.count; ++j)
+                            test_pair(i, j, out);
+                } else {
+                    next.push_back({a.first, a.first});
+                    next.push_back({a.first + 1, a.first + 1});
+                    next.push_back({a.first, a.first + 1});
+                }
+                return;
+            }
+            if (!overlap(a.bounds, b.bounds)) return;
+            if (a.is_leaf() && b.is_leaf()) {
+                for (std::uint32_t i = a.first; i < a.first + a.count; ++i)
+                    for (std::uint32_t j = b.first; j < b.first + b.count; ++j)
+                        test_pair(i, j, out);
+                return;
+            }
+            // Open the inner node with the larger box (or the only inner one).
+            auto extent = [](const BBox& box) {
+                const Vec3f d = box.hi - box.lo;
+                return d.x + d.y + d.z;
+            };
+            if (b.is_leaf() || (!a.is_leaf() && extent(a.bounds) >= extent(b.bounds))) {
+                next.push_back({a.first, pair.second});
+                next.push_back({a.first + 1, pair.second});
+            } else {
+                next.push_back({pair.first, b.first});
+                next.push_back({pair.first, b.first + 1});
+            }
+        };
+        std::vector<PairCrossing> found;
+        std::vector<NodePair> tasks{{0u, 0u}}, next;
+        const std::size_t wanted_tasks = 256;
+        while (!tasks.empty() && tasks.size() < wanted_tasks) {
+            next.clear();
+            for (const NodePair& pair : tasks) expand(pair, next, found);
+            tasks.swap(next);
+        }
+        auto deeper = gather_chunks<PairCrossing>(
+            static_cast<int>(tasks.size()), 4, threads,
+            [&](int i0, int i1, std::vector<PairCrossing>& out) {
+                std::vector<NodePair> stack, pushed;
+                for (int i = i0; i < i1; ++i) {
+                    stack.assign(1, tasks[static_cast<std::size_t>(i)]);
                     while (!stack.empty()) {
-                        const BvhNode& node = bvh.nodes[stack.back()];
+                        const NodePair pair = stack.back();
                         stack.pop_back();
-                        if (!overlap(node.bounds, leaf.bounds)) continue;
-                        if (node.is_leaf()) {
-                            near.insert(near.end(), bvh.prim_indices.begin() + node.first,
-                                        bvh.prim_indices.begin() + node.first + node.count);
-                        } else {
-                            stack.push_back(node.first);
-                            stack.push_back(node.first + 1);
-                        }
-                    }
-                    for (std::uint32_t i = leaf.first; i < leaf.first + leaf.count; ++i) {
-                        const std::uint32_t t = bvh.prim_indices[i];
-                        if (!usable(t)) continue;
-                        const auto a = corners(scene, t);
-                        const BBox& box = boxes[t];
-                        for (std::uint32_t u : near) {
-                            if (u <= t || !overlap(boxes[u], box) || !usable(u)) continue;
-                            // Triangles sharing a corner position (in any object) touch there: no line.
-                            const auto& pa = tri_position[t];
-                            const auto& pb = tri_position[u];
-                            bool shared = false;
-                            for (std::uint32_t a_corner : pa)
-                                shared = shared || a_corner == pb[0] || a_corner == pb[1] ||
-                                         a_corner == pb[2];
-                            if (shared) continue;
-                            const auto b = corners(scene, u);
-                            TriangleCrossing c;
-                            if (!intersect_triangles(a, b, c)) continue;
-                            FeatureSegment seg;
-                            seg.type = EdgeType::Intersection;
-                            seg.p0 = c.p[0];
-                            seg.p1 = c.p[1];
-                            seg.faces = {t, u};
-                            for (int e = 0; e < 2; ++e) {
-                                const std::uint32_t on = c.on_b[e] ? u : t,
-                                                    other = c.on_b[e] ? t : u;
-                                std::uint32_t w0 = mesh.tri_vertices[on][c.edge[e][0]],
-                                              w1 = mesh.tri_vertices[on][c.edge[e][1]];
-                                if (w1 < w0) std::swap(w0, w1);
-                                (e == 0 ? seg.key0 : seg.key1) = {w0, w1, other};
-                            }
-                            out.push_back(seg);
-                        }
+                        pushed.clear();
+                        expand(pair, pushed, out);
+                        stack.insert(stack.end(), pushed.begin(), pushed.end());
                     }
                 }
             });
+        found.insert(found.end(), deeper.begin(), deeper.end());
+        if (cache) {
+            // The cache's crossings of triangles that are not stale and take part now; then
+            // the cache is this frame's.
+            for (const PairCrossing& c : cache->crossings)
+                if (!stale[c.t] && !stale[c.u] && live_triangle[c.t] && live_triangle[c.u])
+                    found.push_back(c);
+            cache->corners.resize(n);
+            for (std::size_t t = 0; t < n; ++t) cache->corners[t] = corners(scene, t);
+            cache->tested = live_triangle;
+        }
         // In the order of the triangle pairs, whatever the tree.
-        std::sort(found.begin(), found.end(), [](const FeatureSegment& x, const FeatureSegment& y) {
-            return x.faces < y.faces;
+        std::sort(found.begin(), found.end(), [](const PairCrossing& x, const PairCrossing& y) {
+            return std::tie(x.t, x.u) < std::tie(y.t, y.u);
         });
-        segments.insert(segments.end(), found.begin(), found.end());
+        for (const PairCrossing& pc : found) {
+            const std::uint32_t t = pc.t, u = pc.u;
+            const TriangleCrossing& c = pc.crossing;
+            FeatureSegment seg;
+            seg.type = EdgeType::Intersection;
+            seg.p0 = c.p[0];
+            seg.p1 = c.p[1];
+            seg.faces = {t, u};
+            seg.certainly_hidden = turned_away[t] || turned_away[u];
+            if (seg.certainly_hidden && !settings.certainly_hidden) continue;
+            for (int e = 0; e < 2; ++e) {
+                const std::uint32_t on = c.on_b[e] ? u : t, other = c.on_b[e] ? t : u;
+                std::uint32_t w0 = mesh.tri_vertices[on][c.edge[e][0]],
+                              w1 = mesh.tri_vertices[on][c.edge[e][1]];
+                if (w1 < w0) std::swap(w0, w1);
+                (e == 0 ? seg.key0 : seg.key1) = {w0, w1, other};
+            }
+            segments.push_back(seg);
+        }
+        if (cache) cache->crossings = std::move(found);
     }
     return segments;
 }

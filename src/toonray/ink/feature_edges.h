@@ -60,6 +60,10 @@ struct FeatureEdgeSettings {
     /// Smooth contours (Hertzmann & Zorin 2000) on triangles with a normal at every corner,
     /// instead of polygonal silhouettes on the edges where shading is smooth.
     bool smooth_contours = true;
+    /// Also the intersection lines on a triangle turned away from the eye on a closed solid
+    /// (FeatureSegment::certainly_hidden). Without them the visible lines are the same, and
+    /// finding the intersection lines skips those triangles.
+    bool certainly_hidden = true;
 };
 
 /// Vertices welded by exact position within each object: two triangle corners share a welded
@@ -79,16 +83,6 @@ struct WeldedMesh {
 
 [[nodiscard]] WeldedMesh weld_vertices(const Scene& scene);
 
-/// All feature segments of the scene seen from `eye`, in a fixed order (mesh edges by welded
-/// vertex pair, then smooth contours by triangle, then intersection lines by triangle pair),
-/// whatever the thread count. `bvh` is a BVH over the scene's triangles (TriangleAccel::bvh())
-/// for the intersection lines.
-[[nodiscard]] std::vector<FeatureSegment> find_feature_edges(const Scene& scene,
-                                                             const WeldedMesh& mesh, const Bvh& bvh,
-                                                             const Vec3f& eye,
-                                                             const FeatureEdgeSettings& settings,
-                                                             int threads);
-
 /// The segment where triangles (a0, a1, a2) and (b0, b1, b2) cross, if they do properly (each
 /// has corners strictly on both sides of the other's plane; coplanar or touching pairs give
 /// none). Each endpoint is where an edge of one crosses the other; `edge` gets that edge's
@@ -100,5 +94,34 @@ struct TriangleCrossing {
 };
 [[nodiscard]] bool intersect_triangles(const std::array<Vec3f, 3>& a, const std::array<Vec3f, 3>& b,
                                        TriangleCrossing& out);
+
+/// Where two triangles t < u cross (intersect_triangles(corners of t, corners of u)).
+struct PairCrossing {
+    std::uint32_t t = 0, u = 0;
+    TriangleCrossing crossing;
+};
+
+/// Intersection lines kept from one frame to the next: whether and where two triangles cross
+/// depends only on their corners, so a pair of triangles that both took part in the last frame
+/// and did not move (corners equal bit for bit) gives the same crossing; only pairs with another
+/// triangle are tested again. Between two frames of the piano most triangles do not move.
+struct IntersectionCache {
+    std::vector<std::array<Vec3f, 3>> corners;  ///< each triangle's corners in the last frame
+    /// Per triangle: it took part in the last frame (without hidden lines, triangles turned
+    /// away from the eye on closed solids do not), so its pairs with others that did are in
+    /// `crossings`.
+    std::vector<std::uint8_t> tested;
+    std::vector<PairCrossing> crossings;  ///< of those pairs, by (t, u)
+};
+
+/// All feature segments of the scene seen from `eye`, in a fixed order (mesh edges by welded
+/// vertex pair, then smooth contours by triangle, then intersection lines by triangle pair),
+/// whatever the thread count. `bvh` is a BVH over the scene's triangles (TriangleAccel::bvh())
+/// for the intersection lines. With a cache, the intersection lines of triangles that did not
+/// move since the cache's last frame are taken from it (the same segments), and the cache is
+/// updated.
+[[nodiscard]] std::vector<FeatureSegment> find_feature_edges(
+    const Scene& scene, const WeldedMesh& mesh, const Bvh& bvh, const Vec3f& eye,
+    const FeatureEdgeSettings& settings, int threads, IntersectionCache* cache = nullptr);
 
 }  // namespace toonray::ink

@@ -21,8 +21,10 @@ void draw_ink_lines(const Scene& scene, const TriangleAccel& accel, const Camera
 
     auto start = std::chrono::steady_clock::now();
     out.mesh = weld_vertices(scene);
-    out.segments =
-        find_feature_edges(scene, out.mesh, accel.bvh(), plane.eye, settings.edges, threads);
+    FeatureEdgeSettings edges = settings.edges;
+    if (!settings.chain.hidden) edges.certainly_hidden = false;  // chaining would drop them
+    out.segments = find_feature_edges(scene, out.mesh, accel.bvh(), plane.eye, edges, threads,
+                                      &out.intersections);
     out.timings.edges = seconds_since(start);
 
     start = std::chrono::steady_clock::now();

@@ -34,7 +34,8 @@ struct InkLines {
     std::vector<FeatureSegment> segments;
     std::vector<EdgePiece> pieces;
     std::vector<Stroke> strokes;
-    ImageF coverage;  ///< visible strokes, 0 = no line, 1 = covered
+    ImageF coverage;                  ///< visible strokes, 0 = no line, 1 = covered
+    IntersectionCache intersections;  ///< for the next frame's unmoved triangles
     InkTimings timings;
 };
 

@@ -9,9 +9,12 @@
 
 namespace toonray::ink {
 
-std::vector<std::uint32_t> ignored_triangles(const FeatureSegment& segment,
-                                             const WeldedMesh& mesh) {
-    std::vector<std::uint32_t> out;
+namespace {
+
+// ignored_triangles into a buffer kept across segments.
+void gather_ignored(const FeatureSegment& segment, const WeldedMesh& mesh,
+                    std::vector<std::uint32_t>& out) {
+    out.clear();
     for (std::uint32_t f : segment.faces)
         if (f != kNoIndex) out.push_back(f);
     if (segment.smooth && segment.faces[0] != kNoIndex)
@@ -20,6 +23,14 @@ std::vector<std::uint32_t> ignored_triangles(const FeatureSegment& segment,
                        mesh.ring_triangles.begin() + mesh.ring_offsets[v + 1]);
     std::sort(out.begin(), out.end());
     out.erase(std::unique(out.begin(), out.end()), out.end());
+}
+
+}  // namespace
+
+std::vector<std::uint32_t> ignored_triangles(const FeatureSegment& segment,
+                                             const WeldedMesh& mesh) {
+    std::vector<std::uint32_t> out;
+    gather_ignored(segment, mesh, out);
     return out;
 }
 
@@ -110,7 +121,9 @@ std::vector<EdgePiece> split_by_visibility(std::span<const FeatureSegment> segme
             std::vector<int> states, sample_states;
             std::vector<Vec3f> dirs, points;
             std::vector<Hit> hits;
+            std::vector<std::uint32_t> ignored;
             std::unique_ptr<bool[]> found;
+            std::size_t found_size = 0;
             for (int i = i0; i < i1; ++i) {
                 const FeatureSegment& seg = segments[static_cast<std::size_t>(i)];
                 ClippedSegment c;
@@ -133,7 +146,7 @@ std::vector<EdgePiece> split_by_visibility(std::span<const FeatureSegment> segme
                     out.push_back(piece);
                     continue;
                 }
-                const std::vector<std::uint32_t> ignored = ignored_triangles(seg, context.mesh);
+                gather_ignored(seg, context.mesh, ignored);
                 auto state_at = [&](float s) {
                     const float t = c.t_of(s);
                     return count_occluders(context.accel, seg.p0 + (seg.p1 - seg.p0) * t,
@@ -160,7 +173,10 @@ std::vector<EdgePiece> split_by_visibility(std::span<const FeatureSegment> segme
                     dirs.resize(padded);
                     points.resize(padded);
                     hits.resize(padded);
-                    found.reset(new bool[padded]);
+                    if (found_size < padded) {
+                        found_size = std::max(padded, 2 * found_size);
+                        found.reset(new bool[found_size]);
+                    }
                     for (std::size_t k = 0; k < padded; ++k) {
                         const int sample = std::min(static_cast<int>(k), n - 1);
                         points[k] = seg.p0 + (seg.p1 - seg.p0) * c.t_of(sample_s(sample));
