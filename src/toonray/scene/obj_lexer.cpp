@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <charconv>
+#include <limits>
 #include <cmath>
 #include <cstring>
 #include <fmt/format.h>
@@ -78,6 +79,16 @@ void LineParser::fail_limit(Limit limit, std::string_view message) const {
 }
 
 float LineParser::number(Tokens& t, std::string_view what) const {
+    bool finite = true;
+    return read_number(t, what, finite, false);
+}
+
+float LineParser::coordinate(Tokens& t, std::string_view what, bool& finite) const {
+    return read_number(t, what, finite, true);
+}
+
+float LineParser::read_number(Tokens& t, std::string_view what, bool& finite,
+                              bool allow_nonfinite) const {
     std::string_view tok = t.next();
     if (tok.empty()) fail(fmt::format("missing number in '{}' statement", what));
     const char* b = tok.data();
@@ -89,20 +100,30 @@ float LineParser::number(Tokens& t, std::string_view what) const {
     auto [ptr, ec] = std::from_chars(b, e, v);
     if (ec == std::errc::result_out_of_range && ptr == e) {
         // Too small for a float reads as zero (as strtof and other readers do: exporters
-        // that write doubles produce such values); too large is an error.
+        // that write doubles produce such values); too large is an error, or an infinite
+        // coordinate where those are allowed.
         double d;
         auto [dptr, dec] = std::from_chars(b, e, d);
         std::string_view digits(b, static_cast<std::size_t>(e - b));
         bool underflow = dec == std::errc() ? std::abs(d) < 1.0
                                             : digits.find("e-") != std::string_view::npos ||
                                                   digits.find("E-") != std::string_view::npos;
-        if (!underflow) fail(fmt::format("number '{}' out of range in '{}' statement", tok, what));
+        if (!underflow) {
+            if (!allow_nonfinite)
+                fail(fmt::format("number '{}' out of range in '{}' statement", tok, what));
+            finite = false;
+            return std::numeric_limits<float>::infinity();
+        }
         v = dec == std::errc() ? static_cast<float>(d) : 0.0f;
         ec = std::errc();
     }
     if (ec != std::errc() || ptr != e)
         fail(fmt::format("malformed number '{}' in '{}' statement", tok, what));
-    if (!std::isfinite(v)) fail(fmt::format("non-finite number '{}' in '{}' statement", tok, what));
+    if (!std::isfinite(v)) {
+        if (!allow_nonfinite)
+            fail(fmt::format("non-finite number '{}' in '{}' statement", tok, what));
+        finite = false;
+    }
     return v;
 }
 

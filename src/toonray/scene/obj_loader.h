@@ -9,6 +9,13 @@
 /// camera block statement `c eye gaze up`. Polygons are triangulated as a fan from their first
 /// corner, which is exact for convex polygons. Faces index only vertices defined before them.
 /// An object is the run of faces after an `o` or `g` statement, named by it.
+///
+/// Read as other tools read them, with a warning (file:line) each: a texture or normal index
+/// that points at no `vt`/`vn` (the face has no texture coordinates, or uses its geometric
+/// normal); a non-finite coordinate (`nan`, `inf`, or beyond a float: faces using the vertex
+/// are dropped; a non-finite normal or texture coordinate only takes those from the face);
+/// `p` elements (ignored, one warning). `mtllib` names may escape spaces (`my\ file.mtl`).
+/// A vertex index of 0 or out of range stays an error.
 
 #include <cstddef>
 #include <filesystem>
