@@ -2,17 +2,19 @@
 
 #include "toonray/core/saturating.h"
 
+#include <fmt/format.h>
 #include <variant>
 #include <vector>
 
 #include "toonray/core/error.h"
 #include "toonray/ink/svg.h"
+#include "toonray/io/exr.h"
 #include "toonray/io/file.h"
 
 namespace toonray {
 RenderSettings FrameOptions::render_settings() const {
     RenderSettings s = settings;
-    s.feature_images = aov_dir.has_value();
+    s.feature_images = aov_dir.has_value() || aov_exr.has_value();
     s.hidden_lines = svg.has_value() && svg_hidden;
     return s;
 }
@@ -51,6 +53,22 @@ std::filesystem::path aov_path(const std::filesystem::path& dir,
     return dir / (output.stem().string() + "_" + std::string(name) + ".png");
 }
 
+std::filesystem::path exr_path(const std::filesystem::path& aov_exr,
+                               const std::filesystem::path& output) {
+    if (aov_exr.extension() == ".exr" || aov_exr.extension() == ".EXR") return aov_exr;
+    return aov_exr / (output.stem().string() + ".exr");
+}
+
+void check_exr_sequence(const std::filesystem::path& aov_exr) {
+    if (!exr_available())
+        throw Error("EXR feature images are not available: this toonray was built without OpenEXR");
+    if (exr_path(aov_exr, "frame.png") == aov_exr)
+        throw Error(
+            fmt::format("{}: EXR feature images of a sequence go to a directory (one file "
+                        "a frame), not one .exr file",
+                        aov_exr.string()));
+}
+
 std::uint64_t frame_bytes(const FrameOptions& options) {
     const RenderSettings settings = options.render_settings();
     const std::uint64_t pixels = static_cast<std::uint64_t>(std::max(settings.width, 0)) *
@@ -59,7 +77,8 @@ std::uint64_t frame_bytes(const FrameOptions& options) {
     // compressed bound and the file's bytes, about three copies, and a compressor of under 1 MiB.
     const std::uint64_t png =
         pixels > UINT64_MAX / 16 ? UINT64_MAX : pixels * 3 * sizeof(Rgb8) + 1024 * 1024;
-    const std::uint64_t total = add_saturated(frame_buffer_bytes(settings), png);
+    std::uint64_t total = add_saturated(frame_buffer_bytes(settings), png);
+    if (options.aov_exr) total = add_saturated(total, feature_exr_bytes(pixels));
     return add_saturated(total, total / 5);
 }
 
@@ -71,6 +90,8 @@ void FrameRenderer::render(const Scene& scene, const CameraSpec& camera,
     validate_camera(camera);
     if (options.svg && settings.edges != EdgeMode::Ink)
         throw Error("an SVG drawing needs the ink line mode");
+    if (options.aov_exr && !exr_available())
+        throw Error("EXR feature images are not available: this toonray was built without OpenEXR");
     const TriangleAccel& accel = accel_.update(scene, options.bvh);
     const TextureSet* textures =
         settings.shading.textures ? &textures_.load(scene, warnings) : nullptr;
@@ -84,6 +105,14 @@ void FrameRenderer::render(const Scene& scene, const CameraSpec& camera,
             std::visit([&](auto member) { write_png(path, aovs.*member, options.png); },
                        feature.image);
         }
+    }
+    if (options.aov_exr) {
+        // Before the frame's PNG, as the PNG feature images: a frame whose PNG is valid has its
+        // EXR too, so resuming a sequence skips it safely.
+        const std::filesystem::path path = exr_path(*options.aov_exr, output);
+        if (path.has_parent_path()) std::filesystem::create_directories(path.parent_path());
+        gather_feature_layers(scene, accel, camera, settings, renderer_, layers_);
+        write_feature_exr(path, layers_);
     }
     if (options.svg) write_svg(renderer_, settings, options);
     write_png(output, image, options.png);
