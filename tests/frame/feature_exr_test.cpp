@@ -176,8 +176,8 @@ TEST(FeatureExr, RobustLayersAgreeWithThePngFeatureImages) {
             ASSERT_GT(nx * gx + ny * gy + nz * gz, 0.5f) << "pixel " << i;
         }
         for (int c = 0; c < 3; ++c)
-            ASSERT_NEAR(exr.values.at(std::string(1, "RGB"[c]))[i], linear(cel_png.rgb.data()[i][c]),
-                        2e-3f);
+            ASSERT_NEAR(exr.values.at(std::string(1, "RGB"[c]))[i],
+                        linear(cel_png.rgb.data()[i][c]), 2e-3f);
     }
     expect_coverage(exr, "lines.silhouette", dir.path / "aov/frame_lines_silhouette.png");
     expect_coverage(exr, "lines.all", dir.path / "aov/frame_edges.png");
@@ -193,7 +193,8 @@ TEST(FeatureExr, InkLinesAllIsTheCoverageAndTypesAddUp) {
     const std::vector<float>& all = exr.values.at("lines.all");
     for (std::size_t i = 0; i < all.size(); ++i) {
         float most = 0.0f;
-        for (const char* type : {"silhouette", "border", "crease", "material", "intersection"})
+        for (const char* type :
+             {"silhouette", "border", "crease", "material", "intersection", "polyline"})
             most = std::max(most, exr.values.at(std::string("lines.") + type)[i]);
         ASSERT_NEAR(most, all[i], 2e-3f) << "pixel " << i;
     }

@@ -162,7 +162,10 @@ TEST(ObjLoader, BadInputIsAnErrorWithFileAndLine) {
         {q + "f 1 2 5\n", "test.obj:5: face vertex index 5 out of range (4 vertices"},
         {q + "f 1 2 -5\n", "test.obj:5: face vertex index -5 out of range"},
         {q + "f 1 2 3000000000\n", "test.obj:5: face vertex index 3000000000 out of range"},
-        {q + "f 1 2\n", "test.obj:5: face needs at least 3 corners, has 2"},
+        {q + "l 1\n", "test.obj:5: line element needs at least 2 points, has 1"},
+        {q + "l 1 0\n", "test.obj:5: line vertex index 0"},
+        {q + "l 1 9\n", "test.obj:5: line vertex index 9 out of range (4 vertices"},
+        {q + "l 1 2//3\n", "test.obj:5: malformed line point '2//3'"},
         {q + "f 1/2/3/4 2 3\n", "test.obj:5: malformed face corner '1/2/3/4'"},
         {q + "f a b c\n", "test.obj:5: malformed face corner 'a'"},
         {"v 1 2\n", "test.obj:1: missing number in 'v' statement"},
@@ -236,6 +239,32 @@ TEST(ObjLoader, TextureAndNormalIndicesPastTheDefinedOnesAreWarnings) {
         << w[0];
     EXPECT_NE(w[1].find("test.obj:8: face normal index 9 out of range"), std::string::npos) << w[1];
     EXPECT_NE(w[2].find("test.obj:9: face texture index 0"), std::string::npos) << w[2];
+}
+
+TEST(ObjLoader, LineElementsAreKeptWithObjectAndMaterial) {
+    Warnings w;
+    Scene s = parse(std::string(kQuad) +
+                        "v nan 0 0\ng wire\nl 1 2 -3\nl 1/1 2/2\nl 1 5\n"
+                        "f 1 2\nf 1 2 3\n",
+                    &w);
+    ASSERT_EQ(s.polylines.size(), 2u);
+    EXPECT_EQ(s.polylines[0].first, 0u);
+    EXPECT_EQ(s.polylines[0].count, 3u);
+    EXPECT_EQ(s.polyline_points[2], 2u);  // -3 of 5 vertices
+    EXPECT_EQ(s.polylines[1].first, 3u);
+    EXPECT_EQ(s.objects[s.polylines[1].object], "wire");
+    EXPECT_EQ(s.polyline_points.size(), 5u);  // the line through the nan vertex is dropped
+    EXPECT_EQ(s.triangle_count(), 1u);        // and so is the two-corner face
+    std::string all;
+    for (const std::string& m : w) all += m + "\n";
+    EXPECT_NE(all.find("test.obj:9: line uses a vertex with a non-finite"), std::string::npos)
+        << all;
+    EXPECT_NE(all.find("test.obj:10: face needs at least 3 corners, has 2; dropped"),
+              std::string::npos)
+        << all;
+    s.clear();
+    EXPECT_TRUE(s.polylines.empty());
+    EXPECT_TRUE(s.polyline_points.empty());
 }
 
 TEST(ObjLoader, PointElementsAreIgnoredWithOneWarning) {

@@ -33,9 +33,9 @@ const FeatureLayers::Layer* FeatureLayers::find(std::string_view name) const {
     return nullptr;
 }
 
-void gather_feature_layers(const Scene& scene, const TriangleAccel& accel,
-                           const CameraSpec& camera, const RenderSettings& settings,
-                           const Renderer& renderer, FeatureLayers& out) {
+void gather_feature_layers(const Scene& scene, const TriangleAccel& accel, const CameraSpec& camera,
+                           const RenderSettings& settings, const Renderer& renderer,
+                           FeatureLayers& out) {
     const int w = settings.width, h = settings.height;
     const std::size_t pixels = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
     out.width = w;
@@ -102,7 +102,8 @@ void gather_feature_layers(const Scene& scene, const TriangleAccel& accel,
     if (settings.edges == EdgeMode::Ink) {
         const ink::InkLines& ink = renderer.ink_lines();
         std::vector<float>& all = add("lines.all", true);
-        if (ink.coverage.size() == pixels) all.assign(ink.coverage.data(), ink.coverage.data() + pixels);
+        if (ink.coverage.size() == pixels)
+            all.assign(ink.coverage.data(), ink.coverage.data() + pixels);
         // Each type drawn on its own, as the renderer draws all visible strokes together.
         const float thickness = ink::stroke_thickness(settings.lines.width, h);
         for (int type = 0; type < ink::kEdgeTypeCount; ++type) {

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "toonray/core/error.h"
+#include "toonray/ink/polylines.h"
 #include "toonray/ink/svg.h"
 #include "toonray/io/exr.h"
 #include "toonray/io/file.h"
@@ -45,6 +46,7 @@ CameraSpec choose_camera(const Scene& scene, const FrameOptions& options) {
     used.reserve(scene.triangle_count() * 3);
     for (const auto& tri : scene.tri_positions)
         for (std::uint32_t v : tri) used.push_back(scene.positions[v]);
+    for (std::uint32_t v : scene.polyline_points) used.push_back(scene.positions[v]);
     return auto_camera(used, options.settings.width, options.settings.height);
 }
 
@@ -95,7 +97,14 @@ void FrameRenderer::render(const Scene& scene, const CameraSpec& camera,
     const TriangleAccel& accel = accel_.update(scene, options.bvh);
     const TextureSet* textures =
         settings.shading.textures ? &textures_.load(scene, warnings) : nullptr;
-    const ImageRgb8& image = renderer_.render(scene, accel, camera, settings, textures);
+    const ImageRgb8* image = &renderer_.render(scene, accel, camera, settings, textures);
+    if (!scene.polylines.empty() && settings.edges != EdgeMode::Ink) {
+        // The ink mode draws polylines with its lines; the others get them over the frame.
+        with_polylines_ = *image;
+        ink::draw_polylines_over(scene, accel, camera, ink_settings(settings),
+                                 settings.lines.colour, settings.threads, with_polylines_);
+        image = &with_polylines_;
+    }
     if (options.aov_dir) {
         std::filesystem::create_directories(*options.aov_dir);
         const Aovs& aovs = renderer_.aovs();
@@ -115,7 +124,7 @@ void FrameRenderer::render(const Scene& scene, const CameraSpec& camera,
         write_feature_exr(path, layers_);
     }
     if (options.svg) write_svg(renderer_, settings, options);
-    write_png(output, image, options.png);
+    write_png(output, *image, options.png);
 }
 
 }  // namespace toonray

@@ -78,6 +78,7 @@ private:
     TextureCache textures_;
     Renderer renderer_;
     FeatureLayers layers_;
+    ImageRgb8 with_polylines_;  ///< classic and robust frames with the polylines drawn over
 };
 
 }  // namespace toonray

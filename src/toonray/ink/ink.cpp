@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <chrono>
 
+#include "toonray/ink/polylines.h"
+
 namespace toonray::ink {
 
 namespace {
@@ -23,6 +25,7 @@ void draw_ink_lines(const Scene& scene, const TriangleAccel& accel, const Camera
     out.mesh = weld_vertices(scene);
     out.segments =
         find_feature_edges(scene, out.mesh, accel.bvh(), plane.eye, settings.edges, threads);
+    add_polyline_segments(scene, out.segments);
     out.timings.edges = seconds_since(start);
 
     start = std::chrono::steady_clock::now();

@@ -70,8 +70,9 @@ void reserve_for(std::string_view text, Scene& scene, const Limits& limits) {
 /// index and each vertex index out of range. A texture or normal index that points at no `vt` or
 /// `vn` (0 or out of range) is read as other tools read it: the face keeps its geometry and
 /// loses its texture coordinates or normals, with a warning (`warn_at` gets its message).
+/// Returns false, with a warning, for a face of fewer than 3 corners, which is dropped.
 template <typename Warn>
-void read_face_corners(const LineParser& parse, Tokens& t, const Scene& scene,
+bool read_face_corners(const LineParser& parse, Tokens& t, const Scene& scene,
                        std::vector<Corner>& corners, const Warn& warn_at) {
     corners.clear();
     bool drop_texcoords = false, drop_normals = false;
@@ -136,12 +137,16 @@ void read_face_corners(const LineParser& parse, Tokens& t, const Scene& scene,
         }
         corners.push_back(c);
     }
-    if (corners.size() < 3)
-        parse.fail(fmt::format("face needs at least 3 corners, has {}", corners.size()));
+    if (corners.size() < 3) {
+        // A point or a line written as a face: other readers skip it.
+        warn_at(fmt::format("face needs at least 3 corners, has {}; dropped", corners.size()));
+        return false;
+    }
     for (Corner& c : corners) {
         if (drop_texcoords) c.t = kNoIndex;
         if (drop_normals) c.n = kNoIndex;
     }
+    return true;
 }
 
 /// Names in an `mtllib` statement: separated by blanks, where `\ ` is a space inside a name
@@ -162,6 +167,38 @@ std::vector<std::string> library_names(std::string_view rest) {
     }
     if (!name.empty()) names.push_back(std::move(name));
     return names;
+}
+
+/// The points of an `l` element ("v" or "v/vt" each; texture coordinates are ignored) as
+/// position indices appended to `points`. A vertex index of 0 or out of range is an error, as
+/// in faces.
+void read_polyline(const LineParser& parse, Tokens& t, const Scene& scene,
+                   std::vector<std::uint32_t>& points) {
+    std::size_t count = 0;
+    while (!t.at_end()) {
+        std::string_view tok = t.next();
+        const char* p = tok.data();
+        const char* e = p + tok.size();
+        long long index;
+        if (!parse_index(p, e, index) || (p != e && *p != '/'))
+            parse.fail(fmt::format("malformed line point '{}'", tok));
+        if (p != e) {
+            ++p;
+            long long texture;
+            if (!parse_index(p, e, texture) || p != e)
+                parse.fail(fmt::format("malformed line point '{}'", tok));
+        }
+        std::uint32_t v;
+        if (!resolve_index(index, scene.positions.size(), v))
+            parse.fail(
+                index == 0
+                    ? fmt::format("line vertex index 0 in '{}' (OBJ indices start at 1)", tok)
+                    : fmt::format("line vertex index {} out of range ({} vertices defined so far)",
+                                  index, scene.positions.size()));
+        points.push_back(v);
+        ++count;
+    }
+    if (count < 2) parse.fail(fmt::format("line element needs at least 2 points, has {}", count));
 }
 
 /// The camera block statement `c eye gaze up`: the indices of two vertices and a normal.
@@ -196,7 +233,7 @@ CameraSpec read_camera(const LineParser& parse, Tokens& t, const Scene& scene) {
 /// Statements that are accepted and ignored: smoothing groups are implied by vn; free-form
 /// geometry is not rendered.
 bool is_ignored_statement(std::string_view kw) {
-    return kw == "s" || kw == "l" || kw == "vp" || kw == "cstype" || kw == "deg" || kw == "curv" ||
+    return kw == "s" || kw == "vp" || kw == "cstype" || kw == "deg" || kw == "curv" ||
            kw == "curv2" || kw == "surf" || kw == "parm" || kw == "end" || kw == "mg" ||
            kw == "lod" || kw == "usemap" || kw == "maplib" || kw == "shadow_obj" ||
            kw == "trace_obj" || kw == "bevel" || kw == "c_interp" || kw == "d_interp" ||
@@ -397,10 +434,10 @@ void parse_obj(std::string_view text, const std::filesystem::path& path, Scene& 
             while (!t.at_end()) parse.number(t, kw);
             mark_nonfinite(nonfinite_position, scene.positions.size(), finite, line_number, kw);
         } else if (kw == "f") {
-            read_face_corners(parse, t, scene, corners, [&](std::string message) {
-                warn.add(located(file, line_number, message));
-            });
-            add_face(parse, line_number);
+            if (read_face_corners(parse, t, scene, corners, [&](std::string message) {
+                    warn.add(located(file, line_number, message));
+                }))
+                add_face(parse, line_number);
         } else if (kw == "vn") {
             adding_normal(parse);
             bool finite = true;
@@ -415,6 +452,26 @@ void parse_obj(std::string_view text, const std::filesystem::path& path, Scene& 
             if (!t.at_end()) parse.number(t, kw);
             scene.texcoords.push_back(uv);
             mark_nonfinite(nonfinite_texcoord, scene.texcoords.size(), finite, line_number, kw);
+        } else if (kw == "l") {
+            Polyline line;
+            line.first = static_cast<std::uint32_t>(scene.polyline_points.size());
+            read_polyline(parse, t, scene, scene.polyline_points);
+            line.count = static_cast<std::uint32_t>(scene.polyline_points.size() - line.first);
+            check_count(parse, scene.polyline_points.size(), max_vertices, "polyline points ('l')",
+                        Limit::Vertices);
+            grew(parse);
+            line.material = material;
+            line.object = object;
+            bool finite = true;
+            for (std::uint32_t i = line.first; i < line.first + line.count; ++i)
+                finite = finite && !flagged(nonfinite_position, scene.polyline_points[i]);
+            if (finite) {
+                scene.polylines.push_back(line);
+            } else {
+                scene.polyline_points.resize(line.first);
+                warn.add(located(file, line_number,
+                                 "line uses a vertex with a non-finite coordinate; dropped"));
+            }
         } else if (kw == "p") {
             if (!warned_points) {
                 warned_points = true;

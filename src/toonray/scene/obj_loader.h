@@ -5,7 +5,8 @@
 /// Reads: v (optional w or colour values ignored), vt, vn, f with 3 or more corners in all four
 /// index forms (v, v/vt, v//vn, v/vt/vn), negative (relative) indices, o, g, usemtl, mtllib
 /// (several files, paths relative to the OBJ), s (accepted, ignored: normals come from vn),
-/// comments, `\` line continuations, LF, CRLF and CR line endings, a UTF-8 byte-order mark, and the
+/// l (polylines, kept in Scene::polylines with their object and material; drawn as ink
+/// strokes), comments, `\` line continuations, LF, CRLF and CR line endings, a UTF-8 byte-order mark, and the
 /// camera block statement `c eye gaze up`. Polygons are triangulated as a fan from their first
 /// corner, which is exact for convex polygons. Faces index only vertices defined before them.
 /// An object is the run of faces after an `o` or `g` statement, named by it.
