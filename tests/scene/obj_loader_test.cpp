@@ -199,7 +199,7 @@ TEST(ObjLoader, NonFiniteCoordinatesDropTheFacesThatUseThem) {
     Warnings w;
     // Vertex 2 is not finite (general path); the other lines take the fast path.
     Scene s = parse(
-        "v 0 0 0\nv 1 nan 0\nv 1 1 0\nv 0 1 0\nv 0 0 inf\nvn 0 0 1\n"
+        "v 0 0 0\nv 1 -1.#IND 0\nv 1 1 0\nv 0 1 0\nv 0 0 inf\nvn 0 0 1\n"
         "vn -nan 0 1\nvt 0 0\nvt inf 1\n"
         "f 1 2 3\nf 1 3 4\nf 1/1/1 3/1/1 4/1/2\nf 1/2 3/1 4/1\nf 1 4 5\n",
         &w);

@@ -78,6 +78,25 @@ void LineParser::fail_limit(Limit limit, std::string_view message) const {
     throw LimitError(limit, located(file_, line_, message));
 }
 
+namespace {
+
+// How Microsoft's C runtime prints non-finite values ("1.#IND", "-1.#INF", "1.#QNAN0"), which
+// files written with it hold.
+bool is_msvc_nonfinite(std::string_view tok) {
+    const std::size_t hash = tok.find(".#");
+    if (hash == std::string_view::npos || hash == 0) return false;
+    const std::string_view digits = tok.substr(tok[0] == '-' || tok[0] == '+' ? 1 : 0,
+                                               hash - (tok[0] == '-' || tok[0] == '+' ? 1 : 0));
+    if (digits.empty()) return false;
+    for (char c : digits)
+        if (!is_digit(c)) return false;
+    const std::string_view rest = tok.substr(hash + 2);
+    return rest.starts_with("IND") || rest.starts_with("INF") || rest.starts_with("QNAN") ||
+           rest.starts_with("SNAN");
+}
+
+}  // namespace
+
 float LineParser::number(Tokens& t, std::string_view what) const {
     bool finite = true;
     return read_number(t, what, finite, false);
@@ -117,8 +136,13 @@ float LineParser::read_number(Tokens& t, std::string_view what, bool& finite,
         v = dec == std::errc() ? static_cast<float>(d) : 0.0f;
         ec = std::errc();
     }
-    if (ec != std::errc() || ptr != e)
+    if (ec != std::errc() || ptr != e) {
+        if (allow_nonfinite && is_msvc_nonfinite(tok)) {
+            finite = false;
+            return std::numeric_limits<float>::quiet_NaN();
+        }
         fail(fmt::format("malformed number '{}' in '{}' statement", tok, what));
+    }
     if (!std::isfinite(v)) {
         if (!allow_nonfinite)
             fail(fmt::format("non-finite number '{}' in '{}' statement", tok, what));

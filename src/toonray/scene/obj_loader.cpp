@@ -270,8 +270,8 @@ void parse_obj(std::string_view text, const std::filesystem::path& path, Scene& 
     std::vector<Corner> corners;
     corners.reserve(16);
 
-    // Non-finite coordinates (nan, inf), which other tools read: the vertex is kept so indices
-    // stay right, and faces that use it are dropped (a non-finite normal or texture coordinate
+    // Non-finite coordinates (nan, inf), which other tools read: the vertex is kept (as 0, so
+    // every stored number stays finite) so indices stay right, and faces that use it are dropped (a non-finite normal or texture coordinate
     // only takes the face's normals or texture coordinates). The flags exist only once such a
     // value was read, so clean files pay one predictable branch per face.
     std::size_t nonfinite_count = 0;
@@ -292,7 +292,8 @@ void parse_obj(std::string_view text, const std::filesystem::path& path, Scene& 
     };
     // After the fast path added a finite element: keeps the flags in step once they exist.
     auto keep_flags = [&](std::vector<std::uint8_t>& flags, std::size_t count) {
-        if (nonfinite_count != 0) flags.resize(count, 0);
+        if (nonfinite_count != 0) [[unlikely]]
+            flags.resize(count, 0);
     };
     auto flagged = [](const std::vector<std::uint8_t>& flags, std::uint32_t i) {
         return i != kNoIndex && i < flags.size() && flags[i] != 0;
@@ -364,7 +365,8 @@ void parse_obj(std::string_view text, const std::filesystem::path& path, Scene& 
         grew(parse);
     };
     auto add_face = [&](const LineParser& parse, std::size_t line) {
-        if (nonfinite_count != 0 && !usable_face(line)) return;
+        if (nonfinite_count != 0 && !usable_face(line)) [[unlikely]]
+            return;
         if (scene.triangle_count() + (corners.size() - 2) > max_triangles)
             parse.fail_limit(Limit::Triangles,
                              fmt::format("more than {} triangles (the limit)", max_triangles));
@@ -429,7 +431,8 @@ void parse_obj(std::string_view text, const std::filesystem::path& path, Scene& 
         if (kw == "v") {
             adding_position(parse);
             bool finite = true;
-            scene.positions.push_back(parse.coordinates3(t, kw, finite));
+            const Vec3f position = parse.coordinates3(t, kw, finite);
+            scene.positions.push_back(finite ? position : Vec3f(0.0f));
             // Optional w (or vertex colour) values are accepted and ignored, but must be numbers.
             while (!t.at_end()) parse.number(t, kw);
             mark_nonfinite(nonfinite_position, scene.positions.size(), finite, line_number, kw);
@@ -441,7 +444,8 @@ void parse_obj(std::string_view text, const std::filesystem::path& path, Scene& 
         } else if (kw == "vn") {
             adding_normal(parse);
             bool finite = true;
-            scene.normals.push_back(parse.coordinates3(t, kw, finite));
+            const Vec3f normal = parse.coordinates3(t, kw, finite);
+            scene.normals.push_back(finite ? normal : Vec3f(0.0f));
             mark_nonfinite(nonfinite_normal, scene.normals.size(), finite, line_number, kw);
         } else if (kw == "vt") {
             adding_texcoord(parse);
@@ -450,7 +454,7 @@ void parse_obj(std::string_view text, const std::filesystem::path& path, Scene& 
             uv.x = parse.coordinate(t, kw, finite);
             if (!t.at_end()) uv.y = parse.coordinate(t, kw, finite);
             if (!t.at_end()) parse.number(t, kw);
-            scene.texcoords.push_back(uv);
+            scene.texcoords.push_back(finite ? uv : Vec2f{});
             mark_nonfinite(nonfinite_texcoord, scene.texcoords.size(), finite, line_number, kw);
         } else if (kw == "l") {
             Polyline line;
