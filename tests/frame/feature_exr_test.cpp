@@ -200,6 +200,36 @@ TEST(FeatureExr, InkLinesAllIsTheCoverageAndTypesAddUp) {
     }
 }
 
+TEST(FeatureExr, PolylinesDrawnOverTheFrameHaveTheirChannel) {
+    test_support::TempDir dir("exr_polylines");
+    Scene scene;
+    Warnings w;
+    parse_obj(
+        "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nf 1 2 3 4\n"
+        "v -0.6 0.4 0.5\nv 0.6 0.4 0.5\nl -2 -1\n",
+        "lines.obj", scene, w);
+    for (EdgeMode mode : {EdgeMode::Classic, EdgeMode::Robust, EdgeMode::Ink}) {
+        FrameOptions options;
+        options.settings.width = 80;
+        options.settings.height = 60;
+        options.settings.edges = mode;
+        options.camera = CameraSpec{{0, 0, 4}, {0, 0, 0}, {0, 1, 0}};
+        options.aov_exr = dir.path / "f.exr";
+        FrameRenderer renderer;
+        renderer.render(scene, *options.camera, dir.path / "f.png", options, w);
+        const ReadExr exr = read_exr(dir.path / "f.exr");
+        ASSERT_TRUE(exr.values.contains("lines.polyline")) << static_cast<int>(mode);
+        const std::vector<float>& line = exr.values.at("lines.polyline");
+        const std::vector<float>& all = exr.values.at("lines.all");
+        int covered = 0;
+        for (std::size_t i = 0; i < line.size(); ++i) {
+            covered += line[i] > 0.05f;  // lines are 2 * 60 / 720 pixels wide here
+            ASSERT_GE(all[i] + 2e-3f, line[i]);
+        }
+        EXPECT_GT(covered, 20) << static_cast<int>(mode);
+    }
+}
+
 TEST(FeatureExr, OiiotoolListsTheChannels) {
     test_support::TempDir dir("exr_oiio");
     const fs::path exr = render_both(dir.path, EdgeMode::Robust);

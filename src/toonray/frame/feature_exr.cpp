@@ -1,5 +1,6 @@
 #include "toonray/frame/feature_exr.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "toonray/core/saturating.h"
@@ -25,6 +26,12 @@ void coverage_of(const ImageGray8& lines, std::vector<float>& out) {
         out[i] = 1.0f - static_cast<float>(lines.data()[i]) / 255.0f;
 }
 
+FeatureLayers::Layer* find_mutable(FeatureLayers& layers, std::string_view name) {
+    for (FeatureLayers::Layer& c : layers.channels)
+        if (c.name == name) return &c;
+    return nullptr;
+}
+
 }  // namespace
 
 const FeatureLayers::Layer* FeatureLayers::find(std::string_view name) const {
@@ -35,7 +42,7 @@ const FeatureLayers::Layer* FeatureLayers::find(std::string_view name) const {
 
 void gather_feature_layers(const Scene& scene, const TriangleAccel& accel, const CameraSpec& camera,
                            const RenderSettings& settings, const Renderer& renderer,
-                           FeatureLayers& out) {
+                           FeatureLayers& out, const ImageF* polylines) {
     const int w = settings.width, h = settings.height;
     const std::size_t pixels = static_cast<std::size_t>(w) * static_cast<std::size_t>(h);
     out.width = w;
@@ -126,6 +133,12 @@ void gather_feature_layers(const Scene& scene, const TriangleAccel& accel, const
             add_lines("depth", aovs.lines_depth);
             add_lines("object", aovs.lines_object);
             add_lines("material", aovs.lines_material);
+        }
+        if (polylines && polylines->size() == pixels) {
+            add("lines.polyline", true).assign(polylines->data(), polylines->data() + pixels);
+            if (FeatureLayers::Layer* all = find_mutable(out, "lines.all"))
+                for (std::size_t i = 0; i < pixels; ++i)
+                    all->values[i] = std::max(all->values[i], polylines->data()[i]);
         }
     }
 }

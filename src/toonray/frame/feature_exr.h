@@ -41,9 +41,11 @@ struct FeatureLayers {
 /// (1 where a surface is seen), Z (distance along the ray), view_depth.Z (along the view
 /// axis), N.X, N.Y, N.Z (world-space shading normal facing the eye), object_id.id,
 /// material_id.id, lines.all and one lines.<type> per line type the mode draws.
+/// `polylines`: in the classic and robust modes, the coverage of the polylines drawn over the
+/// frame (ink/polylines.h), as lines.polyline and in lines.all; nullptr when none were drawn.
 void gather_feature_layers(const Scene& scene, const TriangleAccel& accel, const CameraSpec& camera,
                            const RenderSettings& settings, const Renderer& renderer,
-                           FeatureLayers& out);
+                           FeatureLayers& out, const ImageF* polylines = nullptr);
 
 /// Writes the layers as one EXR file, atomically. Throws Error when the build has no OpenEXR.
 void write_feature_exr(const std::filesystem::path& path, const FeatureLayers& layers);

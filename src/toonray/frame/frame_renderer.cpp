@@ -102,7 +102,8 @@ void FrameRenderer::render(const Scene& scene, const CameraSpec& camera,
         // The ink mode draws polylines with its lines; the others get them over the frame.
         with_polylines_ = *image;
         ink::draw_polylines_over(scene, accel, camera, ink_settings(settings),
-                                 settings.lines.colour, settings.threads, with_polylines_);
+                                 settings.lines.colour, settings.threads, with_polylines_,
+                                 polyline_coverage_);
         image = &with_polylines_;
     }
     if (options.aov_dir) {
@@ -120,7 +121,9 @@ void FrameRenderer::render(const Scene& scene, const CameraSpec& camera,
         // EXR too, so resuming a sequence skips it safely.
         const std::filesystem::path path = exr_path(*options.aov_exr, output);
         if (path.has_parent_path()) std::filesystem::create_directories(path.parent_path());
-        gather_feature_layers(scene, accel, camera, settings, renderer_, layers_);
+        const bool drawn_over = !scene.polylines.empty() && settings.edges != EdgeMode::Ink;
+        gather_feature_layers(scene, accel, camera, settings, renderer_, layers_,
+                              drawn_over ? &polyline_coverage_ : nullptr);
         write_feature_exr(path, layers_);
     }
     if (options.svg) write_svg(renderer_, settings, options);

@@ -79,6 +79,7 @@ private:
     Renderer renderer_;
     FeatureLayers layers_;
     ImageRgb8 with_polylines_;  ///< classic and robust frames with the polylines drawn over
+    ImageF polyline_coverage_;  ///< and the polylines' coverage, for the EXR
 };
 
 }  // namespace toonray

@@ -34,7 +34,7 @@ void add_polyline_segments(const Scene& scene, std::vector<FeatureSegment>& out)
 
 void draw_polylines_over(const Scene& scene, const TriangleAccel& accel, const CameraSpec& camera,
                          const InkSettings& settings, const Vec3f& colour, int threads,
-                         ImageRgb8& image) {
+                         ImageRgb8& image, ImageF& coverage) {
     if (scene.polylines.empty()) return;
     const int width = image.width(), height = image.height();
     std::vector<FeatureSegment> segments;
@@ -50,7 +50,7 @@ void draw_polylines_over(const Scene& scene, const TriangleAccel& accel, const C
     chain.hidden = false;
     std::vector<Stroke> strokes = chain_pieces(pieces, chain);
     std::erase_if(strokes, [](const Stroke& s) { return !s.visible; });
-    ImageF coverage(width, height, 0.0f);
+    coverage.resize(width, height, 0.0f);
     draw_strokes(strokes, stroke_thickness(settings.width, height), coverage, threads);
     composite_lines(coverage, colour, image);
 }

@@ -22,9 +22,10 @@ void add_polyline_segments(const Scene& scene, std::vector<FeatureSegment>& out)
 
 /// Draws the scene's visible polylines over `image` as ink strokes of settings.width, in
 /// `colour`: visibility by rays against `accel` (visibility.h), strokes chained and drawn as in
-/// draw_ink_lines. Does nothing for a scene without polylines.
+/// draw_ink_lines. `coverage` gets their coverage (0 to 1, the image's size). Does nothing for a
+/// scene without polylines.
 void draw_polylines_over(const Scene& scene, const TriangleAccel& accel, const CameraSpec& camera,
                          const InkSettings& settings, const Vec3f& colour, int threads,
-                         ImageRgb8& image);
+                         ImageRgb8& image, ImageF& coverage);
 
 }  // namespace toonray::ink
