@@ -90,6 +90,9 @@ void RenderArgs::add_to(CLI::App& app) {
         "NAME_depth, _normal, _edges, _cel .png, and per mode: classic _edges_depth, "
         "_edges_normal; robust _lines_silhouette, _lines_crease, _lines_depth, _lines_object, "
         "_lines_material, _object_id, _material_id; ink _object_id, _material_id");
+    app.add_option("--aov-exr", aov_exr,
+                   "Also write the feature images as one multi-layer OpenEXR (docs/exr.md): "
+                   "render: this .exr file; batch, piano, demo: a directory, one NAME.exr a frame");
     app.add_option("--threads", threads, "Threads to use (0 = all)")
         ->check(CLI::Range(0, 1024))
         ->capture_default_str();
@@ -136,6 +139,7 @@ FrameOptions RenderArgs::resolve() const {
     o.bvh.max_leaf_size = leaf_size;
     o.png.level = png_level;
     if (!aov_dir.empty()) o.aov_dir = aov_dir;
+    if (!aov_exr.empty()) o.aov_exr = aov_exr;
     return o;
 }
 

@@ -38,6 +38,7 @@ struct RenderArgs {
     int leaf_size = Bvh::Config{}.max_leaf_size;
     int png_level = PngOptions{}.level;
     std::string aov_dir;
+    std::string aov_exr;
 
     void add_to(CLI::App& app);
     [[nodiscard]] FrameOptions resolve() const;

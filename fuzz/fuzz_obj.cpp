@@ -33,6 +33,12 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         FUZZ_CHECK(scene.tri_material[i] < scene.materials.size());
         FUZZ_CHECK(scene.tri_object[i] < scene.objects.size());
     }
+    for (const Polyline& line : scene.polylines) {
+        FUZZ_CHECK(line.count >= 2 && line.first + line.count <= scene.polyline_points.size());
+        FUZZ_CHECK(line.material < scene.materials.size() && line.object < scene.objects.size());
+    }
+    for (std::uint32_t v : scene.polyline_points) FUZZ_CHECK(v < scene.positions.size());
+    // Non-finite coordinates are read as warnings, stored as 0, and their faces dropped.
     for (const Vec3f& p : scene.positions) FUZZ_CHECK(is_finite(p));
     for (const Vec3f& p : scene.normals) FUZZ_CHECK(is_finite(p));
     for (const Vec2f& t : scene.texcoords) FUZZ_CHECK(std::isfinite(t.x) && std::isfinite(t.y));

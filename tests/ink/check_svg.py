@@ -8,7 +8,7 @@ import sys
 import xml.etree.ElementTree as ET
 
 SVG = "{http://www.w3.org/2000/svg}"
-TYPES = ["silhouette", "border", "crease", "material", "intersection"]
+TYPES = ["silhouette", "border", "crease", "material", "intersection", "polyline"]
 
 
 def fail(message):

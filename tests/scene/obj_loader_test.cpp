@@ -162,17 +162,19 @@ TEST(ObjLoader, BadInputIsAnErrorWithFileAndLine) {
         {q + "f 1 2 5\n", "test.obj:5: face vertex index 5 out of range (4 vertices"},
         {q + "f 1 2 -5\n", "test.obj:5: face vertex index -5 out of range"},
         {q + "f 1 2 3000000000\n", "test.obj:5: face vertex index 3000000000 out of range"},
-        {q + "f 1 2\n", "test.obj:5: face needs at least 3 corners, has 2"},
-        {q + "f 1/9 2 3\n", "test.obj:5: face texture index 9 out of range"},
-        {q + "f 1//9 2 3\n", "test.obj:5: face normal index 9 out of range"},
+        {q + "l 1\n", "test.obj:5: line element needs at least 2 points, has 1"},
+        {q + "l 1 0\n", "test.obj:5: line vertex index 0"},
+        {q + "l 1 9\n", "test.obj:5: line vertex index 9 out of range (4 vertices"},
+        {q + "l 1 2//3\n", "test.obj:5: malformed line point '2//3'"},
         {q + "f 1/2/3/4 2 3\n", "test.obj:5: malformed face corner '1/2/3/4'"},
         {q + "f a b c\n", "test.obj:5: malformed face corner 'a'"},
         {"v 1 2\n", "test.obj:1: missing number in 'v' statement"},
         {"v 1 2 abc\n", "test.obj:1: malformed number 'abc' in 'v' statement"},
         {"v 1 2 3.0.0\n", "test.obj:1: malformed number '3.0.0'"},
-        {"v 1 nan 3\n", "test.obj:1: non-finite number 'nan'"},
-        {"v 1 1e99 3\n", "test.obj:1: number '1e99' out of range"},
         {"vn 1 2\n", "test.obj:1: missing number in 'vn' statement"},
+        {"v 1 nan\n", "test.obj:1: missing number in 'v' statement"},
+        {"v 1 nanx 3\n", "test.obj:1: malformed number 'nanx'"},
+        {"p 1\nv 1 2 3 inf\n", "test.obj:2: non-finite number 'inf'"},  // w stays strict
         {std::string("v 0 0 0\n\0\0\0 binary\n", 19), "test.obj:2: binary data"},
     };
     for (const Case& c : cases) {
@@ -181,13 +183,112 @@ TEST(ObjLoader, BadInputIsAnErrorWithFileAndLine) {
     }
 }
 
-TEST(ObjLoader, UnderflowReadsAsZeroOverflowIsAnError) {
+TEST(ObjLoader, UnderflowReadsAsZeroOverflowIsNonFinite) {
     Scene s = parse("v 1e-50 -1e-400 2.5e-39\n");
     EXPECT_EQ(s.positions[0].x, 0.0f);
     EXPECT_EQ(s.positions[0].y, 0.0f);
     EXPECT_GT(s.positions[0].z, 0.0f);  // a denormal, kept
-    EXPECT_NE(error_of("v 1 1e400 0\n").find("test.obj:1: number '1e400' out of range"),
-              std::string::npos);
+    Warnings w;
+    Scene big = parse("v 1 1e400 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", &w);
+    EXPECT_EQ(big.triangle_count(), 0u);
+    ASSERT_EQ(w.size(), 2u);
+    EXPECT_NE(w[0].find("test.obj:1: non-finite coordinate in 'v'"), std::string::npos) << w[0];
+}
+
+TEST(ObjLoader, NonFiniteCoordinatesDropTheFacesThatUseThem) {
+    Warnings w;
+    // Vertex 2 is not finite (general path); the other lines take the fast path.
+    Scene s = parse(
+        "v 0 0 0\nv 1 -1.#IND 0\nv 1 1 0\nv 0 1 0\nv 0 0 inf\nvn 0 0 1\n"
+        "vn -nan 0 1\nvt 0 0\nvt inf 1\n"
+        "f 1 2 3\nf 1 3 4\nf 1/1/1 3/1/1 4/1/2\nf 1/2 3/1 4/1\nf 1 4 5\n",
+        &w);
+    ASSERT_EQ(s.triangle_count(), 3u);  // faces on lines 10 and 14 are dropped
+    EXPECT_EQ(s.positions.size(), 5u);  // indices stay right
+    EXPECT_EQ(s.tri_positions[0], (std::array<std::uint32_t, 3>{0, 2, 3}));
+    // A non-finite normal or texture coordinate takes them from the face, not the face.
+    EXPECT_EQ(s.tri_normals[1], (std::array<std::uint32_t, 3>{kNoIndex, kNoIndex, kNoIndex}));
+    EXPECT_EQ(s.tri_texcoords[1], (std::array<std::uint32_t, 3>{0, 0, 0}));
+    EXPECT_EQ(s.tri_texcoords[2], (std::array<std::uint32_t, 3>{kNoIndex, kNoIndex, kNoIndex}));
+    std::string all;
+    for (const std::string& m : w) all += m + "\n";
+    EXPECT_NE(all.find("test.obj:2: non-finite coordinate in 'v'"), std::string::npos) << all;
+    EXPECT_NE(all.find("test.obj:7: non-finite coordinate in 'vn'"), std::string::npos) << all;
+    EXPECT_NE(all.find("test.obj:9: non-finite coordinate in 'vt'"), std::string::npos) << all;
+    EXPECT_NE(all.find("test.obj:10: face uses a vertex with a non-finite"), std::string::npos)
+        << all;
+    EXPECT_NE(all.find("test.obj:14: face uses a vertex with a non-finite"), std::string::npos)
+        << all;
+}
+
+TEST(ObjLoader, TextureAndNormalIndicesPastTheDefinedOnesAreWarnings) {
+    Warnings w;
+    Scene s = parse(std::string(kQuad) +
+                        "vt 0 0\nvn 0 0 1\nf 1/9/1 2/1/1 3/1/1\nf 1//9 2//1 3//1\n"
+                        "f 1/0 2/1 3/1\nf 1/1/1 2/1/1 3/1/1\n",
+                    &w);
+    ASSERT_EQ(s.triangle_count(), 4u);
+    EXPECT_EQ(s.tri_texcoords[0], (std::array<std::uint32_t, 3>{kNoIndex, kNoIndex, kNoIndex}));
+    EXPECT_EQ(s.tri_normals[0], (std::array<std::uint32_t, 3>{0, 0, 0}));
+    EXPECT_EQ(s.tri_normals[1], (std::array<std::uint32_t, 3>{kNoIndex, kNoIndex, kNoIndex}));
+    EXPECT_EQ(s.tri_texcoords[2], (std::array<std::uint32_t, 3>{kNoIndex, kNoIndex, kNoIndex}));
+    EXPECT_EQ(s.tri_texcoords[3], (std::array<std::uint32_t, 3>{0, 0, 0}));
+    ASSERT_EQ(w.size(), 3u);
+    EXPECT_NE(w[0].find("test.obj:7: face texture index 9 out of range (1 defined so far)"),
+              std::string::npos)
+        << w[0];
+    EXPECT_NE(w[1].find("test.obj:8: face normal index 9 out of range"), std::string::npos) << w[1];
+    EXPECT_NE(w[2].find("test.obj:9: face texture index 0"), std::string::npos) << w[2];
+}
+
+TEST(ObjLoader, LineElementsAreKeptWithObjectAndMaterial) {
+    Warnings w;
+    Scene s = parse(std::string(kQuad) +
+                        "v nan 0 0\ng wire\nl 1 2 -3\nl 1/1 2/2\nl 1 5\n"
+                        "f 1 2\nf 1 2 3\n",
+                    &w);
+    ASSERT_EQ(s.polylines.size(), 2u);
+    EXPECT_EQ(s.polylines[0].first, 0u);
+    EXPECT_EQ(s.polylines[0].count, 3u);
+    EXPECT_EQ(s.polyline_points[2], 2u);  // -3 of 5 vertices
+    EXPECT_EQ(s.polylines[1].first, 3u);
+    EXPECT_EQ(s.objects[s.polylines[1].object], "wire");
+    EXPECT_EQ(s.polyline_points.size(), 5u);  // the line through the nan vertex is dropped
+    EXPECT_EQ(s.triangle_count(), 1u);        // and so is the two-corner face
+    std::string all;
+    for (const std::string& m : w) all += m + "\n";
+    EXPECT_NE(all.find("test.obj:9: line uses a vertex with a non-finite"), std::string::npos)
+        << all;
+    EXPECT_NE(all.find("test.obj:10: face needs at least 3 corners, has 2; dropped"),
+              std::string::npos)
+        << all;
+    s.clear();
+    EXPECT_TRUE(s.polylines.empty());
+    EXPECT_TRUE(s.polyline_points.empty());
+}
+
+TEST(ObjLoader, PointElementsAreIgnoredWithOneWarning) {
+    Warnings w;
+    Scene s = parse(std::string(kQuad) + "p 1\np 2 3\nf 1 2 3\n", &w);
+    ASSERT_EQ(w.size(), 1u);
+    EXPECT_NE(w[0].find("test.obj:5: point elements ('p')"), std::string::npos) << w[0];
+    EXPECT_EQ(s.triangle_count(), 1u);
+}
+
+TEST(ObjLoader, MtllibNamesMayEscapeSpaces) {
+    const fs::path dir = temp_dir("escaped");
+    write(dir / "my file.mtl", "newmtl red\nKd 1 0 0\n");
+    write(dir / "b.mtl", "newmtl blue\nKd 0 0 1\n");
+    write(dir / "scene.obj", std::string("mtllib my\\ file.mtl b.mtl\n") + kQuad +
+                                 "usemtl red\nf 1 2 3\nusemtl blue\nf 1 3 4\n");
+    Scene s;
+    Warnings w;
+    load_obj(dir / "scene.obj", s, w);
+    EXPECT_TRUE(w.empty()) << w.front();
+    ASSERT_EQ(s.triangle_count(), 2u);
+    EXPECT_EQ(s.materials[s.tri_material[0]].kd, Vec3f(1, 0, 0));
+    EXPECT_EQ(s.materials[s.tri_material[1]].kd, Vec3f(0, 0, 1));
+    fs::remove_all(dir);
 }
 
 TEST(ObjLoader, CommentsAreNotContinued) {

@@ -225,6 +225,7 @@ BatchReport run_batch(const BatchOptions& options, BatchObserver* observer) {
             throw Error(fmt::format("{}: AOV directory cannot be created or is not writable",
                                     options.render.aov_dir->string()));
     }
+    if (options.render.aov_exr) check_exr_sequence(*options.render.aov_exr);
     std::vector<int> frames = shard_frames(options.first, options.last, options.shard);
     const FramePlan plan = plan_frame_jobs(options.render, options.jobs, frames.size());
     ScheduleOptions schedule;

@@ -166,6 +166,7 @@ PianoMovieReport render_piano_movie(const Score& score, const CameraPath& camera
         check_directory(options.output_dir, "output");
     }
     if (options.render.aov_dir) check_directory(*options.render.aov_dir, "AOV");
+    if (options.render.aov_exr) check_exr_sequence(*options.render.aov_exr);
     PianoFrames source(score, camera_path, options);
     const Scene& piano = source.scene();
     // Each job poses its own copy of the scene with its own BVH, and (unless exporting)

@@ -2,17 +2,20 @@
 
 #include "toonray/core/saturating.h"
 
+#include <fmt/format.h>
 #include <variant>
 #include <vector>
 
 #include "toonray/core/error.h"
+#include "toonray/ink/polylines.h"
 #include "toonray/ink/svg.h"
+#include "toonray/io/exr.h"
 #include "toonray/io/file.h"
 
 namespace toonray {
 RenderSettings FrameOptions::render_settings() const {
     RenderSettings s = settings;
-    s.feature_images = aov_dir.has_value();
+    s.feature_images = aov_dir.has_value() || aov_exr.has_value();
     s.hidden_lines = svg.has_value() && svg_hidden;
     return s;
 }
@@ -43,12 +46,29 @@ CameraSpec choose_camera(const Scene& scene, const FrameOptions& options) {
     used.reserve(scene.triangle_count() * 3);
     for (const auto& tri : scene.tri_positions)
         for (std::uint32_t v : tri) used.push_back(scene.positions[v]);
+    for (std::uint32_t v : scene.polyline_points) used.push_back(scene.positions[v]);
     return auto_camera(used, options.settings.width, options.settings.height);
 }
 
 std::filesystem::path aov_path(const std::filesystem::path& dir,
                                const std::filesystem::path& output, std::string_view name) {
     return dir / (output.stem().string() + "_" + std::string(name) + ".png");
+}
+
+std::filesystem::path exr_path(const std::filesystem::path& aov_exr,
+                               const std::filesystem::path& output) {
+    if (aov_exr.extension() == ".exr" || aov_exr.extension() == ".EXR") return aov_exr;
+    return aov_exr / (output.stem().string() + ".exr");
+}
+
+void check_exr_sequence(const std::filesystem::path& aov_exr) {
+    if (!exr_available())
+        throw Error("EXR feature images are not available: this toonray was built without OpenEXR");
+    if (exr_path(aov_exr, "frame.png") == aov_exr)
+        throw Error(
+            fmt::format("{}: EXR feature images of a sequence go to a directory (one file "
+                        "a frame), not one .exr file",
+                        aov_exr.string()));
 }
 
 std::uint64_t frame_bytes(const FrameOptions& options) {
@@ -59,7 +79,8 @@ std::uint64_t frame_bytes(const FrameOptions& options) {
     // compressed bound and the file's bytes, about three copies, and a compressor of under 1 MiB.
     const std::uint64_t png =
         pixels > UINT64_MAX / 16 ? UINT64_MAX : pixels * 3 * sizeof(Rgb8) + 1024 * 1024;
-    const std::uint64_t total = add_saturated(frame_buffer_bytes(settings), png);
+    std::uint64_t total = add_saturated(frame_buffer_bytes(settings), png);
+    if (options.aov_exr) total = add_saturated(total, feature_exr_bytes(pixels));
     return add_saturated(total, total / 5);
 }
 
@@ -71,10 +92,20 @@ void FrameRenderer::render(const Scene& scene, const CameraSpec& camera,
     validate_camera(camera);
     if (options.svg && settings.edges != EdgeMode::Ink)
         throw Error("an SVG drawing needs the ink line mode");
+    if (options.aov_exr && !exr_available())
+        throw Error("EXR feature images are not available: this toonray was built without OpenEXR");
     const TriangleAccel& accel = accel_.update(scene, options.bvh);
     const TextureSet* textures =
         settings.shading.textures ? &textures_.load(scene, warnings) : nullptr;
-    const ImageRgb8& image = renderer_.render(scene, accel, camera, settings, textures);
+    const ImageRgb8* image = &renderer_.render(scene, accel, camera, settings, textures);
+    if (!scene.polylines.empty() && settings.edges != EdgeMode::Ink) {
+        // The ink mode draws polylines with its lines; the others get them over the frame.
+        with_polylines_ = *image;
+        ink::draw_polylines_over(scene, accel, camera, ink_settings(settings),
+                                 settings.lines.colour, settings.threads, with_polylines_,
+                                 polyline_coverage_);
+        image = &with_polylines_;
+    }
     if (options.aov_dir) {
         std::filesystem::create_directories(*options.aov_dir);
         const Aovs& aovs = renderer_.aovs();
@@ -85,8 +116,18 @@ void FrameRenderer::render(const Scene& scene, const CameraSpec& camera,
                        feature.image);
         }
     }
+    if (options.aov_exr) {
+        // Before the frame's PNG, as the PNG feature images: a frame whose PNG is valid has its
+        // EXR too, so resuming a sequence skips it safely.
+        const std::filesystem::path path = exr_path(*options.aov_exr, output);
+        if (path.has_parent_path()) std::filesystem::create_directories(path.parent_path());
+        const bool drawn_over = !scene.polylines.empty() && settings.edges != EdgeMode::Ink;
+        gather_feature_layers(scene, accel, camera, settings, renderer_, layers_,
+                              drawn_over ? &polyline_coverage_ : nullptr);
+        write_feature_exr(path, layers_);
+    }
     if (options.svg) write_svg(renderer_, settings, options);
-    write_png(output, image, options.png);
+    write_png(output, *image, options.png);
 }
 
 }  // namespace toonray

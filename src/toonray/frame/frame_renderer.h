@@ -11,6 +11,7 @@
 
 #include "toonray/core/error.h"
 #include "toonray/frame/animation_accel.h"
+#include "toonray/frame/feature_exr.h"
 #include "toonray/frame/textures.h"
 #include "toonray/io/png.h"
 #include "toonray/render/renderer.h"
@@ -24,6 +25,9 @@ struct FrameOptions {
         settings;  ///< settings.feature_images is set from aov_dir, hidden_lines from svg
     std::optional<CameraSpec> camera;              ///< overrides the scene's camera block
     std::optional<std::filesystem::path> aov_dir;  ///< write the feature images here
+    /// Also write the feature images as one multi-layer EXR (frame/feature_exr.h): this file
+    /// when it ends in ".exr", else `<aov_exr>/<stem>.exr` for each output (exr_path).
+    std::optional<std::filesystem::path> aov_exr;
     /// Ink lines only: also write the strokes as SVG here (ink/svg.h), with hidden lines in a
     /// layer of their own when svg_hidden.
     std::optional<std::filesystem::path> svg;
@@ -41,6 +45,15 @@ CameraSpec choose_camera(const Scene& scene, const FrameOptions& options);
 /// The feature image file for an output and a feature name: `<dir>/<stem>_<name>.png`.
 std::filesystem::path aov_path(const std::filesystem::path& dir,
                                const std::filesystem::path& output, std::string_view name);
+
+/// The EXR feature image file of an output: `aov_exr` itself when it names an .exr file, else
+/// `<aov_exr>/<stem>.exr`, named like the output's PNG.
+std::filesystem::path exr_path(const std::filesystem::path& aov_exr,
+                               const std::filesystem::path& output);
+
+/// A sequence writes one EXR a frame: throws Error when `aov_exr` names a single .exr file, or
+/// when the build has no OpenEXR (before any frame is rendered).
+void check_exr_sequence(const std::filesystem::path& aov_exr);
 
 /// Memory of one frame in flight: the renderer's buffers (frame_buffer_bytes), the PNG encoding
 /// of the largest image written (filtered rows, the compressed bound and the file's bytes, and
@@ -64,6 +77,9 @@ private:
     AnimationAccel accel_;
     TextureCache textures_;
     Renderer renderer_;
+    FeatureLayers layers_;
+    ImageRgb8 with_polylines_;  ///< classic and robust frames with the polylines drawn over
+    ImageF polyline_coverage_;  ///< and the polylines' coverage, for the EXR
 };
 
 }  // namespace toonray

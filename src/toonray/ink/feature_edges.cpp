@@ -19,6 +19,7 @@ const char* edge_type_name(EdgeType type) {
         case EdgeType::Crease: return "crease";
         case EdgeType::Material: return "material";
         case EdgeType::Intersection: return "intersection";
+        case EdgeType::Polyline: return "polyline";
     }
     return "?";
 }

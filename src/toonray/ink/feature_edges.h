@@ -20,9 +20,10 @@ enum class EdgeType : std::uint8_t {
     Crease,        ///< geometric normals of the two faces differ by more than the crease angle
     Material,      ///< the two faces have different materials
     Intersection,  ///< where two triangles cross
+    Polyline,      ///< a polyline of the scene (OBJ `l`), drawn as it is (ink/polylines.h)
 };
-inline constexpr int kEdgeTypeCount = 5;
-/// "silhouette", "border", "crease", "material", "intersection".
+inline constexpr int kEdgeTypeCount = 6;
+/// "silhouette", "border", "crease", "material", "intersection", "polyline".
 const char* edge_type_name(EdgeType type);
 
 /// Identifies a segment's endpoint so that segments meeting there can be chained without

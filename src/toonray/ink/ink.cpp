@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <chrono>
 
+#include "toonray/ink/polylines.h"
+
 namespace toonray::ink {
 
 namespace {
@@ -25,6 +27,7 @@ void draw_ink_lines(const Scene& scene, const TriangleAccel& accel, const Camera
     if (!settings.chain.hidden) edges.certainly_hidden = false;  // chaining would drop them
     out.segments = find_feature_edges(scene, out.mesh, accel.bvh(), plane.eye, edges, threads,
                                       &out.intersections);
+    add_polyline_segments(scene, out.segments);
     out.timings.edges = seconds_since(start);
 
     start = std::chrono::steady_clock::now();

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <charconv>
+#include <limits>
 #include <cmath>
 #include <cstring>
 #include <fmt/format.h>
@@ -77,7 +78,36 @@ void LineParser::fail_limit(Limit limit, std::string_view message) const {
     throw LimitError(limit, located(file_, line_, message));
 }
 
+namespace {
+
+// How Microsoft's C runtime prints non-finite values ("1.#IND", "-1.#INF", "1.#QNAN0"), which
+// files written with it hold.
+bool is_msvc_nonfinite(std::string_view tok) {
+    const std::size_t hash = tok.find(".#");
+    if (hash == std::string_view::npos || hash == 0) return false;
+    const std::string_view digits = tok.substr(tok[0] == '-' || tok[0] == '+' ? 1 : 0,
+                                               hash - (tok[0] == '-' || tok[0] == '+' ? 1 : 0));
+    if (digits.empty()) return false;
+    for (char c : digits)
+        if (!is_digit(c)) return false;
+    const std::string_view rest = tok.substr(hash + 2);
+    return rest.starts_with("IND") || rest.starts_with("INF") || rest.starts_with("QNAN") ||
+           rest.starts_with("SNAN");
+}
+
+}  // namespace
+
 float LineParser::number(Tokens& t, std::string_view what) const {
+    bool finite = true;
+    return read_number(t, what, finite, false);
+}
+
+float LineParser::coordinate(Tokens& t, std::string_view what, bool& finite) const {
+    return read_number(t, what, finite, true);
+}
+
+float LineParser::read_number(Tokens& t, std::string_view what, bool& finite,
+                              bool allow_nonfinite) const {
     std::string_view tok = t.next();
     if (tok.empty()) fail(fmt::format("missing number in '{}' statement", what));
     const char* b = tok.data();
@@ -89,20 +119,35 @@ float LineParser::number(Tokens& t, std::string_view what) const {
     auto [ptr, ec] = std::from_chars(b, e, v);
     if (ec == std::errc::result_out_of_range && ptr == e) {
         // Too small for a float reads as zero (as strtof and other readers do: exporters
-        // that write doubles produce such values); too large is an error.
+        // that write doubles produce such values); too large is an error, or an infinite
+        // coordinate where those are allowed.
         double d;
         auto [dptr, dec] = std::from_chars(b, e, d);
         std::string_view digits(b, static_cast<std::size_t>(e - b));
         bool underflow = dec == std::errc() ? std::abs(d) < 1.0
                                             : digits.find("e-") != std::string_view::npos ||
                                                   digits.find("E-") != std::string_view::npos;
-        if (!underflow) fail(fmt::format("number '{}' out of range in '{}' statement", tok, what));
+        if (!underflow) {
+            if (!allow_nonfinite)
+                fail(fmt::format("number '{}' out of range in '{}' statement", tok, what));
+            finite = false;
+            return std::numeric_limits<float>::infinity();
+        }
         v = dec == std::errc() ? static_cast<float>(d) : 0.0f;
         ec = std::errc();
     }
-    if (ec != std::errc() || ptr != e)
+    if (ec != std::errc() || ptr != e) {
+        if (allow_nonfinite && is_msvc_nonfinite(tok)) {
+            finite = false;
+            return std::numeric_limits<float>::quiet_NaN();
+        }
         fail(fmt::format("malformed number '{}' in '{}' statement", tok, what));
-    if (!std::isfinite(v)) fail(fmt::format("non-finite number '{}' in '{}' statement", tok, what));
+    }
+    if (!std::isfinite(v)) {
+        if (!allow_nonfinite)
+            fail(fmt::format("non-finite number '{}' in '{}' statement", tok, what));
+        finite = false;
+    }
     return v;
 }
 

@@ -159,8 +159,21 @@ public:
         v.z = number(t, what);
         return v;
     }
+    /// As number(), but a non-finite value ("nan", "inf", or too large for a float) is read
+    /// rather than refused, and clears `finite`: a coordinate other tools read, whose faces the
+    /// OBJ reader drops.
+    float coordinate(Tokens& t, std::string_view what, bool& finite) const;
+    Vec3f coordinates3(Tokens& t, std::string_view what, bool& finite) const {
+        Vec3f v;
+        v.x = coordinate(t, what, finite);
+        v.y = coordinate(t, what, finite);
+        v.z = coordinate(t, what, finite);
+        return v;
+    }
 
 private:
+    float read_number(Tokens& t, std::string_view what, bool& finite, bool allow_nonfinite) const;
+
     std::string_view file_;
     std::size_t line_;
 };

@@ -66,11 +66,16 @@ void reserve_for(std::string_view text, Scene& scene, const Limits& limits) {
     scene.tri_object.reserve(f);
 }
 
-/// The corners of an 'f' statement in any form, with a precise message for each malformed or
-/// out-of-range index.
-void read_face_corners(const LineParser& parse, Tokens& t, const Scene& scene,
-                       std::vector<Corner>& corners) {
+/// The corners of an 'f' statement in any form, with a precise message for each malformed
+/// index and each vertex index out of range. A texture or normal index that points at no `vt` or
+/// `vn` (0 or out of range) is read as other tools read it: the face keeps its geometry and
+/// loses its texture coordinates or normals, with a warning (`warn_at` gets its message).
+/// Returns false, with a warning, for a face of fewer than 3 corners, which is dropped.
+template <typename Warn>
+bool read_face_corners(const LineParser& parse, Tokens& t, const Scene& scene,
+                       std::vector<Corner>& corners, const Warn& warn_at) {
     corners.clear();
+    bool drop_texcoords = false, drop_normals = false;
     while (!t.at_end()) {
         std::string_view tok = t.next();
         const char* p = tok.data();
@@ -116,16 +121,84 @@ void read_face_corners(const LineParser& parse, Tokens& t, const Scene& scene,
                     ? fmt::format("face vertex index 0 in '{}' (OBJ indices start at 1)", tok)
                     : fmt::format("face vertex index {} out of range ({} vertices defined so far)",
                                   idx[0], scene.positions.size()));
-        if (present[1] && !resolve_index(idx[1], scene.texcoords.size(), c.t))
-            parse.fail(fmt::format("face texture index {} out of range ({} defined so far)", idx[1],
-                                   scene.texcoords.size()));
-        if (present[2] && !resolve_index(idx[2], scene.normals.size(), c.n))
-            parse.fail(fmt::format("face normal index {} out of range ({} defined so far)", idx[2],
-                                   scene.normals.size()));
+        if (present[1] && !resolve_index(idx[1], scene.texcoords.size(), c.t) && !drop_texcoords) {
+            drop_texcoords = true;
+            warn_at(
+                fmt::format("face texture index {} out of range ({} defined so far); the "
+                            "face has no texture coordinates",
+                            idx[1], scene.texcoords.size()));
+        }
+        if (present[2] && !resolve_index(idx[2], scene.normals.size(), c.n) && !drop_normals) {
+            drop_normals = true;
+            warn_at(
+                fmt::format("face normal index {} out of range ({} defined so far); the "
+                            "face uses its geometric normal",
+                            idx[2], scene.normals.size()));
+        }
         corners.push_back(c);
     }
-    if (corners.size() < 3)
-        parse.fail(fmt::format("face needs at least 3 corners, has {}", corners.size()));
+    if (corners.size() < 3) {
+        // A point or a line written as a face: other readers skip it.
+        warn_at(fmt::format("face needs at least 3 corners, has {}; dropped", corners.size()));
+        return false;
+    }
+    for (Corner& c : corners) {
+        if (drop_texcoords) c.t = kNoIndex;
+        if (drop_normals) c.n = kNoIndex;
+    }
+    return true;
+}
+
+/// Names in an `mtllib` statement: separated by blanks, where `\ ` is a space inside a name
+/// (`mtllib my\ file.mtl`, as shells and some exporters escape it).
+std::vector<std::string> library_names(std::string_view rest) {
+    std::vector<std::string> names;
+    std::string name;
+    for (std::size_t i = 0; i < rest.size(); ++i) {
+        const char ch = rest[i];
+        if (ch == '\\' && i + 1 < rest.size() && is_blank(rest[i + 1])) {
+            name += rest[++i];
+        } else if (is_space(ch)) {
+            if (!name.empty()) names.push_back(std::move(name));
+            name.clear();
+        } else {
+            name += ch;
+        }
+    }
+    if (!name.empty()) names.push_back(std::move(name));
+    return names;
+}
+
+/// The points of an `l` element ("v" or "v/vt" each; texture coordinates are ignored) as
+/// position indices appended to `points`. A vertex index of 0 or out of range is an error, as
+/// in faces.
+void read_polyline(const LineParser& parse, Tokens& t, const Scene& scene,
+                   std::vector<std::uint32_t>& points) {
+    std::size_t count = 0;
+    while (!t.at_end()) {
+        std::string_view tok = t.next();
+        const char* p = tok.data();
+        const char* e = p + tok.size();
+        long long index;
+        if (!parse_index(p, e, index) || (p != e && *p != '/'))
+            parse.fail(fmt::format("malformed line point '{}'", tok));
+        if (p != e) {
+            ++p;
+            long long texture;
+            if (!parse_index(p, e, texture) || p != e)
+                parse.fail(fmt::format("malformed line point '{}'", tok));
+        }
+        std::uint32_t v;
+        if (!resolve_index(index, scene.positions.size(), v))
+            parse.fail(
+                index == 0
+                    ? fmt::format("line vertex index 0 in '{}' (OBJ indices start at 1)", tok)
+                    : fmt::format("line vertex index {} out of range ({} vertices defined so far)",
+                                  index, scene.positions.size()));
+        points.push_back(v);
+        ++count;
+    }
+    if (count < 2) parse.fail(fmt::format("line element needs at least 2 points, has {}", count));
 }
 
 /// The camera block statement `c eye gaze up`: the indices of two vertices and a normal.
@@ -157,12 +230,12 @@ CameraSpec read_camera(const LineParser& parse, Tokens& t, const Scene& scene) {
     return cam;
 }
 
-/// Statements that are accepted and ignored: smoothing groups are implied by vn; lines,
-/// points and free-form geometry are not rendered.
+/// Statements that are accepted and ignored: smoothing groups are implied by vn; free-form
+/// geometry is not rendered.
 bool is_ignored_statement(std::string_view kw) {
-    return kw == "s" || kw == "l" || kw == "p" || kw == "vp" || kw == "cstype" || kw == "deg" ||
-           kw == "curv" || kw == "curv2" || kw == "surf" || kw == "parm" || kw == "end" ||
-           kw == "mg" || kw == "lod" || kw == "usemap" || kw == "maplib" || kw == "shadow_obj" ||
+    return kw == "s" || kw == "vp" || kw == "cstype" || kw == "deg" || kw == "curv" ||
+           kw == "curv2" || kw == "surf" || kw == "parm" || kw == "end" || kw == "mg" ||
+           kw == "lod" || kw == "usemap" || kw == "maplib" || kw == "shadow_obj" ||
            kw == "trace_obj" || kw == "bevel" || kw == "c_interp" || kw == "d_interp" ||
            kw == "ctech" || kw == "stech" || kw == "trim" || kw == "hole" || kw == "scrv" ||
            kw == "sp" || kw == "con" || kw == "bmat" || kw == "step";
@@ -193,8 +266,56 @@ void parse_obj(std::string_view text, const std::filesystem::path& path, Scene& 
     };
     std::unordered_map<std::string, bool> libraries;  // each MTL file is read once
     std::uint32_t material = 0, object = 0;
+    bool warned_points = false;
     std::vector<Corner> corners;
     corners.reserve(16);
+
+    // Non-finite coordinates (nan, inf), which other tools read: the vertex is kept (as 0, so
+    // every stored number stays finite) so indices stay right, and faces that use it are dropped (a non-finite normal or texture coordinate
+    // only takes the face's normals or texture coordinates). The flags exist only once such a
+    // value was read, so clean files pay one predictable branch per face.
+    std::size_t nonfinite_count = 0;
+    std::vector<std::uint8_t> nonfinite_position, nonfinite_normal, nonfinite_texcoord;
+    auto mark_nonfinite = [&](std::vector<std::uint8_t>& flags, std::size_t count, bool finite,
+                              std::size_t line, std::string_view what) {
+        if (finite && nonfinite_count == 0) return;
+        flags.resize(count, 0);
+        if (finite) return;
+        flags.back() = 1;
+        ++nonfinite_count;
+        warn.add(
+            located(file, line,
+                    fmt::format("non-finite coordinate in '{}'; the faces that use it {}", what,
+                                what == "v" ? "are dropped"
+                                            : (what == "vn" ? "use their geometric normals"
+                                                            : "have no texture coordinates"))));
+    };
+    // After the fast path added a finite element: keeps the flags in step once they exist.
+    auto keep_flags = [&](std::vector<std::uint8_t>& flags, std::size_t count) {
+        if (nonfinite_count != 0) [[unlikely]]
+            flags.resize(count, 0);
+    };
+    auto flagged = [](const std::vector<std::uint8_t>& flags, std::uint32_t i) {
+        return i != kNoIndex && i < flags.size() && flags[i] != 0;
+    };
+    // False when the face must be dropped; clears non-finite normals and texture coordinates.
+    auto usable_face = [&](std::size_t line) {
+        bool normals_ok = true, texcoords_ok = true;
+        for (const Corner& c : corners) {
+            if (flagged(nonfinite_position, c.v)) {
+                warn.add(located(file, line,
+                                 "face uses a vertex with a non-finite coordinate; dropped"));
+                return false;
+            }
+            normals_ok = normals_ok && !flagged(nonfinite_normal, c.n);
+            texcoords_ok = texcoords_ok && !flagged(nonfinite_texcoord, c.t);
+        }
+        for (Corner& c : corners) {
+            if (!normals_ok) c.n = kNoIndex;
+            if (!texcoords_ok) c.t = kNoIndex;
+        }
+        return true;
+    };
 
     // Memory: the text, the scene, its BVH, times the scenes loaded at once, plus what the
     // caller has committed elsewhere (frame buffers).
@@ -243,7 +364,9 @@ void parse_obj(std::string_view text, const std::filesystem::path& path, Scene& 
                     Limit::Vertices);
         grew(parse);
     };
-    auto add_face = [&](const LineParser& parse) {
+    auto add_face = [&](const LineParser& parse, std::size_t line) {
+        if (nonfinite_count != 0 && !usable_face(line)) [[unlikely]]
+            return;
         if (scene.triangle_count() + (corners.size() - 2) > max_triangles)
             parse.fail_limit(Limit::Triangles,
                              fmt::format("more than {} triangles (the limit)", max_triangles));
@@ -270,25 +393,29 @@ void parse_obj(std::string_view text, const std::filesystem::path& path, Scene& 
             if (begin[0] == 'f') {
                 if (is_blank(begin[1]) &&
                     within_limit(next = read_face_line(begin + 1, end, scene, corners))) {
-                    add_face(LineParser(file, reader.consumed_line(next)));
+                    const std::size_t n = reader.consumed_line(next);
+                    add_face(LineParser(file, n), n);
                     continue;
                 }
             } else if (is_blank(begin[1])) {
                 if (within_limit(next = read_numbers_line(begin + 1, end, f, 3))) {
                     adding_position(LineParser(file, reader.consumed_line(next)));
                     scene.positions.push_back({f[0], f[1], f[2]});
+                    keep_flags(nonfinite_position, scene.positions.size());
                     continue;
                 }
             } else if (begin[1] == 'n' && end - begin >= 3 && is_blank(begin[2])) {
                 if (within_limit(next = read_numbers_line(begin + 2, end, f, 3))) {
                     adding_normal(LineParser(file, reader.consumed_line(next)));
                     scene.normals.push_back({f[0], f[1], f[2]});
+                    keep_flags(nonfinite_normal, scene.normals.size());
                     continue;
                 }
             } else if (begin[1] == 't' && end - begin >= 3 && is_blank(begin[2])) {
                 if (within_limit(next = read_numbers_line(begin + 2, end, f, 2))) {
                     adding_texcoord(LineParser(file, reader.consumed_line(next)));
                     scene.texcoords.push_back({f[0], f[1]});
+                    keep_flags(nonfinite_texcoord, scene.texcoords.size());
                     continue;
                 }
             }
@@ -303,22 +430,59 @@ void parse_obj(std::string_view text, const std::filesystem::path& path, Scene& 
 
         if (kw == "v") {
             adding_position(parse);
-            scene.positions.push_back(parse.vec3(t, kw));
+            bool finite = true;
+            const Vec3f position = parse.coordinates3(t, kw, finite);
+            scene.positions.push_back(finite ? position : Vec3f(0.0f));
             // Optional w (or vertex colour) values are accepted and ignored, but must be numbers.
             while (!t.at_end()) parse.number(t, kw);
+            mark_nonfinite(nonfinite_position, scene.positions.size(), finite, line_number, kw);
         } else if (kw == "f") {
-            read_face_corners(parse, t, scene, corners);
-            add_face(parse);
+            if (read_face_corners(parse, t, scene, corners, [&](std::string message) {
+                    warn.add(located(file, line_number, message));
+                }))
+                add_face(parse, line_number);
         } else if (kw == "vn") {
             adding_normal(parse);
-            scene.normals.push_back(parse.vec3(t, kw));
+            bool finite = true;
+            const Vec3f normal = parse.coordinates3(t, kw, finite);
+            scene.normals.push_back(finite ? normal : Vec3f(0.0f));
+            mark_nonfinite(nonfinite_normal, scene.normals.size(), finite, line_number, kw);
         } else if (kw == "vt") {
             adding_texcoord(parse);
+            bool finite = true;
             Vec2f uv;
-            uv.x = parse.number(t, kw);
-            if (!t.at_end()) uv.y = parse.number(t, kw);
+            uv.x = parse.coordinate(t, kw, finite);
+            if (!t.at_end()) uv.y = parse.coordinate(t, kw, finite);
             if (!t.at_end()) parse.number(t, kw);
-            scene.texcoords.push_back(uv);
+            scene.texcoords.push_back(finite ? uv : Vec2f{});
+            mark_nonfinite(nonfinite_texcoord, scene.texcoords.size(), finite, line_number, kw);
+        } else if (kw == "l") {
+            Polyline line;
+            line.first = static_cast<std::uint32_t>(scene.polyline_points.size());
+            read_polyline(parse, t, scene, scene.polyline_points);
+            line.count = static_cast<std::uint32_t>(scene.polyline_points.size() - line.first);
+            check_count(parse, scene.polyline_points.size(), max_vertices, "polyline points ('l')",
+                        Limit::Vertices);
+            grew(parse);
+            line.material = material;
+            line.object = object;
+            bool finite = true;
+            for (std::uint32_t i = line.first; i < line.first + line.count; ++i)
+                finite = finite && !flagged(nonfinite_position, scene.polyline_points[i]);
+            if (finite) {
+                scene.polylines.push_back(line);
+            } else {
+                scene.polyline_points.resize(line.first);
+                warn.add(located(file, line_number,
+                                 "line uses a vertex with a non-finite coordinate; dropped"));
+            }
+        } else if (kw == "p") {
+            if (!warned_points) {
+                warned_points = true;
+                warn.add(located(file, line_number,
+                                 "point elements ('p') are not drawn; ignored (this warning is "
+                                 "given once a file)"));
+            }
         } else if (kw == "usemtl") {
             std::string_view name = t.rest();
             auto it = material_ids.find(name);
@@ -337,10 +501,8 @@ void parse_obj(std::string_view text, const std::filesystem::path& path, Scene& 
             grew(parse);
         } else if (kw == "mtllib") {
             if (!options.load_materials) continue;
-            while (!t.at_end()) {
-                std::string_view name = t.next();
-                std::filesystem::path library =
-                    (path.parent_path() / std::string(name)).lexically_normal();
+            for (const std::string& name : library_names(t.rest())) {
+                std::filesystem::path library = (path.parent_path() / name).lexically_normal();
                 // Each library once: "mtllib a.mtl a.mtl ..." must not read a.mtl again and again.
                 if (!libraries.emplace(library.string(), true).second) continue;
                 Warnings library_warnings;

@@ -5,10 +5,18 @@
 /// Reads: v (optional w or colour values ignored), vt, vn, f with 3 or more corners in all four
 /// index forms (v, v/vt, v//vn, v/vt/vn), negative (relative) indices, o, g, usemtl, mtllib
 /// (several files, paths relative to the OBJ), s (accepted, ignored: normals come from vn),
-/// comments, `\` line continuations, LF, CRLF and CR line endings, a UTF-8 byte-order mark, and the
+/// l (polylines, kept in Scene::polylines with their object and material; drawn as ink
+/// strokes), comments, `\` line continuations, LF, CRLF and CR line endings, a UTF-8 byte-order mark, and the
 /// camera block statement `c eye gaze up`. Polygons are triangulated as a fan from their first
 /// corner, which is exact for convex polygons. Faces index only vertices defined before them.
 /// An object is the run of faces after an `o` or `g` statement, named by it.
+///
+/// Read as other tools read them, with a warning (file:line) each: a texture or normal index
+/// that points at no `vt`/`vn` (the face has no texture coordinates, or uses its geometric
+/// normal); a non-finite coordinate (`nan`, `inf`, or beyond a float: faces using the vertex
+/// are dropped; a non-finite normal or texture coordinate only takes those from the face);
+/// `p` elements (ignored, one warning). `mtllib` names may escape spaces (`my\ file.mtl`).
+/// A vertex index of 0 or out of range stays an error.
 
 #include <cstddef>
 #include <filesystem>

@@ -26,6 +26,8 @@ void Scene::clear() {
     materials.assign(1, Material{"(default)"});
     objects.assign(1, "(default)");
     camera.reset();
+    polyline_points.clear();
+    polylines.clear();
 }
 
 std::uint64_t scene_bytes(std::uint64_t vertices, std::uint64_t triangles) {

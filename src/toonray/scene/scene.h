@@ -33,6 +33,13 @@ struct Material {
     std::shared_ptr<const ImageRgb8> kd_image;
 };
 
+/// A polyline (an OBJ `l` element): its points are positions[polyline_points[first + i]] for
+/// i < count (at least 2), drawn as ink strokes with its object's and material's lines.
+struct Polyline {
+    std::uint32_t first = 0, count = 0;
+    std::uint32_t material = 0, object = 0;
+};
+
 /// Triangles with per-corner indices into shared attribute arrays. Material 0 is always the
 /// default material and object 0 the default object, so every triangle has both.
 struct Scene {
@@ -53,6 +60,9 @@ struct Scene {
     std::vector<std::string> objects{"(default)"};
 
     std::optional<CameraSpec> camera;  ///< from the OBJ camera block, if any
+
+    std::vector<std::uint32_t> polyline_points;  ///< position indices of all polylines
+    std::vector<Polyline> polylines;
 
     [[nodiscard]] std::size_t triangle_count() const { return tri_positions.size(); }
     /// Bounds of the vertices that triangles use (camera vertices do not count).
