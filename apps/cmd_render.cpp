@@ -6,6 +6,8 @@
 #include "toonray/core/error.h"
 #include "toonray/core/limits.h"
 #include "toonray/frame/frame_renderer.h"
+#include "toonray/frame/lights.h"
+#include "toonray/scene/auto_smooth.h"
 #include "toonray/scene/obj_loader.h"
 
 namespace toonray::cli {
@@ -13,6 +15,7 @@ namespace {
 
 struct RenderCommandArgs {
     RenderArgs render;
+    SceneArgs scene;
     std::string input, output, svg;
     bool svg_hidden = false;
 };
@@ -34,6 +37,9 @@ int run_render(const RenderCommandArgs& args) {
     Warnings warnings;
     Scene scene;
     load_obj(args.input, scene, warnings);
+    // The scene's own lights (NAME.lights next to it) unless the command line gives lights.
+    options.settings.shading.lights = frame_lights(args.input, options.settings.shading.lights);
+    if (auto angle = args.scene.auto_smooth_angle()) auto_smooth(scene, *angle);
     FrameRenderer renderer;
     renderer.render(scene, choose_camera(scene, options), args.output, options, warnings);
     print_warnings(warnings);
@@ -50,6 +56,7 @@ Subcommand add_render_command(CLI::App& app, LimitArgs& limit_args) {
         ->check(CLI::ExistingFile);
     render->add_option("-o,--output", args->output, "Output PNG file")->required();
     args->render.add_to(*render);
+    args->scene.add_to(*render);
     render->add_option(
         "--svg", args->svg,
         "With --edges ink: also write the visible lines as SVG paths in pixel units, "
