@@ -12,9 +12,10 @@ Intensity: toonray's bands are thresholds on the diffuse term l.n summed over th
 where a light of intensity 1 gives l.n itself (0..1). Cycles lights a white diffuse surface with
 strength * n.l for a sun, whatever its strength, so one light of any strength gets intensity 1:
 its bands are the bands of Cycles' n.l. Between several lights the ratios are kept: each light
-is weighted by what it gives a white surface facing it at the centre of the exported objects'
-bounds, in Cycles' units (sun: strength; point and spot: power / (4 pi^2 d^2); area:
-power / (pi^2 d^2) times the cosine of the angle off its axis), and the brightest gets 1.
+is weighted by the irradiance it gives a surface facing it at the centre of the exported
+objects' bounds, as Cycles computes it (sun: strength; point and spot: power / (4 pi d^2), a
+spot's power being that of a point light shining everywhere; area: power / (pi d^2) times the
+cosine of the angle off its axis), and the brightest gets 1.
 Light colour is not kept: toonray's lights are white.
 """
 
@@ -37,9 +38,9 @@ def _num(x):
 
 
 def light_weight(kind, energy, position, axis, centre):
-    """What the light gives a white diffuse surface facing it at `centre` (Blender world
-    coordinates), in Cycles' units (a sun of strength S gives S). `axis`: the light's local -Z
-    in world coordinates (unit)."""
+    """The irradiance the light gives a surface facing it at `centre` (Blender world
+    coordinates), in Cycles' units (a sun of strength S gives S, W/m^2). `axis`: the light's
+    local -Z in world coordinates (unit)."""
     energy = max(0.0, energy)
     if kind == "SUN":
         return energy
@@ -49,8 +50,8 @@ def light_weight(kind, energy, position, axis, centre):
         d2 = 1e-12
     if kind == "AREA":
         cos = sum(a * c for a, c in zip(axis, d)) / math.sqrt(d2)
-        return energy * max(0.0, cos) / (math.pi * math.pi * d2)
-    return energy / (4.0 * math.pi * math.pi * d2)  # POINT, SPOT
+        return energy * max(0.0, cos) / (math.pi * d2)  # radiance power / (pi area)
+    return energy / (4.0 * math.pi * d2)  # POINT, SPOT: intensity power / (4 pi)
 
 
 def scene_lights(objects, centre, global_scale=1.0):
