@@ -56,8 +56,8 @@ Scene cube() {
 
 Vec3f face_normal(const Scene& s, std::size_t t) {
     const auto& tp = s.tri_positions[t];
-    return normalize(cross(s.positions[tp[1]] - s.positions[tp[0]],
-                           s.positions[tp[2]] - s.positions[tp[0]]));
+    return normalize(
+        cross(s.positions[tp[1]] - s.positions[tp[0]], s.positions[tp[2]] - s.positions[tp[0]]));
 }
 
 TEST(AutoSmooth, CylinderSidesSmoothCapsFlat) {
@@ -148,8 +148,7 @@ TEST(AutoSmooth, ObjectsAndGivenNormalsAreKeptApart) {
     EXPECT_EQ(s.tri_normals[4], (std::array<std::uint32_t, 3>{0, 0, 0}));
     for (std::size_t t = 0; t < 4; ++t) {
         const Vec3f fn = face_normal(s, t);
-        for (int k = 0; k < 3; ++k)
-            EXPECT_GT(dot(s.normals[s.tri_normals[t][k]], fn), 0.999999f);
+        for (int k = 0; k < 3; ++k) EXPECT_GT(dot(s.normals[s.tri_normals[t][k]], fn), 0.999999f);
     }
     // In one object the fold is smoothed: the shared edge's normals are the mean.
     for (auto& o : s.tri_object) o = 0;

@@ -72,9 +72,10 @@ struct Edge {
 
 std::size_t auto_smooth(Scene& scene, float angle_degrees) {
     if (!(angle_degrees >= 0.0f && angle_degrees <= 180.0f))
-        throw Error(fmt::format("auto-smooth angle {} is not between 0 and 180 degrees",
-                                angle_degrees));
-    const double cos_limit = std::cos(static_cast<double>(angle_degrees) * (std::numbers::pi / 180.0));
+        throw Error(
+            fmt::format("auto-smooth angle {} is not between 0 and 180 degrees", angle_degrees));
+    const double cos_limit =
+        std::cos(static_cast<double>(angle_degrees) * (std::numbers::pi / 180.0));
 
     // The triangles to smooth, with their unit face normals.
     std::vector<std::uint32_t> tris;
@@ -131,8 +132,8 @@ std::size_t auto_smooth(Scene& scene, float angle_degrees) {
         if (!usable[i]) continue;
         for (std::uint8_t k = 0; k < 3; ++k) {
             const std::uint32_t a = weld[3 * i + k], b = weld[3 * i + (k + 1) % 3];
-            edges.push_back({std::min(a, b), std::max(a, b), static_cast<std::uint32_t>(i), k,
-                             a < b});
+            edges.push_back(
+                {std::min(a, b), std::max(a, b), static_cast<std::uint32_t>(i), k, a < b});
         }
     }
     std::sort(edges.begin(), edges.end(), [](const Edge& a, const Edge& b) {
