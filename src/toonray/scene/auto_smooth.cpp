@@ -13,6 +13,7 @@
 #include "toonray/core/error.h"
 #include "toonray/core/index.h"
 #include "toonray/core/limits.h"
+#include "toonray/core/portable_math.h"
 
 namespace toonray {
 namespace {
@@ -26,6 +27,33 @@ Vec3d cross(const Vec3d& a, const Vec3d& b) {
 }
 double dot(const Vec3d& a, const Vec3d& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 double length(const Vec3d& a) { return std::sqrt(dot(a, a)); }
+
+// atan(t) for |t| <= tan(pi/8) (0.4142...): its Taylor series to 1e-17, in IEEE operations
+// only, so the normals have the same bits wherever they are computed (core/portable_math.h).
+double atan_small(double t) {
+    const double t2 = t * t;
+    double sum = 0.0;
+    for (int k = 23; k >= 0; --k) sum = (k % 2 ? -1.0 : 1.0) / (2 * k + 1) + t2 * sum;
+    return t * sum;
+}
+
+// atan(t) for |t| <= 1.
+double atan_unit(double t) {
+    const double a = std::fabs(t);
+    if (a <= 0.41421356237309503) return atan_small(t);
+    const double r = std::numbers::pi / 4 + atan_small((a - 1.0) / (a + 1.0));
+    return t < 0 ? -r : r;
+}
+
+// The angle in [0, pi] with sine proportional to y >= 0 and cosine to x: atan2(y, x), portably.
+double angle_of(double y, double x) {
+    if (y == 0.0 && x >= 0.0) return 0.0;
+    if (y <= std::fabs(x)) {
+        const double a = atan_unit(y / std::fabs(x));
+        return x > 0.0 ? a : std::numbers::pi - a;
+    }
+    return std::numbers::pi / 2 - atan_unit(x / y);
+}
 
 // The bits of a coordinate as a weld key: -0 and +0 weld together.
 std::uint32_t weld_bits(float f) { return std::bit_cast<std::uint32_t>(f == 0.0f ? 0.0f : f); }
@@ -75,7 +103,7 @@ std::size_t auto_smooth(Scene& scene, float angle_degrees) {
         throw Error(
             fmt::format("auto-smooth angle {} is not between 0 and 180 degrees", angle_degrees));
     const double cos_limit =
-        std::cos(static_cast<double>(angle_degrees) * (std::numbers::pi / 180.0));
+        portable::cos(static_cast<double>(angle_degrees) * (std::numbers::pi / 180.0));
 
     // The triangles to smooth, with their unit face normals.
     std::vector<std::uint32_t> tris;
@@ -171,7 +199,7 @@ std::size_t auto_smooth(Scene& scene, float angle_degrees) {
             const Vec3d p = to_double(scene.positions[tp[k]]);
             const Vec3d u = sub(to_double(scene.positions[tp[(k + 1) % 3]]), p);
             const Vec3d v = sub(to_double(scene.positions[tp[(k + 2) % 3]]), p);
-            const double angle = std::atan2(length(cross(u, v)), dot(u, v));
+            const double angle = angle_of(length(cross(u, v)), dot(u, v));
             Vec3d& s = sum[sets.find(static_cast<std::uint32_t>(3 * i + k))];
             for (int c = 0; c < 3; ++c) s[c] += face_normal[i][c] * angle;
         }

@@ -22,7 +22,8 @@ namespace toonray {
 ///
 /// Triangles with normals at all three corners are left as they are and take no part; so are
 /// degenerate triangles (no area, or two corners welded together), which stay flat. New
-/// normals are appended to scene.normals. Deterministic: the same scene gives the same bits.
+/// normals are appended to scene.normals. Deterministic: the same scene gives the same bits on
+/// every platform (IEEE operations only, no libm functions; see core/portable_math.h).
 /// Returns the number of triangles given normals. Throws Error when `angle_degrees` is not in
 /// [0, 180] or the normals would not fit 32-bit indices.
 std::size_t auto_smooth(Scene& scene, float angle_degrees);
