@@ -19,6 +19,7 @@ struct BatchArgs {
     bool resume = false, fail_fast = false, quiet = false;
     RenderArgs render;
     GltfArgs gltf;
+    SceneArgs scene;
 
     void add_to(CLI::App& app) {
         app.add_option("name", name,
@@ -62,6 +63,7 @@ int run_batch(const BatchArgs& args, const CLI::App& command) {
     if (!args.pattern.empty()) options.input_pattern = args.pattern;
     if (!args.output_pattern.empty()) options.output_pattern = args.output_pattern;
     options.render = args.render.resolve();
+    options.auto_smooth = args.scene.auto_smooth_angle();
     options.jobs = args.jobs;
     options.resume = args.resume;
     options.fail_fast = args.fail_fast;
@@ -92,6 +94,7 @@ Subcommand add_batch_command(CLI::App& app, LimitArgs& limit_args) {
     args->add_to(*batch);
     args->render.add_to(*batch);
     args->gltf.add_to(*batch, false);
+    args->scene.add_to(*batch);
     limit_args.add_to(*batch);
     return {batch, [args, batch] { return run_batch(*args, *batch); }};
 }

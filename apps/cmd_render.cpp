@@ -10,6 +10,8 @@
 #include "toonray/core/saturating.h"
 #include "toonray/frame/frame_renderer.h"
 #include "toonray/scene/gltf_loader.h"
+#include "toonray/frame/lights.h"
+#include "toonray/scene/auto_smooth.h"
 #include "toonray/scene/obj_loader.h"
 
 namespace toonray::cli {
@@ -17,6 +19,7 @@ namespace {
 
 struct RenderCommandArgs {
     RenderArgs render;
+    SceneArgs scene;
     std::string input, output, svg;
     bool svg_hidden = false;
     GltfArgs gltf;
@@ -35,6 +38,7 @@ void render_gltf(const RenderCommandArgs& args, const FrameOptions& options, War
     std::vector<Light> lights;
     animator.pose(args.gltf.seconds(), options.settings.width, options.settings.height, scene,
                   lights);
+    if (auto angle = args.scene.auto_smooth_angle()) auto_smooth(scene, *angle);
     const FrameOptions lit = with_gltf_lights(options, lights);
     FrameRenderer renderer;
     renderer.render(scene, choose_camera(scene, lit), args.output, lit, warnings);
@@ -64,6 +68,9 @@ int run_render(const RenderCommandArgs& args) {
         throw Error("--animation, --camera-node, --time and --frame need a glTF scene");
     Scene scene;
     load_obj(args.input, scene, warnings);
+    // The scene's own lights (NAME.lights next to it) unless the command line gives lights.
+    options.settings.shading.lights = frame_lights(args.input, options.settings.shading.lights);
+    if (auto angle = args.scene.auto_smooth_angle()) auto_smooth(scene, *angle);
     FrameRenderer renderer;
     renderer.render(scene, choose_camera(scene, options), args.output, options, warnings);
     print_warnings(warnings);
@@ -82,6 +89,7 @@ Subcommand add_render_command(CLI::App& app, LimitArgs& limit_args) {
         ->check(CLI::ExistingFile);
     render->add_option("-o,--output", args->output, "Output PNG file")->required();
     args->render.add_to(*render);
+    args->scene.add_to(*render);
     render->add_option(
         "--svg", args->svg,
         "With --edges ink: also write the visible lines as SVG paths in pixel units, "

@@ -143,6 +143,18 @@ FrameOptions RenderArgs::resolve() const {
     return o;
 }
 
+void SceneArgs::add_to(CLI::App& app) {
+    app.add_option("--auto-smooth", auto_smooth,
+                   "Smooth normals for meshes without vertex normals: faces meeting at less than "
+                   "ANGLE degrees shade as one smooth surface, sharper edges stay creases "
+                   "(as Blender's auto-smooth; default off)")
+        ->check(CLI::Range(0.0f, 180.0f));
+}
+
+std::optional<float> SceneArgs::auto_smooth_angle() const {
+    return auto_smooth >= 0.0f ? std::optional<float>(auto_smooth) : std::nullopt;
+}
+
 void LimitArgs::add_to(CLI::App& app) {
     const Limits d;
     app.add_option("--max-triangles", triangles,

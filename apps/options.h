@@ -44,6 +44,15 @@ struct RenderArgs {
     [[nodiscard]] FrameOptions resolve() const;
 };
 
+/// Options of render and batch that change the scene as loaded.
+struct SceneArgs {
+    float auto_smooth = -1.0f;  ///< degrees; below 0: off
+
+    void add_to(CLI::App& app);
+    /// The auto-smooth angle when asked for.
+    [[nodiscard]] std::optional<float> auto_smooth_angle() const;
+};
+
 /// Limits on what inputs may ask for (docs/robustness.md), as text until validated.
 struct LimitArgs {
     std::string triangles, vertices, pixels, memory, input_size;

@@ -28,14 +28,14 @@ bl_info = {
 if "bpy" in locals():  # reload (F3 > Reload Scripts)
     import importlib
 
-    for _m in (note_script, camera, exporter, keys):  # noqa: F821
+    for _m in (note_script, camera, lights, exporter, keys):  # noqa: F821
         importlib.reload(_m)
 
 import bpy
 from bpy.props import (BoolProperty, EnumProperty, FloatProperty, IntProperty, StringProperty)
 from bpy.types import Operator
 
-from . import camera, exporter, keys, note_script
+from . import camera, exporter, keys, lights, note_script  # noqa: F401
 
 
 class TOONRAY_OT_export_obj_sequence(Operator):

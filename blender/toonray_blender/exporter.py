@@ -15,6 +15,7 @@ import os
 import bpy
 
 from . import camera as cam
+from . import lights as lights_io
 
 # The parameters we pass to bpy.ops.wm.obj_export. Their names are the same from Blender 3.2
 # (the C++ exporter) through 4.x; any that a version lacks is left out, and the required ones
@@ -123,9 +124,32 @@ def export_frame(context, filepath, use_selection=False, global_scale=1.0, apply
                "(sensor fit %s); render with --size %dx%d"
                % (info["camera"], scene.frame_current, info["fov_x_degrees"], info["sensor_fit"],
                   info["size"][0], info["size"][1]))
+    if export_materials:
+        info["default_material_objects"] = lights_io.add_default_material(filepath)
     with open(filepath, "a", encoding="utf-8", newline="\n") as f:
         f.write(cam.camera_block_text(eye, gaze, up, comment))
+    lights = frame_lights(context, depsgraph, use_selection, eval_mode, global_scale)
+    info["lights"] = len(lights)
+    lights_io.write_lights(filepath, lights,
+                           "toonray lights: Blender scene '%s' at frame %d (docs/blender.md)"
+                           % (scene.name, scene.frame_current))
     return info
+
+
+def frame_lights(context, depsgraph, use_selection, eval_mode, global_scale):
+    """The scene's lights that render at the current frame (every light, with or without
+    use_selection), evaluated, as lights.scene_lights gives them."""
+    scene = context.scene
+    render = eval_mode == "DAG_EVAL_RENDER"
+
+    def shown(obj):
+        return not obj.hide_render if render else obj.visible_get()
+
+    lights = [o.evaluated_get(depsgraph) for o in scene.objects
+              if o.type == "LIGHT" and shown(o)]
+    geometry = [o.evaluated_get(depsgraph) for o in scene.objects
+                if o.type != "LIGHT" and shown(o) and (not use_selection or o.select_get())]
+    return lights_io.scene_lights(lights, lights_io.exported_centre(geometry), global_scale)
 
 
 def export_sequence(context, directory, name="keys", frame_start=1, frame_end=250, frame_step=1,

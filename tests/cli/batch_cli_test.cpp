@@ -126,3 +126,26 @@ TEST(BatchCli, RangeErrors) {
     EXPECT_NE(r.exit_code, 0);
     EXPECT_NE(r.output.find("first frame is after the last"), std::string::npos) << r.output;
 }
+
+TEST(BatchCli, EachFrameIsLitByItsOwnLightsFile) {
+    TempDir dir("cli_batch_lights");
+    write_frames(dir, 2);
+    dir.write("in/keys_000001.lights", "directional 1 -1 -0.5\n");
+    dir.write("in/keys_000002.lights", "directional -1 -1 -0.5\n");
+    const std::string common = " --size 160x90 --edges classic --quiet --auto-smooth 30";
+    CommandResult r = run_toonray("batch keys 1 2 --input " + (dir / "in").string() + " --output " +
+                                  (dir / "png").string() + common);
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    for (auto [frame, light] : {std::pair{1, "dir:1,-1,-0.5"}, std::pair{2, "dir:-1,-1,-0.5"}}) {
+        const std::string name = "keys_00000" + std::to_string(frame);
+        r = run_toonray("render " + (dir / "in" / (name + ".obj")).string() + " -o " +
+                        (dir / (name + ".png")).string() + " --light " + light +
+                        " --size 160x90 --edges classic --auto-smooth 30");
+        ASSERT_EQ(r.exit_code, 0) << r.output;
+        std::ifstream a(dir / "png" / (name + ".png"), std::ios::binary),
+            b(dir / (name + ".png"), std::ios::binary);
+        EXPECT_EQ(std::string(std::istreambuf_iterator<char>(a), {}),
+                  std::string(std::istreambuf_iterator<char>(b), {}))
+            << "frame " << frame;
+    }
+}

@@ -180,3 +180,58 @@ TEST(RenderCli, InkLinesAreTheDefault) {
     EXPECT_NE(bytes(dir / "default.png"), bytes(dir / "robust.png"));
     EXPECT_TRUE(fs::exists(dir / "default.svg"));
 }
+
+namespace {
+std::string file_bytes(const fs::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    return {std::istreambuf_iterator<char>(in), {}};
+}
+}  // namespace
+
+TEST(RenderCli, TheScenesLightsFileLightsItUnlessLightsAreGiven) {
+    TempDir dir("cli_scene_lights");
+    fs::copy_file(kData + "/teapot.obj", dir / "pot.obj");
+    const std::string common = " --size 160x100 --edges classic --threads 2";
+    auto render = [&](const std::string& out, const std::string& extra) {
+        CommandResult r = run_toonray("render " + (dir / "pot.obj").string() + " -o " +
+                                      (dir / out).string() + common + extra);
+        EXPECT_EQ(r.exit_code, 0) << r.output;
+        return file_bytes(dir / out);
+    };
+    const std::string plain = render("default.png", "");
+    const std::string given = render("given.png", " --light dir:1,-1,-0.5");
+    ASSERT_NE(plain, given);
+    dir.write("pot.lights", "# from the exporter\ndirectional 1 -1 -0.5 1   # sun\n");
+    EXPECT_EQ(render("file.png", ""), given);  // read with no option
+    // The command line wins over the file.
+    const std::string overridden = render("override.png", " --light dir:0,0,-1");
+    EXPECT_NE(overridden, given);
+    fs::remove(dir / "pot.lights");
+    EXPECT_EQ(render("explicit.png", " --light dir:0,0,-1"), overridden);
+    dir.write("pot.lights", "directional 1 -1 -0.5\npoint 1 2\n");
+    CommandResult r = run_toonray("render " + (dir / "pot.obj").string() + " -o " +
+                                  (dir / "bad.png").string() + common);
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_NE(r.output.find("pot.lights:2: expected x y z [intensity]"), std::string::npos)
+        << r.output;
+    EXPECT_FALSE(fs::exists(dir / "bad.png"));
+}
+
+TEST(RenderCli, AutoSmoothChangesOnlyMeshesWithoutNormalsAndChecksTheAngle) {
+    TempDir dir("cli_auto_smooth");
+    const std::string common = " --size 160x100 --threads 2";
+    auto render = [&](const std::string& out, const std::string& extra) {
+        CommandResult r = run_toonray("render " + kData + "/teapot.obj -o " + (dir / out).string() +
+                                      common + extra);
+        EXPECT_EQ(r.exit_code, 0) << r.output;
+        return file_bytes(dir / out);
+    };
+    const std::string flat = render("flat.png", "");
+    const std::string smooth = render("smooth.png", " --auto-smooth 30");
+    EXPECT_NE(flat, smooth);
+    EXPECT_EQ(render("smooth2.png", " --auto-smooth 30"), smooth);
+    CommandResult r = run_toonray("render " + kData + "/teapot.obj -o " +
+                                  (dir / "bad.png").string() + " --auto-smooth 200");
+    EXPECT_NE(r.exit_code, 0);
+    EXPECT_NE(r.output.find("--auto-smooth"), std::string::npos) << r.output;
+}

@@ -47,3 +47,32 @@ TEST(LightsFile, LoadsAFileAndNamesItInErrors) {
     }
     EXPECT_THROW(load_lights(dir.path / "missing.lights"), Error);
 }
+
+TEST(LightsFile, AFrameIsLitByItsLightsFileUnlessLightsAreGiven) {
+    test_support::TempDir dir("frame_lights");
+    const auto obj = dir.path / "keys_000030.obj";
+    EXPECT_EQ(scene_lights_path(obj), dir.path / "keys_000030.lights");
+    // No lights file: no lights (the renderer's default light).
+    EXPECT_TRUE(frame_lights(obj, {}).empty());
+    std::ofstream(dir.path / "keys_000030.lights")
+        << "# toonray lights\ndirectional 0.5 -1 0 1    # sun 'Sun'\npoint 1 2 3 0.25\n";
+    auto lights = frame_lights(obj, {});
+    ASSERT_EQ(lights.size(), 2u);
+    EXPECT_EQ(lights[0].kind, Light::Kind::Directional);
+    EXPECT_EQ(lights[0].vector, Vec3f(0.5f, -1, 0));
+    EXPECT_EQ(lights[1].intensity, 0.25f);
+    // Lights given (--light, --lights) win; the file is not even read.
+    std::ofstream(dir.path / "keys_000031.lights") << "spot 1 2 3\n";
+    const std::vector<Light> given{parse_light("dir:0,0,-1")};
+    lights = frame_lights(dir.path / "keys_000031.obj", given);
+    ASSERT_EQ(lights.size(), 1u);
+    EXPECT_EQ(lights[0].vector, Vec3f(0, 0, -1));
+    try {
+        frame_lights(dir.path / "keys_000031.obj", {});
+        FAIL();
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("keys_000031.lights:1: unknown light 'spot'"),
+                  std::string::npos)
+            << e.what();
+    }
+}

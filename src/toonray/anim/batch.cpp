@@ -14,6 +14,8 @@
 #include "toonray/core/limits.h"
 #include "toonray/core/saturating.h"
 #include "toonray/scene/gltf_loader.h"
+#include "toonray/frame/lights.h"
+#include "toonray/scene/auto_smooth.h"
 #include "toonray/scene/obj_loader.h"
 
 namespace toonray {
@@ -65,8 +67,9 @@ public:
 
     std::unique_ptr<FrameJob> make_job(int jobs) override;
 
-    // Loads frame's scene. Runs on a job's loading thread; throws Error.
-    void load(int frame, Scene& scene, Warnings& warnings) const {
+    // Loads frame's scene and returns its lights (frame_lights). Runs on a job's loading
+    // thread; throws Error.
+    std::vector<Light> load(int frame, Scene& scene, Warnings& warnings) const {
         auto input = find_frame_file(options_.input_dir, input_patterns_, frame);
         if (!input) {
             std::string tried;
@@ -77,6 +80,8 @@ public:
         }
         try {
             load_obj(*input, scene, warnings, obj_);
+            if (options_.auto_smooth) auto_smooth(scene, *options_.auto_smooth);
+            return frame_lights(*input, options_.render.settings.shading.lights);
         } catch (const Error&) {
             throw;
         } catch (const std::exception& e) {
@@ -116,6 +121,7 @@ public:
         slot_ = 1 - slot_;
         warnings.insert(warnings.end(), current.warnings.begin(), current.warnings.end());
         if (current.error) std::rethrow_exception(current.error);
+        render_.settings.shading.lights = std::move(current.lights);
         renderer_.render(scene, choose_camera(scene, render_), source_.output(frame), render_,
                          warnings);
     }
@@ -125,12 +131,13 @@ private:
     struct Loaded {
         Warnings warnings;
         std::exception_ptr error;
+        std::vector<Light> lights;  ///< the frame's lights (empty: the default light)
     };
 
     Loaded load_into(int frame, Scene& scene) const {
         Loaded loaded;
         try {
-            source_.load(frame, scene, loaded.warnings);
+            loaded.lights = source_.load(frame, scene, loaded.warnings);
         } catch (...) {
             loaded.error = std::current_exception();
         }

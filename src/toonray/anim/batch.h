@@ -44,6 +44,10 @@ struct BatchOptions {
     std::optional<std::string> input_pattern;   ///< default: see default_input_patterns()
     std::optional<std::string> output_pattern;  ///< default: NAME_%06d.png
     FrameOptions render;
+    /// Auto-smooth angle in degrees for triangles without normals (scene/auto_smooth.h); off
+    /// when unset. Frames are lit by render.settings.shading.lights when given, else by each
+    /// frame's lights file (frame/lights.h, frame_lights), else by the default light.
+    std::optional<float> auto_smooth;
     int jobs = 0;            ///< frames rendered at once; 0 = one per hardware thread
     bool resume = false;     ///< skip frames whose PNG exists and is valid
     bool fail_fast = false;  ///< stop at the first failed frame

@@ -53,4 +53,18 @@ std::vector<Light> load_lights(const std::filesystem::path& path) {
     return parse_lights(read_file(path), path.string());
 }
 
+std::filesystem::path scene_lights_path(const std::filesystem::path& scene_file) {
+    std::filesystem::path path = scene_file;
+    return path.replace_extension(".lights");
+}
+
+std::vector<Light> frame_lights(const std::filesystem::path& scene_file,
+                                const std::vector<Light>& given) {
+    if (!given.empty()) return given;
+    const std::filesystem::path path = scene_lights_path(scene_file);
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(path, ec)) return {};
+    return load_lights(path);
+}
+
 }  // namespace toonray
