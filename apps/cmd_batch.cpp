@@ -17,6 +17,7 @@ struct BatchArgs {
     int jobs = 0;
     bool resume = false, fail_fast = false, quiet = false;
     RenderArgs render;
+    SvgArgs svg;
 
     void add_to(CLI::App& app) {
         app.add_option("name", name,
@@ -59,6 +60,7 @@ int run_batch(const BatchArgs& args, const CLI::App& command) {
     if (!args.pattern.empty()) options.input_pattern = args.pattern;
     if (!args.output_pattern.empty()) options.output_pattern = args.output_pattern;
     options.render = args.render.resolve();
+    args.svg.apply(options.render, true);
     options.jobs = args.jobs;
     options.resume = args.resume;
     options.fail_fast = args.fail_fast;
@@ -86,6 +88,7 @@ Subcommand add_batch_command(CLI::App& app, LimitArgs& limit_args) {
         "Render numbered frames NAME FIRST LAST to a PNG sequence (all render options apply)");
     args->add_to(*batch);
     args->render.add_to(*batch);
+    args->svg.add_to(*batch, true);
     limit_args.add_to(*batch);
     return {batch, [args, batch] { return run_batch(*args, *batch); }};
 }

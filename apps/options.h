@@ -38,9 +38,28 @@ struct RenderArgs {
     int leaf_size = Bvh::Config{}.max_leaf_size;
     int png_level = PngOptions{}.level;
     std::string aov_dir;
+    // Ink line styles (add_ink_style_options).
+    std::string line_style;
+    float line_taper = 0.0f;
 
     void add_to(CLI::App& app);
     [[nodiscard]] FrameOptions resolve() const;
+
+private:
+    void add_ink_style_options(CLI::App& app);
+    void resolve_ink_style(FrameOptions& options) const;
+};
+
+/// Vector output of the ink lines: `--svg FILE` (render) or `--svg DIR` (one SVG per frame,
+/// named like its PNG), `--hidden-lines` (alias `--svg-hidden`), `--svg-fill`.
+struct SvgArgs {
+    std::string svg;
+    bool hidden = false, fill = false;
+
+    void add_to(CLI::App& app, bool per_frame);
+    /// Sets options.svg (or svg_dir), svg_hidden, svg_fill; Error for --hidden-lines or
+    /// --svg-fill without --svg.
+    void apply(FrameOptions& options, bool per_frame) const;
 };
 
 /// Limits on what inputs may ask for (docs/robustness.md), as text until validated.

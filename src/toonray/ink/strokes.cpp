@@ -47,6 +47,7 @@ struct Link {
     bool visible;
     Point2 s0, s1;
     EndpointKey key0, key1;
+    std::uint16_t style;
 };
 
 }  // namespace
@@ -68,7 +69,8 @@ std::vector<Point2> simplify_polyline(std::span<const Point2> points, float tole
     return out;
 }
 
-std::vector<Stroke> chain_pieces(std::span<const EdgePiece> pieces, const ChainSettings& settings) {
+std::vector<Stroke> chain_pieces(std::span<const EdgePiece> pieces, const ChainSettings& settings,
+                                 std::span<const SegmentStyles> segment_styles) {
     // 1. Per segment: absorb sub-pixel pieces into their neighbours, then merge runs of one
     //    visibility into links.
     std::vector<Link> links;
@@ -98,7 +100,10 @@ std::vector<Stroke> chain_pieces(std::span<const EdgePiece> pieces, const ChainS
                 links.back().key1 = p.key1;
                 continue;
             }
-            links.push_back({p.type, visible[k], p.s0, p.s1, p.key0, p.key1});
+            const std::uint16_t style = p.segment < segment_styles.size()
+                                            ? segment_styles[p.segment][visible[k] ? 0 : 1]
+                                            : 0;
+            links.push_back({p.type, visible[k], p.s0, p.s1, p.key0, p.key1, style});
         }
         i = j;
     }
@@ -154,7 +159,7 @@ std::vector<Stroke> chain_pieces(std::span<const EdgePiece> pieces, const ChainS
                 for (const End& e : ends_at(key)) {
                     const Link& l = links[e.link];
                     if (used[e.link] || l.type != first.type || l.visible != first.visible ||
-                        e.link == last_link)
+                        l.style != first.style || e.link == last_link)
                         continue;
                     last_link = e.link;
                     ++candidates;
@@ -190,6 +195,7 @@ std::vector<Stroke> chain_pieces(std::span<const EdgePiece> pieces, const ChainS
         Stroke stroke;
         stroke.type = first.type;
         stroke.visible = first.visible;
+        stroke.style = first.style;
         stroke.closed = closed;
         stroke.points = simplify_polyline(spaced, settings.simplify);
         if (stroke.visible && settings.min_length > 0.0f &&

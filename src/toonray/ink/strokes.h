@@ -2,6 +2,8 @@
 /// Chaining: visible (or hidden) edge pieces joined into strokes, the polylines that are drawn
 /// and written to SVG.
 
+#include <array>
+#include <cstdint>
 #include <span>
 #include <vector>
 
@@ -14,7 +16,11 @@ struct Stroke {
     bool visible = true;
     std::vector<Point2> points;  ///< on the image, in pixels; at least two
     bool closed = false;         ///< the last point is the first (a loop)
+    std::uint16_t style = 0;     ///< index into the frame's resolved line styles (ink.h)
 };
+
+/// Per segment, the style index of its visible pieces [0] and of its hidden pieces [1].
+using SegmentStyles = std::array<std::uint16_t, 2>;
 
 struct ChainSettings {
     /// A piece whose image is shorter than this (pixels), between pieces of the other
@@ -40,9 +46,12 @@ struct ChainSettings {
 /// unused matching piece it continues with it, whatever the angle; with several, it continues
 /// with the straightest on the image if that turns by at most max_turn, else it stops. A
 /// stroke that comes back to its start is closed. Strokes come out in the order of their
-/// first pieces (so deterministic).
+/// first pieces (so deterministic). With `segment_styles` (one entry per segment), pieces
+/// also chain only when they have the same style, and strokes carry it; without, every
+/// stroke has style 0.
 [[nodiscard]] std::vector<Stroke> chain_pieces(std::span<const EdgePiece> pieces,
-                                               const ChainSettings& settings);
+                                               const ChainSettings& settings,
+                                               std::span<const SegmentStyles> segment_styles = {});
 
 /// Douglas-Peucker: the fewest points of `points` (ends kept) such that every dropped point
 /// is within `tolerance` of the simplified polyline.
