@@ -90,7 +90,15 @@ std::uint64_t frame_bytes(const FrameOptions& options) {
     // compressed bound and the file's bytes, about three copies, and a compressor of under 1 MiB.
     const std::uint64_t png =
         pixels > UINT64_MAX / 16 ? UINT64_MAX : pixels * 3 * sizeof(Rgb8) + 1024 * 1024;
-    const std::uint64_t total = add_saturated(frame_buffer_bytes(settings), png);
+    std::uint64_t total = add_saturated(frame_buffer_bytes(settings), png);
+    if (options.svg || options.svg_dir) {
+        // The ink line layer of an SVG asked of another mode (coverage and style), and the
+        // embedded fill: its PNG and the base64 text, within twice the RGB pixels.
+        const std::uint64_t per_pixel =
+            (settings.edges != EdgeMode::Ink ? sizeof(float) + sizeof(std::uint16_t) : 0) +
+            (options.svg_fill ? 2 * sizeof(Rgb8) : 0);
+        total = add_saturated(total, pixels > UINT64_MAX / 16 ? UINT64_MAX : pixels * per_pixel);
+    }
     return add_saturated(total, total / 5);
 }
 
