@@ -18,8 +18,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     }
     for (int t = 0; t < ink::kEdgeTypeCount; ++t)
         for (bool visible : {false, true}) {
-            const ink::LineStyle s = ink::resolve_line_style(set, ink::LineStyle{}, "w12", "ivory",
-                                                             static_cast<ink::EdgeType>(t), visible);
+            const ink::LineStyle s = ink::resolve_line_style(
+                set, ink::LineStyle{}, "w12", "ivory", static_cast<ink::EdgeType>(t), visible);
             FUZZ_CHECK(s.width >= 0.0f && s.width <= 1000.0f);
             FUZZ_CHECK(s.opacity >= 0.0f && s.opacity <= 1.0f);
             FUZZ_CHECK(s.dash.size() % 2 == 0);

@@ -66,7 +66,8 @@ TEST(LineStyle, ErrorsNameTheFileLineAndWhatWasWrong) {
     EXPECT_EQ(parse_error("\nmatch width=-1\n"),
               "keys.style:2: width: expected pixels in [0, 1000], got '-1'");
     EXPECT_EQ(parse_error("draw=yes\n"), "keys.style:1: expected 'match', got 'draw=yes'");
-    EXPECT_EQ(parse_error("match colr=#000000\n").substr(0, 32), "keys.style:1: unknown key 'colr'");
+    EXPECT_EQ(parse_error("match colr=#000000\n").substr(0, 32),
+              "keys.style:1: unknown key 'colr'");
     EXPECT_EQ(parse_error("match type=edge\n").substr(0, 44),
               "keys.style:1: type: unknown line type 'edge'");
     EXPECT_EQ(parse_error("# ok\nmatch dash=0,0\n"),
@@ -78,11 +79,13 @@ TEST(LineStyle, ErrorsNameTheFileLineAndWhatWasWrong) {
     EXPECT_EQ(parse_error("match lines=some\n"),
               "keys.style:1: lines: expected visible, hidden or all, got 'some'");
     EXPECT_EQ(parse_error("match width=1 width=2\n"), "keys.style:1: 'width' given twice");
-    EXPECT_EQ(parse_error("match object=a,,b\n"), "keys.style:1: object: empty name pattern in 'a,,b'");
+    EXPECT_EQ(parse_error("match object=a,,b\n"),
+              "keys.style:1: object: empty name pattern in 'a,,b'");
     EXPECT_EQ(parse_error("match width\n"), "keys.style:1: expected key=value, got 'width'");
     EXPECT_NE(parse_error("match color=#12345\n").find("keys.style:1: color: expected #rrggbb"),
               std::string::npos);
-    EXPECT_EQ(parse_error("match width=nan\n"), "keys.style:1: width: expected a number, got 'nan'");
+    EXPECT_EQ(parse_error("match width=nan\n"),
+              "keys.style:1: width: expected a number, got 'nan'");
 }
 
 TEST(LineStyle, LaterRulesOverrideTheAttributesTheySet) {
@@ -121,8 +124,8 @@ ink::Stroke line(float y, std::uint16_t style) {
 }
 
 TEST(StyledStrokes, OneSolidPenDrawsExactlyLikeDrawStrokes) {
-    const std::vector<ink::Stroke> strokes{line(10.3f, 0), line(12.0f, 0),
-                                           {ink::EdgeType::Crease, true, {{5, 5}, {30, 40}}}};
+    const std::vector<ink::Stroke> strokes{
+        line(10.3f, 0), line(12.0f, 0), {ink::EdgeType::Crease, true, {{5, 5}, {30, 40}}}};
     ImageF plain(64, 48, 0.0f);
     ink::draw_strokes(strokes, 2.5f, plain, 1);
     const std::vector<ink::StrokePen> pens{{true, 2.5f, Vec3f{0.0f}, 1.0f, {}, 0.0f}};
@@ -160,7 +163,8 @@ TEST(StyledStrokes, DashesOpacityAndTheStrongestStrokeWins) {
     EXPECT_EQ(image(5, 19), (Rgb8{255, 128, 128}));  // red at half opacity over white
     // Overlapping strokes: each pixel keeps the larger coverage, ties the lower style, in any
     // stroke order and thread count.
-    std::vector<ink::Stroke> crossing{line(20.0f, 1), line(20.4f, 0),
+    std::vector<ink::Stroke> crossing{line(20.0f, 1),
+                                      line(20.4f, 0),
                                       {ink::EdgeType::Crease, true, {{30, 2}, {30, 46}}, false, 1}};
     ImageF c1, c2;
     Image<std::uint16_t> s1, s2;
@@ -171,7 +175,7 @@ TEST(StyledStrokes, DashesOpacityAndTheStrongestStrokeWins) {
         ASSERT_EQ(c1.data()[i], c2.data()[i]);
         ASSERT_EQ(s1.data()[i], s2.data()[i]);
     }
-    EXPECT_EQ(s1(30, 20), 0);  // all three cover it fully: the lower style
+    EXPECT_EQ(s1(30, 20), 0);     // all three cover it fully: the lower style
     EXPECT_EQ(c1(30, 35), 1.0f);  // only the vertical line, in an "on" dash
     EXPECT_EQ(s1(30, 35), 1);
 }
@@ -187,8 +191,8 @@ TEST(StyledStrokes, TaperThinsOpenStrokesToTheirEnds) {
         for (int y = 0; y < 48; ++y) sum += coverage(x, y);
         return sum;
     };
-    EXPECT_NEAR(across(32), 4.0f, 1e-5f);      // the middle: full thickness
-    EXPECT_LT(across(9), across(16));           // thinner toward the ends
+    EXPECT_NEAR(across(32), 4.0f, 1e-5f);  // the middle: full thickness
+    EXPECT_LT(across(9), across(16));      // thinner toward the ends
     EXPECT_LT(across(16), across(32));
     EXPECT_NEAR(across(59), across(4), 0.25f);  // symmetric
 }

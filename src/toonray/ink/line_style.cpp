@@ -36,7 +36,8 @@ struct LineContext {
 float parse_number(std::string_view text, std::string_view key, const LineContext& at) {
     float value = 0.0f;
     const auto [p, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
-    if (text.empty() || ec != std::errc() || p != text.data() + text.size() || !std::isfinite(value))
+    if (text.empty() || ec != std::errc() || p != text.data() + text.size() ||
+        !std::isfinite(value))
         at.fail(fmt::format("{}: expected a number, got '{}'", key, text));
     return value;
 }
@@ -55,9 +56,10 @@ unsigned parse_types(std::string_view text, const LineContext& at) {
         for (int t = 0; t < kEdgeTypeCount; ++t)
             if (name == edge_type_name(static_cast<EdgeType>(t))) found = t;
         if (found < 0)
-            at.fail(fmt::format("type: unknown line type '{}' (silhouette, border, crease, "
-                                "material, intersection or all)",
-                                name));
+            at.fail(
+                fmt::format("type: unknown line type '{}' (silhouette, border, crease, "
+                            "material, intersection or all)",
+                            name));
         types |= 1u << found;
     }
     return types;
@@ -69,7 +71,8 @@ std::vector<float> parse_dash(std::string_view text, const LineContext& at) {
     float total = 0.0f;
     for (std::string_view part : split(text, ',')) {
         const float v = parse_number(part, "dash", at);
-        if (v < 0.0f || v > 1e4f) at.fail(fmt::format("dash: lengths must be in [0, 10000], got '{}'", part));
+        if (v < 0.0f || v > 1e4f)
+            at.fail(fmt::format("dash: lengths must be in [0, 10000], got '{}'", part));
         dash.push_back(v);
         total += v;
     }
@@ -165,9 +168,10 @@ LineStyleRule parse_rule(std::string_view body, const LineContext& at) {
         } else if (key == "dash") {
             rule.dash = parse_dash(value, at);
         } else {
-            at.fail(fmt::format("unknown key '{}' (object, material, type, lines, draw, color, "
-                                "width, opacity, dash, taper)",
-                                key));
+            at.fail(
+                fmt::format("unknown key '{}' (object, material, type, lines, draw, color, "
+                            "width, opacity, dash, taper)",
+                            key));
         }
     }
     return rule;

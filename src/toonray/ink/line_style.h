@@ -41,7 +41,7 @@ struct LineStyle {
 /// One `match` line of a style file: matchers and the attributes it sets.
 struct LineStyleRule {
     std::vector<std::string> objects{"*"}, materials{"*"};  ///< globs, any may match
-    unsigned types = (1u << kEdgeTypeCount) - 1;  ///< bit (1 << EdgeType) per matched type
+    unsigned types = (1u << kEdgeTypeCount) - 1;      ///< bit (1 << EdgeType) per matched type
     bool match_visible = true, match_hidden = false;  ///< `lines=`: visible by default
     std::optional<bool> draw;
     std::optional<Vec3f> colour;
