@@ -115,10 +115,14 @@ void RenderArgs::add_ink_style_options(CLI::App& app) {
                    "lines (0 = off); a style's taper overrides it")
         ->check(CLI::Range(0.0f, 1000.0f))
         ->capture_default_str();
+    app.add_flag("--line-width-by-depth", line_width_by_depth,
+                 "Ink: lines thinner farther away: full width at the distance of the scene's "
+                 "centre, scaled by it over the line's distance, within 0.25x-2x");
 }
 
 void RenderArgs::resolve_ink_style(FrameOptions& options) const {
     options.settings.line_taper = line_taper;
+    options.settings.line_width_by_depth = line_width_by_depth;
     if (!line_style.empty())
         options.settings.line_styles = ink::parse_line_styles(read_file(line_style), line_style);
 }

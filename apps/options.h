@@ -41,6 +41,7 @@ struct RenderArgs {
     // Ink line styles (add_ink_style_options).
     std::string line_style;
     float line_taper = 0.0f;
+    bool line_width_by_depth = false;
 
     void add_to(CLI::App& app);
     [[nodiscard]] FrameOptions resolve() const;

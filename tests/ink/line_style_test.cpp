@@ -199,3 +199,34 @@ TEST(StyledStrokes, TaperThinsOpenStrokesToTheirEnds) {
 
 }  // namespace
 }  // namespace toonray
+
+namespace toonray {
+namespace {
+
+TEST(StyledStrokes, WidthByDepthThinsFartherPoints) {
+    ink::StrokePen pen{true, 4.0f, Vec3f{0.0f}, 1.0f, {}, 0.0f};
+    pen.depth_reference = 10.0f;
+    ink::Stroke s = line(24.0f, 0);
+    s.depth = {10.0f, 20.0f};  // full width at the start, half at the end
+    ImageF coverage;
+    Image<std::uint16_t> style;
+    ink::draw_styled_strokes(std::vector<ink::Stroke>{s}, std::vector<ink::StrokePen>{pen}, 64, 48,
+                             coverage, style, 1);
+    auto across = [&](int x) {
+        float sum = 0;
+        for (int y = 0; y < 48; ++y) sum += coverage(x, y);
+        return sum;
+    };
+    // The nearest centreline point of pixel x is at t = (x + 0.5 - 4) / 56 along the line.
+    for (int x : {8, 20, 32, 44, 56}) {
+        const float t = (x + 0.5f - 4.0f) / 56.0f;
+        const float depth = 10.0f + 10.0f * t;
+        EXPECT_NEAR(across(x), 4.0f * 10.0f / depth, 0.02f) << x;
+    }
+    const ink::LineStyleSet set = ink::parse_line_styles("match width_by_depth=yes\n", "s");
+    EXPECT_TRUE(
+        ink::resolve_line_style(set, ink::LineStyle{}, "a", "b", EdgeType::Crease, true).by_depth);
+}
+
+}  // namespace
+}  // namespace toonray

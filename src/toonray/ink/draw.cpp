@@ -17,23 +17,38 @@ struct Segment2 {
     float reach;         // half the thickness + 0.5: coverage is reach - distance
     std::uint16_t style;
     float arc0 = 0;                  // arc length of the stroke at a (dashes, taper)
-    const StrokePen* pen = nullptr;  // set for dashed or tapered strokes only
+    const StrokePen* pen = nullptr;  // set for dashed, tapered or depth-scaled strokes only
     float stroke_length = 0;
+    float d0 = 0, d1 = 0;  // depths at a and b (width by depth)
 };
+
+constexpr float kMinDepthScale = 0.25f, kMaxDepthScale = 2.0f;
+
+float depth_scale(const StrokePen& pen, float depth) {
+    return depth > 0.0f ? std::clamp(pen.depth_reference / depth, kMinDepthScale, kMaxDepthScale)
+                        : kMaxDepthScale;
+}
 
 // Every segment of every stroke with the pixels it can reach.
 void add_stroke_segments(const Stroke& s, float thickness, std::uint16_t style,
                          const StrokePen* pen, int w, int h, std::vector<Segment2>& out) {
     const float reach = thickness * 0.5f + 0.5f;
     const float total = pen ? polyline_length(s.points) : 0.0f;
+    const bool by_depth = pen && pen->depth_reference > 0.0f && s.depth.size() == s.points.size();
     float arc = 0.0f;
     for (std::size_t i = 0; i + 1 < s.points.size(); ++i) {
         const Point2 a = s.points[i], b = s.points[i + 1];
         const float arc0 = arc;
+        const float d0 = by_depth ? s.depth[i] : 0.0f, d1 = by_depth ? s.depth[i + 1] : 0.0f;
+        // The widest the segment gets (the scale is monotonic in depth, so at an end).
+        const float box_reach =
+            by_depth
+                ? thickness * 0.5f * std::max(depth_scale(*pen, d0), depth_scale(*pen, d1)) + 0.5f
+                : reach;
         if (pen) arc += polyline_length(std::span<const Point2>(&s.points[i], 2));
         // Pixel x has its centre at x + 0.5; it can be covered if within reach of the box.
-        const float lx = std::min(a.x, b.x) - reach, hx = std::max(a.x, b.x) + reach;
-        const float ly = std::min(a.y, b.y) - reach, hy = std::max(a.y, b.y) + reach;
+        const float lx = std::min(a.x, b.x) - box_reach, hx = std::max(a.x, b.x) + box_reach;
+        const float ly = std::min(a.y, b.y) - box_reach, hy = std::max(a.y, b.y) + box_reach;
         if (!(hx >= 0.5f && lx <= w - 0.5f && hy >= 0.5f && ly <= h - 0.5f)) continue;  // also NaN
         Segment2 seg{a,
                      b,
@@ -44,8 +59,10 @@ void add_stroke_segments(const Stroke& s, float thickness, std::uint16_t style,
                      reach,
                      style,
                      arc0,
-                     pen,
-                     total};
+                     by_depth || (pen && (!pen->dash.empty() || pen->taper > 0.0f)) ? pen : nullptr,
+                     s.closed ? -1.0f : total,  // closed strokes have no ends to taper
+                     d0,
+                     d1};
         if (seg.x0 <= seg.x1 && seg.y0 <= seg.y1) out.push_back(seg);
     }
 }
@@ -94,11 +111,14 @@ void rasterise(const std::vector<Segment2>& segments, ImageF& coverage, Image<st
                         if (s.pen) {
                             const float arc = s.arc0 + t * len;
                             if (!s.pen->dash.empty() && !in_dash(s.pen->dash, arc)) continue;
-                            if (s.pen->taper > 0.0f) {
+                            float f = 1.0f;
+                            if (s.pen->taper > 0.0f && s.stroke_length >= 0.0f) {
                                 const float end = std::min(arc, s.stroke_length - arc);
-                                const float f = std::clamp(end / s.pen->taper, 0.0f, 1.0f);
-                                reach = (s.reach - 0.5f) * f + 0.5f;
+                                f = std::clamp(end / s.pen->taper, 0.0f, 1.0f);
                             }
+                            if (s.pen->depth_reference > 0.0f && s.d0 > 0.0f)
+                                f *= depth_scale(*s.pen, s.d0 + (s.d1 - s.d0) * t);
+                            reach = (s.reach - 0.5f) * f + 0.5f;
                         }
                         const float c = std::min(1.0f, reach - std::sqrt(ex * ex + ey * ey));
                         if (c > row[x]) {
@@ -143,7 +163,8 @@ void draw_styled_strokes(std::span<const Stroke> strokes, std::span<const Stroke
         if (s.style >= pens.size()) continue;
         const StrokePen& pen = pens[s.style];
         if (!pen.draw || !(pen.thickness > 0.0f) || !(pen.opacity > 0.0f)) continue;
-        const bool shaped = !pen.dash.empty() || (pen.taper > 0.0f && !s.closed);
+        const bool shaped = !pen.dash.empty() || (pen.taper > 0.0f && !s.closed) ||
+                            (pen.depth_reference > 0.0f && s.depth.size() == s.points.size());
         add_stroke_segments(s, pen.thickness, s.style, shaped ? &pen : nullptr, width, height,
                             segments);
     }

@@ -34,6 +34,10 @@ struct StrokePen {
     /// Open strokes grow from zero thickness at their ends to full thickness over this many
     /// pixels along the stroke; 0: no taper.
     float taper = 0.0f;
+    /// Width by depth: when > 0 (and strokes have Stroke::depth), the thickness at a point at
+    /// distance d from the eye is scaled by clamp(depth_reference / d, 0.25, 2), d interpolated
+    /// linearly along each segment on the image.
+    float depth_reference = 0.0f;
 };
 
 /// Draws each stroke with pens[stroke.style] (strokes whose pen does not draw are skipped)

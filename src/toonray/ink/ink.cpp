@@ -24,6 +24,7 @@ std::vector<SegmentStyles> resolve_segment_styles(const Scene& scene,
     base.colour = settings.colour;
     base.width = settings.width;
     base.taper = settings.taper;
+    base.by_depth = settings.width_by_depth;
     LineStyle hidden = base;
     hidden.draw = false;
     styles = {base, hidden};
@@ -94,6 +95,9 @@ void draw_ink_lines(const Scene& scene, const TriangleAccel& accel, const Camera
     start = std::chrono::steady_clock::now();
     const std::vector<SegmentStyles> segment_styles =
         resolve_segment_styles(scene, out.segments, settings, out.styles);
+    bool by_depth = false;
+    for (const LineStyle& style : out.styles) by_depth = by_depth || style.by_depth;
+    if (by_depth) chain.eye = plane.eye;
     out.strokes = chain_pieces(out.pieces, chain, segment_styles);
     out.timings.chaining = seconds_since(start);
 
@@ -104,6 +108,10 @@ void draw_ink_lines(const Scene& scene, const TriangleAccel& accel, const Camera
                       style.colour, style.opacity,
                       style.dash,   stroke_thickness(style.taper, height)};
         for (float& d : pen.dash) d = stroke_thickness(d, height);
+        if (style.by_depth) {
+            const BBox bounds = scene.bounds();
+            pen.depth_reference = length((bounds.lo + bounds.hi) * 0.5f - plane.eye);
+        }
         out.pens.push_back(std::move(pen));
     }
     draw_styled_strokes(out.strokes, out.pens, width, height, out.coverage, out.style, threads);

@@ -24,6 +24,9 @@ struct InkSettings {
     float width = 2.0f;  ///< line width in pixels at 720 lines; scales with the image height
     Vec3f colour{0.0f};  ///< line colour where no style says otherwise
     float taper = 0.0f;  ///< default taper at open stroke ends, pixels at 720 lines (LineStyle)
+    /// Default width by depth: full width at the distance from the eye to the centre of the
+    /// scene's bounds, scaled by that distance over the point's, within [0.25, 2].
+    bool width_by_depth = false;
     /// Line sets: which strokes are drawn and how (line_style.h). Without rules visible lines
     /// are drawn with width and colour, hidden ones are not drawn.
     LineStyleSet styles;

@@ -144,6 +144,8 @@ LineStyleRule parse_rule(std::string_view body, const LineContext& at) {
             rule.match_hidden = value != "visible";
         } else if (key == "draw") {
             rule.draw = parse_yes_no(value, key, at);
+        } else if (key == "width_by_depth") {
+            rule.by_depth = parse_yes_no(value, key, at);
         } else if (key == "color" || key == "colour") {
             try {
                 rule.colour = parse_colour(value, key);
@@ -170,7 +172,7 @@ LineStyleRule parse_rule(std::string_view body, const LineContext& at) {
         } else {
             at.fail(
                 fmt::format("unknown key '{}' (object, material, type, lines, draw, color, "
-                            "width, opacity, dash, taper)",
+                            "width, opacity, dash, taper, width_by_depth)",
                             key));
         }
     }
@@ -229,6 +231,7 @@ LineStyle resolve_line_style(const LineStyleSet& set, const LineStyle& base,
         if (rule.opacity) style.opacity = *rule.opacity;
         if (rule.dash) style.dash = *rule.dash;
         if (rule.taper) style.taper = *rule.taper;
+        if (rule.by_depth) style.by_depth = *rule.by_depth;
     }
     return style;
 }

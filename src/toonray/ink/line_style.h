@@ -12,7 +12,7 @@
 /// when not given, so hidden lines are only styled, and drawn, where a rule says so). Attributes: draw (yes/no), color or colour (#rrggbb or
 /// r,g,b in [0, 1]), width (pixels at 720 lines), opacity ([0, 1]), dash (lengths in
 /// pixels at 720 lines, on,off,... or `none`), taper (pixels at 720 lines along the stroke over which open strokes
-/// thin to nothing at their ends; 0 = none). Every rule whose matchers all match a stroke applies in file order,
+/// thin to nothing at their ends; 0 = none), width_by_depth (yes/no). Every rule whose matchers all match a stroke applies in file order,
 /// each attribute it sets overriding the earlier value of that attribute only.
 
 #include <cstdint>
@@ -34,7 +34,8 @@ struct LineStyle {
     float opacity = 1.0f;  ///< in [0, 1]
     /// Dash pattern in pixels along the stroke: on, off, on, off, ...; empty = solid.
     std::vector<float> dash;
-    float taper = 0.0f;  ///< pixels at 720 lines over which open strokes thin to 0 at their ends
+    float taper = 0.0f;     ///< pixels at 720 lines over which open strokes thin to 0 at their ends
+    bool by_depth = false;  ///< width scaled by depth (draw.h, StrokePen::depth_reference)
     bool operator==(const LineStyle&) const = default;
 };
 
@@ -43,7 +44,7 @@ struct LineStyleRule {
     std::vector<std::string> objects{"*"}, materials{"*"};  ///< globs, any may match
     unsigned types = (1u << kEdgeTypeCount) - 1;      ///< bit (1 << EdgeType) per matched type
     bool match_visible = true, match_hidden = false;  ///< `lines=`: visible by default
-    std::optional<bool> draw;
+    std::optional<bool> draw, by_depth;
     std::optional<Vec3f> colour;
     std::optional<float> width, opacity, taper;
     std::optional<std::vector<float>> dash;

@@ -4,6 +4,7 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -17,6 +18,9 @@ struct Stroke {
     std::vector<Point2> points;  ///< on the image, in pixels; at least two
     bool closed = false;         ///< the last point is the first (a loop)
     std::uint16_t style = 0;     ///< index into the frame's resolved line styles (ink.h)
+    /// Per point, its distance from the eye (world units) when ChainSettings::eye is set,
+    /// else empty: for widths by depth.
+    std::vector<float> depth;
 };
 
 /// Per segment, the style index of its visible pieces [0] and of its hidden pieces [1].
@@ -37,6 +41,8 @@ struct ChainSettings {
     /// Visible strokes shorter than this (pixels, along the polyline) are dropped; 0 keeps all.
     float min_length = 0.0f;
     bool hidden = false;  ///< also chain the hidden pieces (into strokes with visible = false)
+    /// When set, strokes keep each point's distance from this eye (Stroke::depth).
+    std::optional<Vec3f> eye;
 };
 
 /// Chains pieces into strokes. The rule: pieces chain when they have the same type and the

@@ -94,6 +94,7 @@ ink::InkSettings ink_settings(const RenderSettings& settings) {
     s.width = settings.lines.width;
     s.colour = settings.lines.colour;
     s.taper = settings.line_taper;
+    s.width_by_depth = settings.line_width_by_depth;
     s.styles = settings.line_styles;
     s.chain.hidden = settings.hidden_lines;
     return s;

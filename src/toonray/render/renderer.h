@@ -47,6 +47,7 @@ struct RenderSettings {
     /// Ink: line sets and styles (ink/line_style.h); hidden lines are drawn where a rule says.
     ink::LineStyleSet line_styles;
     float line_taper = 0.0f;  ///< ink: default taper at open stroke ends, pixels at 720 lines
+    bool line_width_by_depth = false;  ///< ink: default width by depth (ink::InkSettings)
 };
 
 /// Sub-samples per pixel side for a sample count: 1, 4, 9, 16 -> 1, 2, 3, 4. Throws Error
