@@ -2,18 +2,20 @@
 /// Line sets and styles for ink lines: rules that match strokes by object, material, line type
 /// and visibility, and set how they are drawn (docs/ink.md, "Line styles").
 ///
-/// The text format, one rule a line, '#' starts a comment:
+/// The text format: one rule a line (it must start with `match`); '#' at the start of a line
+/// or after a blank starts a comment:
 ///
 ///     match object=w*,b* material=* type=crease,silhouette lines=hidden  draw=yes
 ///           color=#808080 width=1.0 opacity=0.5 dash=4,2
 ///
-/// Matchers: object, material (comma-separated globs with * and ?), type (line types or `all`),
-/// lines (visible, hidden or all; visible
-/// when not given, so hidden lines are only styled, and drawn, where a rule says so). Attributes: draw (yes/no), color or colour (#rrggbb or
-/// r,g,b in [0, 1]), width (pixels at 720 lines), opacity ([0, 1]), dash (lengths in
-/// pixels at 720 lines, on,off,... or `none`), taper (pixels at 720 lines along the stroke over which open strokes
-/// thin to nothing at their ends; 0 = none), width_by_depth (yes/no). Every rule whose matchers all match a stroke applies in file order,
-/// each attribute it sets overriding the earlier value of that attribute only.
+/// Matchers: object, material (comma-separated globs with * and ?), type (line types or
+/// `all`), lines (visible, hidden or all; visible when not given, so hidden lines are styled,
+/// and drawn, only where a rule says so). Attributes: draw (yes/no), color or colour (#rrggbb
+/// or r,g,b in [0, 1]), width (pixels at 720 lines), opacity ([0, 1]), dash (lengths in pixels
+/// at 720 lines, on,off,... or `none`), taper (pixels at 720 lines along the stroke over which
+/// open strokes thin to nothing at their ends; 0 = none), width_by_depth (yes/no). Every rule
+/// whose matchers all match a stroke applies in file order, each attribute it sets overriding
+/// the earlier value of that attribute only.
 
 #include <cstdint>
 #include <optional>
