@@ -86,8 +86,11 @@ void draw_ink_lines(const Scene& scene, const TriangleAccel& accel, const Camera
     start = std::chrono::steady_clock::now();
     ChainSettings chain = settings.chain;
     chain.hidden = chain.hidden || settings.styles.draws_hidden();
+    // Styles only need hidden from visible; how deep a line is hidden is counted for the SVG's
+    // hidden layer (settings.chain.hidden) only.
     VisibilitySettings visibility = settings.visibility;
-    if (!chain.hidden) visibility.max_invisibility = std::min(visibility.max_invisibility, 1);
+    if (!settings.chain.hidden)
+        visibility.max_invisibility = std::min(visibility.max_invisibility, 1);
     out.pieces = split_by_visibility(out.segments, VisibilityContext{scene, out.mesh, accel, view},
                                      visibility, threads);
     out.timings.visibility = seconds_since(start);
