@@ -20,6 +20,7 @@ struct BatchArgs {
     RenderArgs render;
     GltfArgs gltf;
     SceneArgs scene;
+    SvgArgs svg;
 
     void add_to(CLI::App& app) {
         app.add_option("name", name,
@@ -64,6 +65,7 @@ int run_batch(const BatchArgs& args, const CLI::App& command) {
     if (!args.output_pattern.empty()) options.output_pattern = args.output_pattern;
     options.render = args.render.resolve();
     options.auto_smooth = args.scene.auto_smooth_angle();
+    args.svg.apply(options.render, true);
     options.jobs = args.jobs;
     options.resume = args.resume;
     options.fail_fast = args.fail_fast;
@@ -95,6 +97,7 @@ Subcommand add_batch_command(CLI::App& app, LimitArgs& limit_args) {
     args->render.add_to(*batch);
     args->gltf.add_to(*batch, false);
     args->scene.add_to(*batch);
+    args->svg.add_to(*batch, true);
     limit_args.add_to(*batch);
     return {batch, [args, batch] { return run_batch(*args, *batch); }};
 }

@@ -36,6 +36,7 @@ private:
 struct DemoArgs {
     PianoArgs piano;
     RenderArgs render;
+    SvgArgs svg;
     std::string output = "out";
     bool full = false;
 };
@@ -50,6 +51,7 @@ int run_demo(const DemoArgs& args, const CLI::App& command) {
     options.seconds = args.full ? std::optional<double>() : std::optional<double>(piano.seconds);
     options.soundfont = piano.soundfont;
     options.movie.render = args.render.resolve();
+    args.svg.apply(options.movie.render, true);
     options.movie.start = piano.start;
     options.movie.fps = piano.fps;
     options.movie.jobs = piano.jobs;
@@ -94,6 +96,7 @@ Subcommand add_demo_command(CLI::App& app, LimitArgs& limit_args) {
     demo->add_option("--score", demo_args.score, "Play another score (MIDI or note script)");
     demo_args.add_common(*demo);
     args->render.add_to(*demo);
+    args->svg.add_to(*demo, true);
     limit_args.add_to(*demo);
     return {demo, [args, demo] { return run_demo(*args, *demo); }};
 }

@@ -17,6 +17,7 @@ namespace {
 struct PianoCommandArgs {
     PianoArgs piano;
     RenderArgs render;
+    SvgArgs svg;
     std::string output;
 };
 
@@ -55,6 +56,7 @@ int run_piano(const PianoCommandArgs& args, const CLI::App& command) {
     if (!piano.export_obj.empty()) options.export_obj_dir = piano.export_obj;
     if (piano.seconds > 0) options.seconds = piano.seconds;
     options.render = args.render.resolve();
+    args.svg.apply(options.render, true);
     std::optional<AudioOptions> audio_opts;  // checked before the frames are rendered
     if (!piano.audio.empty()) audio_opts = audio_options(score, piano, options.seconds);
     PianoMovieReport report = run_piano_movie(score, piano, options, command);
@@ -92,6 +94,7 @@ Subcommand add_piano_command(CLI::App& app, LimitArgs& limit_args) {
                       "Also write the soundtrack of the same stretch to this WAV");
     piano_args.add_common(*piano);
     args->render.add_to(*piano);
+    args->svg.add_to(*piano, true);
     limit_args.add_to(*piano);
     return {piano, [args, piano] { return run_piano(*args, *piano); }};
 }

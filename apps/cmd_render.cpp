@@ -20,8 +20,8 @@ namespace {
 struct RenderCommandArgs {
     RenderArgs render;
     SceneArgs scene;
-    std::string input, output, svg;
-    bool svg_hidden = false;
+    std::string input, output;
+    SvgArgs svg;
     GltfArgs gltf;
 };
 
@@ -46,13 +46,7 @@ void render_gltf(const RenderCommandArgs& args, const FrameOptions& options, War
 
 int run_render(const RenderCommandArgs& args) {
     FrameOptions options = args.render.resolve();
-    if (!args.svg.empty()) {
-        if (options.settings.edges != EdgeMode::Ink) throw Error("--svg needs --edges ink");
-        options.svg = args.svg;
-        options.svg_hidden = args.svg_hidden;
-    } else if (args.svg_hidden) {
-        throw Error("--svg-hidden needs --svg");
-    }
+    args.svg.apply(options, false);
     {  // The frame buffers come first: the loader counts them in its memory estimate.
         Limits l = limits();
         l.reserved_memory = plan_frame_jobs(options, 1, 1).frame_bytes;
@@ -90,12 +84,7 @@ Subcommand add_render_command(CLI::App& app, LimitArgs& limit_args) {
     render->add_option("-o,--output", args->output, "Output PNG file")->required();
     args->render.add_to(*render);
     args->scene.add_to(*render);
-    render->add_option(
-        "--svg", args->svg,
-        "With --edges ink: also write the visible lines as SVG paths in pixel units, "
-        "grouped by type (silhouette, border, crease, material, intersection)");
-    render->add_flag("--svg-hidden", args->svg_hidden,
-                     "With --svg: also write the hidden lines, in a layer of their own");
+    args->svg.add_to(*render, false);
     args->gltf.add_to(*render, true);
     limit_args.add_to(*render);
     return {render, [args] { return run_render(*args); }};

@@ -10,6 +10,8 @@
 #include "toonray/core/limits.h"
 #include "toonray/core/parse.h"
 #include "toonray/frame/lights.h"
+#include "toonray/ink/line_style.h"
+#include "toonray/io/file.h"
 #include "toonray/score/score_io.h"
 
 namespace toonray::cli {
@@ -102,6 +104,30 @@ void RenderArgs::add_to(CLI::App& app) {
     app.add_option("--png-level", png_level, "PNG compression level, 1 (fast) to 12 (small)")
         ->check(CLI::Range(1, 12))
         ->capture_default_str();
+    add_ink_style_options(app);
+}
+
+void RenderArgs::add_ink_style_options(CLI::App& app) {
+    app.add_option("--line-style", line_style,
+                   "Ink: line sets and styles file (docs/ink.md): rules matching objects, "
+                   "materials, line types and visible/hidden lines, setting draw, color, width, "
+                   "opacity, dash and taper")
+        ->check(CLI::ExistingFile);
+    app.add_option("--line-taper", line_taper,
+                   "Ink: open strokes thin to nothing at their ends over this many pixels at 720 "
+                   "lines (0 = off); a style's taper overrides it")
+        ->check(CLI::Range(0.0f, 1000.0f))
+        ->capture_default_str();
+    app.add_flag("--line-width-by-depth", line_width_by_depth,
+                 "Ink: lines thinner farther away: full width at the distance of the scene's "
+                 "centre, scaled by it over the line's distance, within 0.25x-2x");
+}
+
+void RenderArgs::resolve_ink_style(FrameOptions& options) const {
+    options.settings.line_taper = line_taper;
+    options.settings.line_width_by_depth = line_width_by_depth;
+    if (!line_style.empty())
+        options.settings.line_styles = ink::parse_line_styles(read_file(line_style), line_style);
 }
 
 FrameOptions RenderArgs::resolve() const {
@@ -140,6 +166,7 @@ FrameOptions RenderArgs::resolve() const {
     o.png.level = png_level;
     if (!aov_dir.empty()) o.aov_dir = aov_dir;
     if (!aov_exr.empty()) o.aov_exr = aov_exr;
+    resolve_ink_style(o);
     return o;
 }
 
@@ -153,6 +180,32 @@ void SceneArgs::add_to(CLI::App& app) {
 
 std::optional<float> SceneArgs::auto_smooth_angle() const {
     return auto_smooth >= 0.0f ? std::optional<float>(auto_smooth) : std::nullopt;
+}
+
+void SvgArgs::add_to(CLI::App& app, bool per_frame) {
+    app.add_option("--svg", svg,
+                   per_frame
+                       ? "Also write each frame's ink lines as SVG into this directory, named "
+                         "like its PNG (NAME_000030.svg), in any --edges mode; resumable like PNGs"
+                       : "Also write the ink lines as SVG paths in pixel units, grouped by type "
+                         "(silhouette, border, crease, material, intersection), in any --edges "
+                         "mode");
+    app.add_flag("--hidden-lines,--svg-hidden", hidden,
+                 "With --svg: also write the hidden lines, in a layer of their own");
+    app.add_flag("--svg-fill", fill,
+                 "With --svg: the cel-shaded colours as an embedded PNG under the lines");
+}
+
+void SvgArgs::apply(FrameOptions& options, bool per_frame) const {
+    if (svg.empty()) {
+        if (hidden) throw Error("--hidden-lines needs --svg");
+        if (fill) throw Error("--svg-fill needs --svg");
+        return;
+    }
+    if (per_frame) options.svg_dir = svg;
+    else options.svg = svg;
+    options.svg_hidden = hidden;
+    options.svg_fill = fill;
 }
 
 void LimitArgs::add_to(CLI::App& app) {

@@ -39,9 +39,29 @@ struct RenderArgs {
     int png_level = PngOptions{}.level;
     std::string aov_dir;
     std::string aov_exr;
+    // Ink line styles (add_ink_style_options).
+    std::string line_style;
+    float line_taper = 0.0f;
+    bool line_width_by_depth = false;
 
     void add_to(CLI::App& app);
     [[nodiscard]] FrameOptions resolve() const;
+
+private:
+    void add_ink_style_options(CLI::App& app);
+    void resolve_ink_style(FrameOptions& options) const;
+};
+
+/// Vector output of the ink lines: `--svg FILE` (render) or `--svg DIR` (one SVG per frame,
+/// named like its PNG), `--hidden-lines` (alias `--svg-hidden`), `--svg-fill`.
+struct SvgArgs {
+    std::string svg;
+    bool hidden = false, fill = false;
+
+    void add_to(CLI::App& app, bool per_frame);
+    /// Sets options.svg (or svg_dir), svg_hidden, svg_fill; Error for --hidden-lines or
+    /// --svg-fill without --svg.
+    void apply(FrameOptions& options, bool per_frame) const;
 };
 
 /// Options of render and batch that change the scene as loaded.

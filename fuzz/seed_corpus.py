@@ -126,6 +126,15 @@ for name, v in shading.items():
     put("shading", name, v)
 
 
+# --- line style files ---
+put("line_style", "piano_keys.style", read("docs", "examples", "piano_keys.style"))
+put("line_style", "all_keys.style",
+    "# every key\nmatch object=* material=* type=all lines=all draw=no\n"
+    "match type=crease,silhouette,border,material,intersection lines=visible draw=yes colour=0.5,0.25,1 "
+    "width=0 opacity=1 dash=none taper=0\nmatch object=a?c*,d lines=hidden dash=1,2,3 color=#ff00ff\n")
+put("line_style", "bad.style", "match width=-1\n")
+
+
 # --- PNG ---
 def png(width, height, colour_type, rows):
     raw = b"".join(b"\0" + r for r in rows)

@@ -54,6 +54,26 @@ TEST(BatchCli, RendersASequenceAndReportsFailuresWithExitCode) {
     EXPECT_EQ(count_files(dir / "png", ".png"), 3);
 }
 
+TEST(BatchCli, SvgPerFrameNamedLikeItsPngAndResumable) {
+    TempDir dir("cli_batch_svg");
+    write_frames(dir, 3);
+    const std::string command = "batch keys 1 3 --input " + (dir / "in").string() + " --output " +
+                                (dir / "png").string() + " --svg " + (dir / "svg").string() +
+                                " --size 96x54";
+    CommandResult r = run_toonray(command + " --quiet");
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_EQ(count_files(dir / "svg", ".svg"), 3);
+    for (const char* name : {"keys_000001.svg", "keys_000002.svg", "keys_000003.svg"})
+        EXPECT_TRUE(fs::exists(dir / "svg" / name)) << name;
+    // A frame counts as done only with both its PNG and its SVG: resume renders just frame 2.
+    fs::remove(dir / "svg" / "keys_000002.svg");
+    r = run_toonray(command + " --resume");
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_NE(r.output.find("1 rendered, 2 skipped, 0 failed of 3 frames"), std::string::npos)
+        << r.output;
+    EXPECT_TRUE(fs::exists(dir / "svg" / "keys_000002.svg"));
+}
+
 TEST(BatchCli, ShardsTogetherRenderEveryFrameOnce) {
     TempDir dir("cli_shard");
     write_frames(dir, 7);

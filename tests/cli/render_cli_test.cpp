@@ -5,9 +5,11 @@
 
 #include "cli/cli_test_util.h"
 #include "toonray/core/image.h"
+#include "toonray/io/file.h"
 #include "toonray/io/png.h"
 
 namespace fs = std::filesystem;
+using toonray::read_file;
 using toonray::read_png;
 
 namespace {
@@ -151,11 +153,51 @@ TEST(RenderCli, InkLinesWithSvg) {
     EXPECT_TRUE(fs::exists(dir / "t.svg"));
     EXPECT_TRUE(fs::exists(dir / "aov" / "t_edges.png"));
     EXPECT_FALSE(fs::exists(dir / "aov" / "t_lines_depth.png"));
-    // An SVG needs the ink lines; the message names the flags.
+    // Any line mode writes the ink lines' SVG; --hidden-lines is the option's other name.
     r = run_toonray("render " + kData + "/teapot.obj -o " + (dir / "u.png").string() +
-                    " --edges robust --svg " + (dir / "u.svg").string());
+                    " --size 320x180 --edges classic --hidden-lines --svg " +
+                    (dir / "u.svg").string());
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_NE(read_file(dir / "u.svg").find("<g id=\"hidden\""), std::string::npos);
+    r = run_toonray("render " + kData + "/teapot.obj -o " + (dir / "v.png").string() +
+                    " --hidden-lines");
     EXPECT_EQ(r.exit_code, 1);
-    EXPECT_NE(r.output.find("--svg needs --edges ink"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("--hidden-lines needs --svg"), std::string::npos) << r.output;
+    EXPECT_FALSE(fs::exists(dir / "v.png"));
+}
+
+TEST(RenderCli, LineStyles) {
+    TempDir dir("cli_line_style");
+    dir.write("dashed.style",
+              "# every line red and dashed, hidden ones too\n"
+              "match lines=all draw=yes color=#ff0000 dash=6,4 opacity=0.5\n");
+    CommandResult r =
+        run_toonray("render " + kData + "/teapot.obj -o " + (dir / "t.png").string() +
+                    " --size 320x180 --edges ink --line-style " + (dir / "dashed.style").string() +
+                    " --svg " + (dir / "t.svg").string() + " --hidden-lines");
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    const std::string svg = read_file(dir / "t.svg");
+    EXPECT_NE(
+        svg.find("stroke=\"#ff0000\" stroke-opacity=\"0.500\" stroke-dasharray=\"1.500,1.000\""),
+        std::string::npos);
+    // The lines are red now, never black.
+    const auto png = read_png(dir / "t.png");
+    int red = 0, black = 0;
+    for (int y = 0; y < png.height; ++y)
+        for (int x = 0; x < png.width; ++x) {
+            const auto c = png.rgb(x, y);
+            red += c[0] > 200 && c[1] < 190 && c[2] < 190;
+            black += c[0] < 40 && c[1] < 40 && c[2] < 40;
+        }
+    EXPECT_GT(red, 200);
+    EXPECT_EQ(black, 0);
+    // A bad rule names the file and line; nothing is written.
+    dir.write("bad.style", "match color=#ff0000\nmatch width=wide\n");
+    r = run_toonray("render " + kData + "/teapot.obj -o " + (dir / "u.png").string() +
+                    " --edges ink --line-style " + (dir / "bad.style").string());
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_NE(r.output.find("bad.style:2: width: expected a number, got 'wide'"), std::string::npos)
+        << r.output;
     EXPECT_FALSE(fs::exists(dir / "u.png"));
 }
 

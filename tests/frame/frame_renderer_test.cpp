@@ -84,10 +84,12 @@ TEST(FrameRenderer, WritesTheInkStrokesAsSvg) {
     o.svg = dir.path / "frame.svg";
     FrameRenderer fr;
     Warnings w;
-    // Only the ink lines have strokes: asked of another mode, nothing is written.
-    EXPECT_THROW(fr.render(teapot, choose_camera(teapot, o), dir.path / "frame.png", o, w), Error);
-    EXPECT_FALSE(fs::exists(dir.path / "frame.png"));
-    EXPECT_FALSE(fs::exists(dir.path / "frame.svg"));
+    // Another line mode runs the ink stages for the SVG only: the same drawing as in ink mode.
+    fr.render(teapot, choose_camera(teapot, o), dir.path / "frame.png", o, w);
+    const std::string robust = read_file(dir.path / "frame.svg");
+    o.settings.edges = EdgeMode::Ink;
+    fr.render(teapot, choose_camera(teapot, o), dir.path / "frame.png", o, w);
+    EXPECT_EQ(read_file(dir.path / "frame.svg"), robust);
     o.settings.edges = EdgeMode::Ink;
     for (bool hidden : {false, true}) {
         o.svg_hidden = hidden;
@@ -98,6 +100,34 @@ TEST(FrameRenderer, WritesTheInkStrokesAsSvg) {
         EXPECT_EQ(svg.find("<g id=\"hidden\"") != std::string::npos, hidden);
         EXPECT_NE(svg.find("<path d=\"M"), std::string::npos);
     }
+    // With the fill, the cel picture is embedded under the lines.
+    o.svg_fill = true;
+    fr.render(teapot, choose_camera(teapot, o), dir.path / "frame.png", o, w);
+    const std::string filled = read_file(dir.path / "frame.svg");
+    const std::size_t image = filled.find("<image id=\"fill\"");
+    ASSERT_NE(image, std::string::npos);
+    EXPECT_LT(image, filled.find("<g id=\"visible\""));
+    EXPECT_NE(filled.find("xlink:href=\"data:image/png;base64,iVBORw0KGgo"), std::string::npos);
+}
+
+TEST(FrameRenderer, SvgDirectoryNamesFilesLikeThePngAndResumeNeedsBoth) {
+    test_support::TempDir dir("frame_svg_dir");
+    const Scene teapot = load("teapot.obj");
+    FrameOptions o;
+    o.settings.width = 96;
+    o.settings.height = 54;
+    o.settings.edges = EdgeMode::Classic;
+    o.svg_dir = dir.path / "svg";
+    EXPECT_EQ(o.svg_path(dir.path / "keys_000030.png"), dir.path / "svg" / "keys_000030.svg");
+    FrameRenderer fr;
+    Warnings w;
+    EXPECT_FALSE(frame_complete(dir.path / "keys_000030.png", o));
+    fr.render(teapot, choose_camera(teapot, o), dir.path / "keys_000030.png", o, w);
+    EXPECT_TRUE(frame_complete(dir.path / "keys_000030.png", o));
+    fs::remove(dir.path / "svg" / "keys_000030.svg");
+    EXPECT_FALSE(frame_complete(dir.path / "keys_000030.png", o));
+    dir.write("svg/keys_000030.svg", "<svg>");  // cut short
+    EXPECT_FALSE(frame_complete(dir.path / "keys_000030.png", o));
 }
 
 TEST(FrameRenderer, ABadCameraWritesNothing) {

@@ -1,7 +1,10 @@
 """Parses an SVG written by toonray's ink lines with xml.etree and checks its structure.
 
-Usage: check_svg.py FILE WIDTH HEIGHT HIDDEN(0|1) MIN_PATHS
-Exits 0 when the file is well-formed XML with the expected groups and enough paths.
+Usage: check_svg.py FILE WIDTH HEIGHT HIDDEN(0|1) MIN_PATHS [MIN_DASHED_HIDDEN]
+Exits 0 when the file is well-formed XML with the expected groups and enough paths, every
+path's own style attributes (stroke, stroke-width, stroke-opacity, stroke-dasharray) are
+well-formed, an embedded fill image (if any) is a PNG data URI under the lines, and at least
+MIN_DASHED_HIDDEN paths of the hidden layer are dashed.
 """
 import re
 import sys
@@ -27,6 +30,16 @@ def main():
     expected = ["visible", "hidden"] if hidden else ["visible"]
     if layers != expected:
         fail(f"layers {layers}")
+    min_dashed_hidden = int(sys.argv[6]) if len(sys.argv) > 6 else 0
+    images = root.findall(SVG + "image")
+    for image in images:
+        href = image.get("{http://www.w3.org/1999/xlink}href") or ""
+        if image.get("id") != "fill" or not href.startswith("data:image/png;base64,iVBORw0KGgo"):
+            fail("the fill image is not an embedded PNG")
+        if list(root).index(image) != 0:
+            fail("the fill image is not under the lines")
+    number = r"\d+\.\d{3}"
+    dashed_hidden = 0
     paths = 0
     for layer in root.findall(SVG + "g"):
         if layer.get("stroke-linecap") != "round" or float(layer.get("stroke-width")) <= 0:
@@ -38,9 +51,22 @@ def main():
             d = path_element.get("d")
             if not re.fullmatch(r"M -?\d+\.\d{3} -?\d+\.\d{3}( L -?\d+\.\d{3} -?\d+\.\d{3}( -?\d+\.\d{3} -?\d+\.\d{3})*)?( Z)?", d):
                 fail(f"path data {d[:80]}")
+            checks = {"stroke": r"#[0-9a-f]{6}", "stroke-width": number, "stroke-opacity": number,
+                      "stroke-dasharray": rf"{number}(,{number})*"}
+            for name, pattern in checks.items():
+                value = path_element.get(name)
+                if value is not None and not re.fullmatch(pattern, value):
+                    fail(f"path {name}={value}")
+            opacity = path_element.get("stroke-opacity")
+            if opacity is not None and not 0.0 <= float(opacity) <= 1.0:
+                fail(f"stroke-opacity {opacity}")
+            if layer.get("id") == "hidden" and path_element.get("stroke-dasharray"):
+                dashed_hidden += 1
             paths += 1
     if paths < min_paths:
         fail(f"{paths} paths, expected at least {min_paths}")
+    if dashed_hidden < min_dashed_hidden:
+        fail(f"{dashed_hidden} dashed hidden paths, expected at least {min_dashed_hidden}")
 
 
 if __name__ == "__main__":

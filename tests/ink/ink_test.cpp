@@ -90,6 +90,52 @@ TEST(InkSvg, ParsesAsXmlWithTheLayersAndGroups) {
     EXPECT_EQ(paths, visible);
 }
 
+TEST(InkSvg, StylesGoIntoThePathsAndTheDrawing) {
+    const Teapot t(640, 360);
+    ink::InkSettings settings;
+    settings.chain.hidden = true;
+    settings.styles = ink::parse_line_styles(
+        "match lines=hidden draw=yes color=#808080 width=1 opacity=0.6 dash=4,3\n"
+        "match type=crease draw=no\n",
+        "teapot.style");
+    ink::InkLines lines;
+    ink::draw_ink_lines(t.scene, t.accel, t.camera, 640, 360, settings, 2, lines);
+    ASSERT_EQ(lines.styles.size(), 3u);  // the defaults, the dashed hidden lines, creases off
+    ASSERT_EQ(lines.pens.size(), 3u);
+    std::size_t hidden = 0, creases = 0;
+    for (const auto& s : lines.strokes) {
+        hidden += !s.visible;
+        if (s.visible && s.type == ink::EdgeType::Crease) {
+            ++creases;
+            EXPECT_FALSE(lines.pens[s.style].draw);
+        }
+        if (!s.visible) EXPECT_EQ(lines.pens[s.style].dash.size(), 2u);
+    }
+    EXPECT_GT(hidden, 10u);
+    EXPECT_GT(creases, 0u);
+    // Hidden lines are drawn now: grey pixels where only hidden strokes lie.
+    std::size_t grey = 0;
+    for (std::size_t i = 0; i < lines.coverage.size(); ++i)
+        grey += lines.coverage.data()[i] > 0.0f && lines.pens[lines.style.data()[i]].opacity < 1;
+    EXPECT_GT(grey, 100u);
+    test_support::TempDir dir("ink_svg_styles");
+    ink::SvgSettings svg;
+    svg.width = 640;
+    svg.height = 360;
+    svg.thickness = ink::stroke_thickness(settings.width, 360);
+    svg.hidden = true;
+    svg.pens = lines.pens;
+    write_svg(dir / "styled.svg", lines.strokes, svg);
+    const std::string check = std::string("python3 ") + TOONRAY_TESTS_DIR + "/ink/check_svg.py " +
+                              (dir / "styled.svg").string() + " 640 360 1 10 10";
+    EXPECT_EQ(std::system(check.c_str()), 0) << check;
+    // Visible creases are off: no path in the crease group.
+    const std::string text = ink::svg_text(lines.strokes, svg);
+    const std::size_t group = text.find("<g id=\"visible-crease\">\n");
+    ASSERT_NE(group, std::string::npos);
+    EXPECT_EQ(text.compare(group + 24, 4, "</g>"), 0);
+}
+
 // A real SVG renderer draws the file like toonray's own coverage: at least 90% of each
 // image's line pixels lie within 1.5 px of the other's.
 TEST(InkSvg, RsvgDrawsWhatToonrayDraws) {

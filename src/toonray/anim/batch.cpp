@@ -64,6 +64,9 @@ public:
     [[nodiscard]] std::filesystem::path output(int frame) const override {
         return options_.output_dir / output_pattern_.format(frame);
     }
+    [[nodiscard]] bool done(int frame) const override {
+        return frame_complete(output(frame), options_.render);
+    }
 
     std::unique_ptr<FrameJob> make_job(int jobs) override;
 
@@ -233,6 +236,12 @@ BatchReport run_batch(const BatchOptions& options, BatchObserver* observer) {
                                     options.render.aov_dir->string()));
     }
     if (options.render.aov_exr) check_exr_sequence(*options.render.aov_exr);
+    if (options.render.svg_dir) {
+        std::filesystem::create_directories(*options.render.svg_dir, ec);
+        if (ec || ::access(options.render.svg_dir->c_str(), W_OK) != 0)
+            throw Error(fmt::format("{}: SVG directory cannot be created or is not writable",
+                                    options.render.svg_dir->string()));
+    }
     std::vector<int> frames = shard_frames(options.first, options.last, options.shard);
     const FramePlan plan = plan_frame_jobs(options.render, options.jobs, frames.size());
     ScheduleOptions schedule;

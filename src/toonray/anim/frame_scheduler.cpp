@@ -42,7 +42,7 @@ private:
             const int i = next_.fetch_add(1);
             if (i >= static_cast<int>(frames_.size())) return std::nullopt;
             const int frame = frames_[i];
-            if (options_.resume && is_valid_png(source_.output(frame))) {
+            if (options_.resume && source_.done(frame)) {
                 report(frame, FrameStatus::Skipped, {}, {});
                 continue;
             }

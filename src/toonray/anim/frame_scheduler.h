@@ -73,6 +73,8 @@ public:
     virtual ~FrameSource() = default;
     /// The file `frame` writes; on resume, a frame whose file is a valid PNG is skipped.
     [[nodiscard]] virtual std::filesystem::path output(int frame) const = 0;
+    /// Whether `frame` is done already (resume): by default, its file is a valid PNG.
+    [[nodiscard]] virtual bool done(int frame) const { return is_valid_png(output(frame)); }
     /// A job's state; `jobs` run at once. Called on the job's thread.
     virtual std::unique_ptr<FrameJob> make_job(int jobs) = 0;
 };

@@ -88,6 +88,9 @@ public:
         return (options_.export_obj_dir ? *options_.export_obj_dir : options_.output_dir) /
                output_pattern_.format(frame);
     }
+    [[nodiscard]] bool done(int frame) const override {
+        return frame_complete(output(frame), options_.render);
+    }
 
     std::unique_ptr<FrameJob> make_job(int jobs) override;
 
@@ -167,6 +170,7 @@ PianoMovieReport render_piano_movie(const Score& score, const CameraPath& camera
     }
     if (options.render.aov_dir) check_directory(*options.render.aov_dir, "AOV");
     if (options.render.aov_exr) check_exr_sequence(*options.render.aov_exr);
+    if (options.render.svg_dir) check_directory(*options.render.svg_dir, "SVG");
     PianoFrames source(score, camera_path, options);
     const Scene& piano = source.scene();
     // Each job poses its own copy of the scene with its own BVH, and (unless exporting)

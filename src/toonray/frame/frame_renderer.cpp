@@ -16,23 +16,54 @@ namespace toonray {
 RenderSettings FrameOptions::render_settings() const {
     RenderSettings s = settings;
     s.feature_images = aov_dir.has_value() || aov_exr.has_value();
-    s.hidden_lines = svg.has_value() && svg_hidden;
+    s.hidden_lines = (svg.has_value() || svg_dir.has_value()) && svg_hidden;
+    s.feature_images = s.feature_images || ((svg.has_value() || svg_dir.has_value()) && svg_fill);
     return s;
+}
+
+std::optional<std::filesystem::path> FrameOptions::svg_path(
+    const std::filesystem::path& output) const {
+    if (svg) return svg;
+    if (svg_dir) return *svg_dir / (output.stem().string() + ".svg");
+    return std::nullopt;
+}
+
+bool frame_complete(const std::filesystem::path& output, const FrameOptions& options) {
+    if (!is_valid_png(output)) return false;
+    const auto svg = options.svg_path(output);
+    if (!svg) return true;
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(*svg, ec)) return false;
+    try {
+        const std::string text = read_file(*svg);
+        static constexpr std::string_view kEnd = "</svg>\n";
+        return text.size() >= kEnd.size() &&
+               text.compare(text.size() - kEnd.size(), kEnd.size(), kEnd) == 0;
+    } catch (const Error&) {
+        return false;
+    }
 }
 
 namespace {
 
-// The strokes of the last ink frame as SVG, written atomically.
-void write_svg(const Renderer& renderer, const RenderSettings& settings,
-               const FrameOptions& options) {
+// The strokes of the frame's ink lines as SVG, written atomically.
+void write_svg(const Renderer& renderer, const ink::InkLines& lines, const RenderSettings& settings,
+               const FrameOptions& options, const std::filesystem::path& path) {
     ink::SvgSettings svg;
     svg.width = settings.width;
     svg.height = settings.height;
     svg.thickness = ink::stroke_thickness(settings.lines.width, settings.height);
     svg.colour = settings.lines.colour;
     svg.hidden = options.svg_hidden;
-    const std::string text = ink::svg_text(renderer.ink_lines().strokes, svg);
-    write_file_atomic(*options.svg,
+    svg.pens = lines.pens;
+    if (options.svg_fill) {
+        const ImageRgb8& cel = renderer.aovs().cel;
+        svg.fill_href = ink::png_data_uri(
+            encode_png(cel.width(), cel.height(), 3,
+                       reinterpret_cast<const std::uint8_t*>(cel.data()), options.png));
+    }
+    const std::string text = ink::svg_text(lines.strokes, svg);
+    write_file_atomic(path,
                       std::span(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()));
 }
 
@@ -81,6 +112,14 @@ std::uint64_t frame_bytes(const FrameOptions& options) {
         pixels > UINT64_MAX / 16 ? UINT64_MAX : pixels * 3 * sizeof(Rgb8) + 1024 * 1024;
     std::uint64_t total = add_saturated(frame_buffer_bytes(settings), png);
     if (options.aov_exr) total = add_saturated(total, feature_exr_bytes(pixels));
+    if (options.svg || options.svg_dir) {
+        // The ink line layer of an SVG asked of another mode (coverage and style), and the
+        // embedded fill: its PNG and the base64 text, within twice the RGB pixels.
+        const std::uint64_t per_pixel =
+            (settings.edges != EdgeMode::Ink ? sizeof(float) + sizeof(std::uint16_t) : 0) +
+            (options.svg_fill ? 2 * sizeof(Rgb8) : 0);
+        total = add_saturated(total, pixels > UINT64_MAX / 16 ? UINT64_MAX : pixels * per_pixel);
+    }
     return add_saturated(total, total / 5);
 }
 
@@ -90,8 +129,6 @@ void FrameRenderer::render(const Scene& scene, const CameraSpec& camera,
     const RenderSettings settings = options.render_settings();
     // Validate the camera before any work so a bad one fails with nothing written.
     validate_camera(camera);
-    if (options.svg && settings.edges != EdgeMode::Ink)
-        throw Error("an SVG drawing needs the ink line mode");
     if (options.aov_exr && !exr_available())
         throw Error("EXR feature images are not available: this toonray was built without OpenEXR");
     const TriangleAccel& accel = accel_.update(scene, options.bvh);
@@ -126,7 +163,15 @@ void FrameRenderer::render(const Scene& scene, const CameraSpec& camera,
                               drawn_over ? &polyline_coverage_ : nullptr);
         write_feature_exr(path, layers_);
     }
-    if (options.svg) write_svg(renderer_, settings, options);
+    if (const auto svg_path = options.svg_path(output)) {
+        if (options.svg_dir && !options.svg) std::filesystem::create_directories(*options.svg_dir);
+        const bool ink = settings.edges == EdgeMode::Ink;
+        if (!ink)  // the lines for the SVG only
+            ink::draw_ink_lines(scene, accel, camera, settings.width, settings.height,
+                                ink_settings(settings), settings.threads, svg_lines_);
+        write_svg(renderer_, ink ? renderer_.ink_lines() : svg_lines_, settings, options,
+                  *svg_path);
+    }
     write_png(output, *image, options.png);
 }
 

@@ -22,22 +22,35 @@ namespace toonray {
 
 struct FrameOptions {
     RenderSettings
-        settings;  ///< settings.feature_images is set from aov_dir, hidden_lines from svg
+        settings;  ///< feature_images is set from aov_dir (and svg_fill), hidden_lines from svg
     std::optional<CameraSpec> camera;              ///< overrides the scene's camera block
     std::optional<std::filesystem::path> aov_dir;  ///< write the feature images here
     /// Also write the feature images as one multi-layer EXR (frame/feature_exr.h): this file
     /// when it ends in ".exr", else `<aov_exr>/<stem>.exr` for each output (exr_path).
     std::optional<std::filesystem::path> aov_exr;
-    /// Ink lines only: also write the strokes as SVG here (ink/svg.h), with hidden lines in a
-    /// layer of their own when svg_hidden.
+    /// Also write the ink strokes as SVG here (ink/svg.h), with hidden lines in a layer of
+    /// their own when svg_hidden. In modes other than ink the ink stages run for the SVG only.
     std::optional<std::filesystem::path> svg;
     bool svg_hidden = false;
+    /// Animations: one SVG per frame in this directory, named like its PNG (`NAME.svg` for
+    /// `NAME.png`); used when svg is not set.
+    std::optional<std::filesystem::path> svg_dir;
+    /// The SVG also holds the cel-shaded picture (without lines) as an embedded PNG under them.
+    bool svg_fill = false;
     Bvh::Config bvh;
     PngOptions png;
 
     /// The settings a frame is rendered with: feature images exactly when they are written.
     [[nodiscard]] RenderSettings render_settings() const;
+    /// The SVG file written with `output`, if any: svg, else svg_dir/<stem>.svg.
+    [[nodiscard]] std::optional<std::filesystem::path> svg_path(
+        const std::filesystem::path& output) const;
 };
+
+/// Whether a frame written to `output` with `options` is complete (for resume): the PNG is
+/// valid and, when an SVG is asked for, the SVG exists and ends with its closing tag (it is
+/// written atomically, so a complete file is a whole one).
+[[nodiscard]] bool frame_complete(const std::filesystem::path& output, const FrameOptions& options);
 
 /// The camera a frame uses: the override, else the scene's camera block, else an automatic one.
 CameraSpec choose_camera(const Scene& scene, const FrameOptions& options);
@@ -65,8 +78,8 @@ class FrameRenderer {
 public:
     /// Renders `scene` seen by `camera` to `output` (and, with options.aov_dir, its feature
     /// images, created if missing; with options.svg, the ink strokes). Throws Error for a bad
-    /// camera or an SVG asked of a line mode other than ink (before anything is written) or a
-    /// failed write; texture problems are appended to `warnings`.
+    /// camera (before anything is written) or a failed write; texture problems are appended
+    /// to `warnings`.
     void render(const Scene& scene, const CameraSpec& camera, const std::filesystem::path& output,
                 const FrameOptions& options, Warnings& warnings);
 
@@ -80,6 +93,7 @@ private:
     FeatureLayers layers_;
     ImageRgb8 with_polylines_;  ///< classic and robust frames with the polylines drawn over
     ImageF polyline_coverage_;  ///< and the polylines' coverage, for the EXR
+    ink::InkLines svg_lines_;   ///< the ink lines of an SVG asked of another line mode
 };
 
 }  // namespace toonray

@@ -14,7 +14,125 @@ constexpr int kBandRows = 16;
 struct Segment2 {
     Point2 a, b;
     int x0, x1, y0, y1;  // pixels whose centres may be covered, inclusive, clamped to the image
+    float reach;         // half the thickness + 0.5: coverage is reach - distance
+    std::uint16_t style;
+    float arc0 = 0;                  // arc length of the stroke at a (dashes, taper)
+    const StrokePen* pen = nullptr;  // set for dashed, tapered or depth-scaled strokes only
+    float stroke_length = 0;
+    float d0 = 0, d1 = 0;  // depths at a and b (width by depth)
 };
+
+constexpr float kMinDepthScale = 0.25f, kMaxDepthScale = 2.0f;
+
+float depth_scale(const StrokePen& pen, float depth) {
+    return depth > 0.0f ? std::clamp(pen.depth_reference / depth, kMinDepthScale, kMaxDepthScale)
+                        : kMaxDepthScale;
+}
+
+// Every segment of every stroke with the pixels it can reach.
+void add_stroke_segments(const Stroke& s, float thickness, std::uint16_t style,
+                         const StrokePen* pen, int w, int h, std::vector<Segment2>& out) {
+    const float reach = thickness * 0.5f + 0.5f;
+    const float total = pen ? polyline_length(s.points) : 0.0f;
+    const bool by_depth = pen && pen->depth_reference > 0.0f && s.depth.size() == s.points.size();
+    float arc = 0.0f;
+    for (std::size_t i = 0; i + 1 < s.points.size(); ++i) {
+        const Point2 a = s.points[i], b = s.points[i + 1];
+        const float arc0 = arc;
+        const float d0 = by_depth ? s.depth[i] : 0.0f, d1 = by_depth ? s.depth[i + 1] : 0.0f;
+        // The widest the segment gets (the scale is monotonic in depth, so at an end).
+        const float box_reach =
+            by_depth
+                ? thickness * 0.5f * std::max(depth_scale(*pen, d0), depth_scale(*pen, d1)) + 0.5f
+                : reach;
+        if (pen) arc += polyline_length(std::span<const Point2>(&s.points[i], 2));
+        // Pixel x has its centre at x + 0.5; it can be covered if within reach of the box.
+        const float lx = std::min(a.x, b.x) - box_reach, hx = std::max(a.x, b.x) + box_reach;
+        const float ly = std::min(a.y, b.y) - box_reach, hy = std::max(a.y, b.y) + box_reach;
+        if (!(hx >= 0.5f && lx <= w - 0.5f && hy >= 0.5f && ly <= h - 0.5f)) continue;  // also NaN
+        Segment2 seg{a,
+                     b,
+                     std::max(0, static_cast<int>(std::ceil(lx - 0.5f))),
+                     std::min(w - 1, static_cast<int>(std::floor(hx - 0.5f))),
+                     std::max(0, static_cast<int>(std::ceil(ly - 0.5f))),
+                     std::min(h - 1, static_cast<int>(std::floor(hy - 0.5f))),
+                     reach,
+                     style,
+                     arc0,
+                     by_depth || (pen && (!pen->dash.empty() || pen->taper > 0.0f)) ? pen : nullptr,
+                     s.closed ? -1.0f : total,  // closed strokes have no ends to taper
+                     d0,
+                     d1};
+        if (seg.x0 <= seg.x1 && seg.y0 <= seg.y1) out.push_back(seg);
+    }
+}
+
+// Whether arc length `s` lies in an "on" dash of the pattern.
+bool in_dash(const std::vector<float>& dash, float s) {
+    float period = 0.0f;
+    for (float d : dash) period += d;
+    float phase = std::fmod(s, period);
+    for (std::size_t i = 0; i < dash.size(); ++i) {
+        if (phase < dash[i]) return i % 2 == 0;
+        phase -= dash[i];
+    }
+    return false;
+}
+
+// Rasterises the segments in bands of rows; `style` (optional) gets the style of the largest
+// coverage, the lower style on ties.
+void rasterise(const std::vector<Segment2>& segments, ImageF& coverage, Image<std::uint16_t>* style,
+               int threads) {
+    const int h = coverage.height();
+    const int bands = (h + kBandRows - 1) / kBandRows;
+    std::vector<std::vector<std::uint32_t>> in_band(static_cast<std::size_t>(bands));
+    for (std::size_t i = 0; i < segments.size(); ++i)
+        for (int b = segments[i].y0 / kBandRows; b <= segments[i].y1 / kBandRows; ++b)
+            in_band[static_cast<std::size_t>(b)].push_back(static_cast<std::uint32_t>(i));
+    parallel_for(bands, 1, threads, [&](int b0, int b1) {
+        for (int band = b0; band < b1; ++band) {
+            const int row0 = band * kBandRows, row1 = std::min(h, row0 + kBandRows) - 1;
+            for (std::uint32_t index : in_band[static_cast<std::size_t>(band)]) {
+                const Segment2& s = segments[index];
+                const float dx = s.b.x - s.a.x, dy = s.b.y - s.a.y;
+                const float len2 = dx * dx + dy * dy;
+                const float inv_len2 = len2 > 0.0f ? 1.0f / len2 : 0.0f;
+                const float len = s.pen ? std::sqrt(len2) : 0.0f;
+                for (int y = std::max(s.y0, row0); y <= std::min(s.y1, row1); ++y) {
+                    float* row = coverage.row(y);
+                    std::uint16_t* style_row = style ? style->row(y) : nullptr;
+                    const float py = static_cast<float>(y) + 0.5f - s.a.y;
+                    for (int x = s.x0; x <= s.x1; ++x) {
+                        const float px = static_cast<float>(x) + 0.5f - s.a.x;
+                        // Distance to the segment: to its nearest point, ends included (round caps).
+                        const float t = std::clamp((px * dx + py * dy) * inv_len2, 0.0f, 1.0f);
+                        const float ex = px - dx * t, ey = py - dy * t;
+                        float reach = s.reach;
+                        if (s.pen) {
+                            const float arc = s.arc0 + t * len;
+                            if (!s.pen->dash.empty() && !in_dash(s.pen->dash, arc)) continue;
+                            float f = 1.0f;
+                            if (s.pen->taper > 0.0f && s.stroke_length >= 0.0f) {
+                                const float end = std::min(arc, s.stroke_length - arc);
+                                f = std::clamp(end / s.pen->taper, 0.0f, 1.0f);
+                            }
+                            if (s.pen->depth_reference > 0.0f && s.d0 > 0.0f)
+                                f *= depth_scale(*s.pen, s.d0 + (s.d1 - s.d0) * t);
+                            reach = (s.reach - 0.5f) * f + 0.5f;
+                        }
+                        const float c = std::min(1.0f, reach - std::sqrt(ex * ex + ey * ey));
+                        if (c > row[x]) {
+                            row[x] = c;
+                            if (style_row) style_row[x] = s.style;
+                        } else if (style_row && c == row[x] && c > 0.0f && s.style < style_row[x]) {
+                            style_row[x] = s.style;
+                        }
+                    }
+                }
+            }
+        }
+    });
+}
 
 std::uint8_t to_byte(float v) {
     return static_cast<std::uint8_t>(std::min(std::max(v, 0.0f), 1.0f) * 255.0f + 0.5f);
@@ -29,53 +147,45 @@ float stroke_thickness(float width, int height) {
 void draw_strokes(std::span<const Stroke> strokes, float thickness, ImageF& coverage, int threads) {
     const int w = coverage.width(), h = coverage.height();
     if (w <= 0 || h <= 0 || !(thickness > 0.0f)) return;
-    const float reach = thickness * 0.5f + 0.5f;
-    // Every segment of every stroke with the pixels it can reach, listed per band of rows.
     std::vector<Segment2> segments;
-    for (const Stroke& s : strokes)
-        for (std::size_t i = 0; i + 1 < s.points.size(); ++i) {
-            const Point2 a = s.points[i], b = s.points[i + 1];
-            // Pixel x has its centre at x + 0.5; it can be covered if within reach of the box.
-            const float lx = std::min(a.x, b.x) - reach, hx = std::max(a.x, b.x) + reach;
-            const float ly = std::min(a.y, b.y) - reach, hy = std::max(a.y, b.y) + reach;
-            if (!(hx >= 0.5f && lx <= w - 0.5f && hy >= 0.5f && ly <= h - 0.5f))
-                continue;  // also NaN
-            Segment2 seg{a,
-                         b,
-                         std::max(0, static_cast<int>(std::ceil(lx - 0.5f))),
-                         std::min(w - 1, static_cast<int>(std::floor(hx - 0.5f))),
-                         std::max(0, static_cast<int>(std::ceil(ly - 0.5f))),
-                         std::min(h - 1, static_cast<int>(std::floor(hy - 0.5f)))};
-            if (seg.x0 <= seg.x1 && seg.y0 <= seg.y1) segments.push_back(seg);
+    for (const Stroke& s : strokes) add_stroke_segments(s, thickness, 0, nullptr, w, h, segments);
+    rasterise(segments, coverage, nullptr, threads);
+}
+
+void draw_styled_strokes(std::span<const Stroke> strokes, std::span<const StrokePen> pens,
+                         int width, int height, ImageF& coverage, Image<std::uint16_t>& style,
+                         int threads) {
+    coverage.resize(width, height, 0.0f);
+    style.resize(width, height, 0);
+    if (width <= 0 || height <= 0) return;
+    std::vector<Segment2> segments;
+    for (const Stroke& s : strokes) {
+        if (s.style >= pens.size()) continue;
+        const StrokePen& pen = pens[s.style];
+        if (!pen.draw || !(pen.thickness > 0.0f) || !(pen.opacity > 0.0f)) continue;
+        const bool shaped = !pen.dash.empty() || (pen.taper > 0.0f && !s.closed) ||
+                            (pen.depth_reference > 0.0f && s.depth.size() == s.points.size());
+        add_stroke_segments(s, pen.thickness, s.style, shaped ? &pen : nullptr, width, height,
+                            segments);
+    }
+    rasterise(segments, coverage, &style, threads);
+}
+
+void composite_styled_lines(const ImageF& coverage, const Image<std::uint16_t>& styles,
+                            std::span<const StrokePen> pens, ImageRgb8& image) {
+    for (int y = 0; y < image.height(); ++y) {
+        const float* cov = coverage.row(y);
+        const std::uint16_t* style = styles.row(y);
+        Rgb8* px = image.row(y);
+        for (int x = 0; x < image.width(); ++x) {
+            if (!(cov[x] > 0.0f) || style[x] >= pens.size()) continue;
+            const StrokePen& pen = pens[style[x]];
+            const float a = cov[x] * pen.opacity;
+            for (int c = 0; c < 3; ++c)
+                px[x][c] = to_byte(static_cast<float>(px[x][c]) * (1.0f / 255.0f) * (1.0f - a) +
+                                   pen.colour[c] * a);
         }
-    const int bands = (h + kBandRows - 1) / kBandRows;
-    std::vector<std::vector<std::uint32_t>> in_band(static_cast<std::size_t>(bands));
-    for (std::size_t i = 0; i < segments.size(); ++i)
-        for (int b = segments[i].y0 / kBandRows; b <= segments[i].y1 / kBandRows; ++b)
-            in_band[static_cast<std::size_t>(b)].push_back(static_cast<std::uint32_t>(i));
-    parallel_for(bands, 1, threads, [&](int b0, int b1) {
-        for (int band = b0; band < b1; ++band) {
-            const int row0 = band * kBandRows, row1 = std::min(h, row0 + kBandRows) - 1;
-            for (std::uint32_t index : in_band[static_cast<std::size_t>(band)]) {
-                const Segment2& s = segments[index];
-                const float dx = s.b.x - s.a.x, dy = s.b.y - s.a.y;
-                const float len2 = dx * dx + dy * dy;
-                const float inv_len2 = len2 > 0.0f ? 1.0f / len2 : 0.0f;
-                for (int y = std::max(s.y0, row0); y <= std::min(s.y1, row1); ++y) {
-                    float* row = coverage.row(y);
-                    const float py = static_cast<float>(y) + 0.5f - s.a.y;
-                    for (int x = s.x0; x <= s.x1; ++x) {
-                        const float px = static_cast<float>(x) + 0.5f - s.a.x;
-                        // Distance to the segment: to its nearest point, ends included (round caps).
-                        const float t = std::clamp((px * dx + py * dy) * inv_len2, 0.0f, 1.0f);
-                        const float ex = px - dx * t, ey = py - dy * t;
-                        const float c = std::min(1.0f, reach - std::sqrt(ex * ex + ey * ey));
-                        if (c > row[x]) row[x] = c;
-                    }
-                }
-            }
-        }
-    });
+    }
 }
 
 void composite_lines(const ImageF& coverage, const Vec3f& colour, ImageRgb8& image) {

@@ -1,7 +1,9 @@
 #pragma once
 /// Drawing strokes with exact anti-aliased coverage, and compositing them over a picture.
 
+#include <cstdint>
 #include <span>
+#include <vector>
 
 #include "toonray/core/image.h"
 #include "toonray/core/math.h"
@@ -20,6 +22,42 @@ namespace toonray::ink {
 /// the larger coverage, so the result does not depend on the order of strokes or on threads.
 /// Each segment is rasterised within its own bounding box.
 void draw_strokes(std::span<const Stroke> strokes, float thickness, ImageF& coverage, int threads);
+
+/// How the strokes of one resolved style are drawn (in pixels of this image).
+struct StrokePen {
+    bool draw = true;
+    float thickness = 2.0f;  ///< pixels
+    Vec3f colour{0.0f};
+    float opacity = 1.0f;
+    std::vector<float>
+        dash;  ///< on, off, ... pixels along the stroke (an even count); empty: solid
+    /// Open strokes grow from zero thickness at their ends to full thickness over this many
+    /// pixels along the stroke; 0: no taper.
+    float taper = 0.0f;
+    /// Width by depth: when > 0 (and strokes have Stroke::depth), the thickness at a point at
+    /// distance d from the eye is scaled by clamp(depth_reference / d, 0.25, 2), d interpolated
+    /// linearly along each segment on the image.
+    float depth_reference = 0.0f;
+};
+
+/// Draws each stroke with pens[stroke.style] (strokes whose pen does not draw are skipped)
+/// into the line layer `coverage` and `style` (per pixel, the coverage of the stroke that covers
+/// it most and that stroke's style: 4 + 2 bytes a pixel), resized to width x height and cleared
+/// first. Coverage is the rule of
+/// draw_strokes with the pen's thickness; a dashed stroke covers a pixel only from the parts
+/// of its centreline in an "on" dash (arc length from the stroke's first point, modulo the
+/// pattern), and a tapered one with the thickness at the nearest centreline point. Each pixel
+/// keeps the largest coverage and its style, the lower style index on equal coverage: the
+/// same for any stroke order and thread count. With a single solid pen the coverage is
+/// exactly draw_strokes's.
+void draw_styled_strokes(std::span<const Stroke> strokes, std::span<const StrokePen> pens,
+                         int width, int height, ImageF& coverage, Image<std::uint16_t>& style,
+                         int threads);
+
+/// image = image * (1 - a) + colour * a with a = coverage * opacity of the pixel's pen, per
+/// channel, rounded as composite_lines. With opacity 1 this is composite_lines exactly.
+void composite_styled_lines(const ImageF& coverage, const Image<std::uint16_t>& style,
+                            std::span<const StrokePen> pens, ImageRgb8& image);
 
 /// image = image * (1 - coverage) + colour * coverage, per channel, in [0, 1] and rounded to
 /// bytes as the renderer does (value * 255 + 0.5, truncated).

@@ -2,6 +2,10 @@
 
 #include <algorithm>
 #include <chrono>
+#include <map>
+#include <tuple>
+
+#include "toonray/core/error.h"
 
 #include "toonray/ink/polylines.h"
 
@@ -13,7 +17,61 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
+// The style of every segment, visible and hidden, resolved once per (object, material, type).
+std::vector<SegmentStyles> resolve_segment_styles(const Scene& scene,
+                                                  std::span<const FeatureSegment> segments,
+                                                  const InkSettings& settings,
+                                                  std::vector<LineStyle>& styles) {
+    LineStyle base;
+    base.colour = settings.colour;
+    base.width = settings.width;
+    base.taper = settings.taper;
+    base.by_depth = settings.width_by_depth;
+    LineStyle hidden = base;
+    hidden.draw = false;
+    styles = {base, hidden};
+    std::vector<SegmentStyles> out(segments.size(), SegmentStyles{0, 1});
+    if (settings.styles.empty()) return out;
+    auto index_of = [&](const LineStyle& style) {
+        for (std::size_t i = 0; i < styles.size(); ++i)
+            if (styles[i] == style) return static_cast<std::uint16_t>(i);
+        if (styles.size() > 0xffff) throw Error("more than 65536 distinct line styles in a frame");
+        styles.push_back(style);
+        return static_cast<std::uint16_t>(styles.size() - 1);
+    };
+    std::map<std::tuple<std::uint32_t, std::uint32_t, EdgeType>, SegmentStyles> known;
+    for (std::size_t i = 0; i < segments.size(); ++i) {
+        const std::uint32_t tri = style_source_triangle(scene, segments[i]);
+        const std::uint32_t object = tri == kNoIndex ? 0 : scene.tri_object[tri];
+        const std::uint32_t material = tri == kNoIndex ? 0 : scene.tri_material[tri];
+        const auto key = std::make_tuple(object, material, segments[i].type);
+        auto it = known.find(key);
+        if (it == known.end()) {
+            SegmentStyles both{};
+            for (int v = 0; v < 2; ++v)
+                both[v] = index_of(resolve_line_style(settings.styles, base, scene.objects[object],
+                                                      scene.materials[material].name,
+                                                      segments[i].type, v == 0));
+            it = known.emplace(key, both).first;
+        }
+        out[i] = it->second;
+    }
+    return out;
+}
+
 }  // namespace
+
+std::uint32_t style_source_triangle(const Scene& scene, const FeatureSegment& segment) {
+    std::uint32_t best = kNoIndex;
+    for (std::uint32_t f : segment.faces) {
+        if (f == kNoIndex || f >= scene.triangle_count()) continue;
+        if (best == kNoIndex ||
+            std::make_pair(scene.tri_object[f], scene.tri_material[f]) <
+                std::make_pair(scene.tri_object[best], scene.tri_material[best]))
+            best = f;
+    }
+    return best;
+}
 
 void draw_ink_lines(const Scene& scene, const TriangleAccel& accel, const CameraSpec& camera,
                     int width, int height, const InkSettings& settings, int threads,
@@ -31,6 +89,10 @@ void draw_ink_lines(const Scene& scene, const TriangleAccel& accel, const Camera
     out.timings.edges = seconds_since(start);
 
     start = std::chrono::steady_clock::now();
+    ChainSettings chain = settings.chain;
+    chain.hidden = chain.hidden || settings.styles.draws_hidden();
+    // Styles only need hidden from visible; how deep a line is hidden is counted for the SVG's
+    // hidden layer (settings.chain.hidden) only.
     VisibilitySettings visibility = settings.visibility;
     if (!settings.chain.hidden)
         visibility.max_invisibility = std::min(visibility.max_invisibility, 1);
@@ -39,15 +101,28 @@ void draw_ink_lines(const Scene& scene, const TriangleAccel& accel, const Camera
     out.timings.visibility = seconds_since(start);
 
     start = std::chrono::steady_clock::now();
-    out.strokes = chain_pieces(out.pieces, settings.chain);
+    const std::vector<SegmentStyles> segment_styles =
+        resolve_segment_styles(scene, out.segments, settings, out.styles);
+    bool by_depth = false;
+    for (const LineStyle& style : out.styles) by_depth = by_depth || style.by_depth;
+    if (by_depth) chain.eye = plane.eye;
+    out.strokes = chain_pieces(out.pieces, chain, segment_styles);
     out.timings.chaining = seconds_since(start);
 
     start = std::chrono::steady_clock::now();
-    out.coverage.resize(width, height, 0.0f);
-    std::vector<Stroke> visible;
-    for (const Stroke& s : out.strokes)
-        if (s.visible) visible.push_back(s);
-    draw_strokes(visible, stroke_thickness(settings.width, height), out.coverage, threads);
+    out.pens.clear();
+    for (const LineStyle& style : out.styles) {
+        StrokePen pen{style.draw,   stroke_thickness(style.width, height),
+                      style.colour, style.opacity,
+                      style.dash,   stroke_thickness(style.taper, height)};
+        for (float& d : pen.dash) d = stroke_thickness(d, height);
+        if (style.by_depth) {
+            const BBox bounds = scene.bounds();
+            pen.depth_reference = length((bounds.lo + bounds.hi) * 0.5f - plane.eye);
+        }
+        out.pens.push_back(std::move(pen));
+    }
+    draw_styled_strokes(out.strokes, out.pens, width, height, out.coverage, out.style, threads);
     out.timings.drawing = seconds_since(start);
 }
 

@@ -9,6 +9,7 @@
 #include "toonray/core/image.h"
 #include "toonray/ink/draw.h"
 #include "toonray/ink/feature_edges.h"
+#include "toonray/ink/line_style.h"
 #include "toonray/ink/strokes.h"
 #include "toonray/ink/visibility.h"
 #include "toonray/scene/camera.h"
@@ -21,6 +22,14 @@ struct InkSettings {
     VisibilitySettings visibility;
     ChainSettings chain;
     float width = 2.0f;  ///< line width in pixels at 720 lines; scales with the image height
+    Vec3f colour{0.0f};  ///< line colour where no style says otherwise
+    float taper = 0.0f;  ///< default taper at open stroke ends, pixels at 720 lines (LineStyle)
+    /// Default width by depth: full width at the distance from the eye to the centre of the
+    /// scene's bounds, scaled by that distance over the point's, within [0.25, 2].
+    bool width_by_depth = false;
+    /// Line sets: which strokes are drawn and how (line_style.h). Without rules visible lines
+    /// are drawn with width and colour, hidden ones are not drawn.
+    LineStyleSet styles;
 };
 
 /// Seconds spent in each stage of the last draw_ink_lines.
@@ -34,10 +43,22 @@ struct InkLines {
     std::vector<FeatureSegment> segments;
     std::vector<EdgePiece> pieces;
     std::vector<Stroke> strokes;
-    ImageF coverage;                  ///< visible strokes, 0 = no line, 1 = covered
+    /// The distinct styles of this frame's strokes (Stroke::style indexes them): 0 is the
+    /// default for visible lines and 1 for hidden ones; the others in order of first use by
+    /// the segments. pens are the same in pixels of this image.
+    std::vector<LineStyle> styles;
+    std::vector<StrokePen> pens;
+    ImageF coverage;  ///< drawn strokes, 0 = no line, 1 = covered (the largest per pixel)
+    Image<std::uint16_t> style;       ///< per pixel, the style of the stroke that gave the coverage
     IntersectionCache intersections;  ///< for the next frame's unmoved triangles
     InkTimings timings;
 };
+
+/// Where a segment takes its object and material from, for its style: of its faces, the one
+/// with the lower object id, then the lower material id (so an intersection line between two
+/// objects is styled as the object listed first). kNoIndex without faces.
+[[nodiscard]] std::uint32_t style_source_triangle(const Scene& scene,
+                                                  const FeatureSegment& segment);
 
 /// Runs every stage for one view of the scene. `accel` holds the scene's triangles in their
 /// order. Without hidden strokes (settings.chain.hidden false) visibility only tells visible

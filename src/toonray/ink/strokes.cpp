@@ -47,7 +47,18 @@ struct Link {
     bool visible;
     Point2 s0, s1;
     EndpointKey key0, key1;
+    std::uint16_t style;
+    Vec3f w0, w1;  // the ends in the world
 };
+
+// Which points Douglas-Peucker keeps.
+std::vector<bool> simplified(std::span<const Point2> points, float tolerance) {
+    if (points.size() <= 2 || !(tolerance > 0.0f)) return std::vector<bool>(points.size(), true);
+    std::vector<bool> keep(points.size(), false);
+    keep.front() = keep.back() = true;
+    douglas_peucker(points, 0, points.size() - 1, tolerance, keep);
+    return keep;
+}
 
 }  // namespace
 
@@ -58,17 +69,15 @@ float polyline_length(std::span<const Point2> points) {
 }
 
 std::vector<Point2> simplify_polyline(std::span<const Point2> points, float tolerance) {
-    if (points.size() <= 2 || !(tolerance > 0.0f)) return {points.begin(), points.end()};
-    std::vector<bool> keep(points.size(), false);
-    keep.front() = keep.back() = true;
-    douglas_peucker(points, 0, points.size() - 1, tolerance, keep);
+    const std::vector<bool> keep = simplified(points, tolerance);
     std::vector<Point2> out;
     for (std::size_t i = 0; i < points.size(); ++i)
         if (keep[i]) out.push_back(points[i]);
     return out;
 }
 
-std::vector<Stroke> chain_pieces(std::span<const EdgePiece> pieces, const ChainSettings& settings) {
+std::vector<Stroke> chain_pieces(std::span<const EdgePiece> pieces, const ChainSettings& settings,
+                                 std::span<const SegmentStyles> segment_styles) {
     // 1. Per segment: absorb sub-pixel pieces into their neighbours, then merge runs of one
     //    visibility into links.
     std::vector<Link> links;
@@ -96,9 +105,13 @@ std::vector<Stroke> chain_pieces(std::span<const EdgePiece> pieces, const ChainS
                 !links.empty()) {
                 links.back().s1 = p.s1;
                 links.back().key1 = p.key1;
+                links.back().w1 = p.p1;
                 continue;
             }
-            links.push_back({p.type, visible[k], p.s0, p.s1, p.key0, p.key1});
+            const std::uint16_t style = p.segment < segment_styles.size()
+                                            ? segment_styles[p.segment][visible[k] ? 0 : 1]
+                                            : 0;
+            links.push_back({p.type, visible[k], p.s0, p.s1, p.key0, p.key1, style, p.p0, p.p1});
         }
         i = j;
     }
@@ -137,9 +150,11 @@ std::vector<Stroke> chain_pieces(std::span<const EdgePiece> pieces, const ChainS
         const Link& first = links[start];
         // Points from the start's s0 through its s1, grown at the back; then the front.
         std::vector<Point2> forward{first.s0, first.s1}, backward;
+        std::vector<Vec3f> forward_world{first.w0, first.w1}, backward_world;
         bool closed = false;
         for (int direction = 0; direction < 2 && !closed; ++direction) {
             std::vector<Point2>& pts = direction == 0 ? forward : backward;
+            std::vector<Vec3f>& world = direction == 0 ? forward_world : backward_world;
             EndpointKey key = direction == 0 ? first.key1 : first.key0;
             Point2 tip = direction == 0 ? first.s1 : first.s0;
             Point2 previous = direction == 0 ? first.s0 : first.s1;
@@ -154,7 +169,7 @@ std::vector<Stroke> chain_pieces(std::span<const EdgePiece> pieces, const ChainS
                 for (const End& e : ends_at(key)) {
                     const Link& l = links[e.link];
                     if (used[e.link] || l.type != first.type || l.visible != first.visible ||
-                        e.link == last_link)
+                        l.style != first.style || e.link == last_link)
                         continue;
                     last_link = e.link;
                     ++candidates;
@@ -176,22 +191,38 @@ std::vector<Stroke> chain_pieces(std::span<const EdgePiece> pieces, const ChainS
                 tip = best->side == 0 ? l.s1 : l.s0;
                 key = best->side == 0 ? l.key1 : l.key0;
                 pts.push_back(tip);
+                world.push_back(best->side == 0 ? l.w1 : l.w0);
             }
         }
         std::vector<Point2> points(backward.rbegin(), backward.rend());
         points.insert(points.end(), forward.begin(), forward.end());
-        if (closed) points.back() = points.front();
+        std::vector<Vec3f> world(backward_world.rbegin(), backward_world.rend());
+        world.insert(world.end(), forward_world.begin(), forward_world.end());
+        if (closed) {
+            points.back() = points.front();
+            world.back() = world.front();
+        }
         // Thin out points closer than min_spacing, keeping both ends.
+        std::vector<std::size_t> spaced_at{0};
         std::vector<Point2> spaced{points.front()};
         for (std::size_t i = 1; i + 1 < points.size(); ++i)
-            if (distance(points[i], spaced.back()) >= settings.min_spacing)
+            if (distance(points[i], spaced.back()) >= settings.min_spacing) {
                 spaced.push_back(points[i]);
+                spaced_at.push_back(i);
+            }
         spaced.push_back(points.back());
+        spaced_at.push_back(points.size() - 1);
         Stroke stroke;
         stroke.type = first.type;
         stroke.visible = first.visible;
+        stroke.style = first.style;
         stroke.closed = closed;
-        stroke.points = simplify_polyline(spaced, settings.simplify);
+        const std::vector<bool> keep = simplified(spaced, settings.simplify);
+        for (std::size_t i = 0; i < spaced.size(); ++i) {
+            if (!keep[i]) continue;
+            stroke.points.push_back(spaced[i]);
+            if (settings.eye) stroke.depth.push_back(length(world[spaced_at[i]] - *settings.eye));
+        }
         if (stroke.visible && settings.min_length > 0.0f &&
             polyline_length(stroke.points) < settings.min_length)
             continue;

@@ -2,6 +2,9 @@
 /// Chaining: visible (or hidden) edge pieces joined into strokes, the polylines that are drawn
 /// and written to SVG.
 
+#include <array>
+#include <cstdint>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -14,7 +17,14 @@ struct Stroke {
     bool visible = true;
     std::vector<Point2> points;  ///< on the image, in pixels; at least two
     bool closed = false;         ///< the last point is the first (a loop)
+    std::uint16_t style = 0;     ///< index into the frame's resolved line styles (ink.h)
+    /// Per point, its distance from the eye (world units) when ChainSettings::eye is set,
+    /// else empty: for widths by depth.
+    std::vector<float> depth;
 };
+
+/// Per segment, the style index of its visible pieces [0] and of its hidden pieces [1].
+using SegmentStyles = std::array<std::uint16_t, 2>;
 
 struct ChainSettings {
     /// A piece whose image is shorter than this (pixels), between pieces of the other
@@ -31,6 +41,8 @@ struct ChainSettings {
     /// Visible strokes shorter than this (pixels, along the polyline) are dropped; 0 keeps all.
     float min_length = 0.0f;
     bool hidden = false;  ///< also chain the hidden pieces (into strokes with visible = false)
+    /// When set, strokes keep each point's distance from this eye (Stroke::depth).
+    std::optional<Vec3f> eye;
 };
 
 /// Chains pieces into strokes. The rule: pieces chain when they have the same type and the
@@ -40,9 +52,12 @@ struct ChainSettings {
 /// unused matching piece it continues with it, whatever the angle; with several, it continues
 /// with the straightest on the image if that turns by at most max_turn, else it stops. A
 /// stroke that comes back to its start is closed. Strokes come out in the order of their
-/// first pieces (so deterministic).
+/// first pieces (so deterministic). With `segment_styles` (one entry per segment), pieces
+/// also chain only when they have the same style, and strokes carry it; without, every
+/// stroke has style 0.
 [[nodiscard]] std::vector<Stroke> chain_pieces(std::span<const EdgePiece> pieces,
-                                               const ChainSettings& settings);
+                                               const ChainSettings& settings,
+                                               std::span<const SegmentStyles> segment_styles = {});
 
 /// Douglas-Peucker: the fewest points of `points` (ends kept) such that every dropped point
 /// is within `tolerance` of the simplified polyline.

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "toonray/core/math.h"
+#include "toonray/ink/draw.h"
 #include "toonray/ink/strokes.h"
 
 namespace toonray::ink {
@@ -17,7 +18,18 @@ struct SvgSettings {
     bool hidden = false;  ///< write hidden strokes too (in group "hidden")
     Vec3f hidden_colour{0.5f};
     float hidden_thickness_scale = 0.5f;
+    /// The frame's pens (InkLines::pens), indexed by Stroke::style. A path whose pen differs
+    /// from its group's defaults carries its own stroke, stroke-width, stroke-opacity and
+    /// stroke-dasharray; visible strokes whose pen does not draw are left out, hidden ones
+    /// whose pen does not draw keep the hidden layer's defaults. Empty: group defaults only.
+    std::span<const StrokePen> pens;
+    /// When not empty, an `<image id="fill">` of the whole view under the lines with this
+    /// href (a data: URI of the cel-shaded picture).
+    std::string fill_href;
 };
+
+/// `data:image/png;base64,...` for PNG bytes.
+[[nodiscard]] std::string png_data_uri(std::span<const std::uint8_t> png);
 
 /// The SVG text: a `<g id="visible">` with one subgroup per line type (`visible-silhouette`,
 /// `visible-border`, `visible-crease`, `visible-material`, `visible-intersection`), each

@@ -92,6 +92,10 @@ ink::InkSettings ink_settings(const RenderSettings& settings) {
     s.edges.intersections = (types & kLineObject) != 0;
     s.edges.crease_angle = settings.lines.crease_angle;
     s.width = settings.lines.width;
+    s.colour = settings.lines.colour;
+    s.taper = settings.line_taper;
+    s.width_by_depth = settings.line_width_by_depth;
+    s.styles = settings.line_styles;
     s.chain.hidden = settings.hidden_lines;
     return s;
 }
@@ -161,10 +165,10 @@ std::uint64_t frame_buffer_bytes(const RenderSettings& settings) {
     const std::uint64_t samples = static_cast<std::uint64_t>(std::max(settings.samples, 1));
     const int sub = samples_per_side(settings.samples);
     if (settings.edges == EdgeMode::Ink) {
-        // The G-buffer, the line coverage (a float a pixel) and the final image. The edges,
+        // The G-buffer, the line layer (coverage and style) and the final image. The edges,
         // pieces and strokes grow with the scene, not the image: they are not counted here.
         const std::uint64_t per_pixel =
-            sizeof(float) + final_image +
+            sizeof(float) + sizeof(std::uint16_t) + final_image +
             (settings.feature_images ? feature_bytes_per_pixel(EdgeMode::Ink) : 0);
         return mul_saturated(pixels, add_saturated(mul_saturated(gbuffer, samples), per_pixel));
     }
@@ -320,7 +324,7 @@ void Renderer::render_ink(const Scene& scene, const TriangleAccel& accel, const 
     if (features) aovs_.cel = final_;
     ink::draw_ink_lines(scene, accel, camera, settings.width, settings.height,
                         ink_settings(settings), threads, ink_);
-    ink::composite_lines(ink_.coverage, settings.lines.colour, final_);
+    ink::composite_styled_lines(ink_.coverage, ink_.style, ink_.pens, final_);
     if (features) {
         ink::coverage_to_gray(ink_.coverage, aovs_.edges);
         gbuffer_feature_images(g, aovs_);

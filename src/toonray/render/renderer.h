@@ -44,6 +44,10 @@ struct RenderSettings {
     /// Ink: also chain the hidden lines into strokes (Renderer::ink_lines, for SVG), with the
     /// number of surfaces hiding them. They are not drawn: the final image is the same.
     bool hidden_lines = false;
+    /// Ink: line sets and styles (ink/line_style.h); hidden lines are drawn where a rule says.
+    ink::LineStyleSet line_styles;
+    float line_taper = 0.0f;  ///< ink: default taper at open stroke ends, pixels at 720 lines
+    bool line_width_by_depth = false;  ///< ink: default width by depth (ink::InkSettings)
 };
 
 /// Sub-samples per pixel side for a sample count: 1, 4, 9, 16 -> 1, 2, 3, 4. Throws Error

@@ -1,0 +1,35 @@
+// Line style files. Checks that every parsed rule is within the documented ranges and that a
+// style resolved from them is too.
+
+#include <cmath>
+
+#include "fuzz_util.h"
+#include "toonray/core/error.h"
+#include "toonray/ink/line_style.h"
+
+using namespace toonray;
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+    ink::LineStyleSet set;
+    try {
+        set = ink::parse_line_styles(toonray_fuzz::as_text(data, size), "fuzz.style");
+    } catch (const Error&) {
+        return 0;
+    }
+    for (int t = 0; t < ink::kEdgeTypeCount; ++t)
+        for (bool visible : {false, true}) {
+            const ink::LineStyle s = ink::resolve_line_style(
+                set, ink::LineStyle{}, "w12", "ivory", static_cast<ink::EdgeType>(t), visible);
+            FUZZ_CHECK(s.width >= 0.0f && s.width <= 1000.0f);
+            FUZZ_CHECK(s.opacity >= 0.0f && s.opacity <= 1.0f);
+            FUZZ_CHECK(s.dash.size() % 2 == 0);
+            float total = 0.0f;
+            for (float d : s.dash) {
+                FUZZ_CHECK(std::isfinite(d) && d >= 0.0f);
+                total += d;
+            }
+            FUZZ_CHECK(s.dash.empty() || total > 0.0f);
+            for (int c = 0; c < 3; ++c) FUZZ_CHECK(s.colour[c] >= 0.0f && s.colour[c] <= 1.0f);
+        }
+    return 0;
+}
