@@ -109,7 +109,9 @@ TEST(InkSvg, StylesGoIntoThePathsAndTheDrawing) {
             ++creases;
             EXPECT_FALSE(lines.pens[s.style].draw);
         }
-        if (!s.visible) EXPECT_EQ(lines.pens[s.style].dash.size(), 2u);
+        if (!s.visible) {
+            EXPECT_EQ(lines.pens[s.style].dash.size(), 2u);
+        }
     }
     EXPECT_GT(hidden, 10u);
     EXPECT_GT(creases, 0u);

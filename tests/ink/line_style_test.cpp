@@ -125,7 +125,9 @@ ink::Stroke line(float y, std::uint16_t style) {
 
 TEST(StyledStrokes, OneSolidPenDrawsExactlyLikeDrawStrokes) {
     const std::vector<ink::Stroke> strokes{
-        line(10.3f, 0), line(12.0f, 0), {ink::EdgeType::Crease, true, {{5, 5}, {30, 40}}}};
+        line(10.3f, 0),
+        line(12.0f, 0),
+        {ink::EdgeType::Crease, true, {{5, 5}, {30, 40}}, false, 0, {}}};
     ImageF plain(64, 48, 0.0f);
     ink::draw_strokes(strokes, 2.5f, plain, 1);
     const std::vector<ink::StrokePen> pens{{true, 2.5f, Vec3f{0.0f}, 1.0f, {}, 0.0f}};
@@ -155,7 +157,9 @@ TEST(StyledStrokes, DashesOpacityAndTheStrongestStrokeWins) {
         const float arc = x + 0.5f - 4.0f;
         const bool on = static_cast<int>(arc / 4.0f) % 2 == 0;
         EXPECT_EQ(coverage(x, 19) == 1.0f, on) << x;
-        if (on) EXPECT_EQ(style(x, 19), 1);
+        if (on) {
+            EXPECT_EQ(style(x, 19), 1);
+        }
         EXPECT_EQ(coverage(x, 29), 0.0f) << x;
     }
     ImageRgb8 image(64, 48, Rgb8{255, 255, 255});
@@ -163,9 +167,10 @@ TEST(StyledStrokes, DashesOpacityAndTheStrongestStrokeWins) {
     EXPECT_EQ(image(5, 19), (Rgb8{255, 128, 128}));  // red at half opacity over white
     // Overlapping strokes: each pixel keeps the larger coverage, ties the lower style, in any
     // stroke order and thread count.
-    std::vector<ink::Stroke> crossing{line(20.0f, 1),
-                                      line(20.4f, 0),
-                                      {ink::EdgeType::Crease, true, {{30, 2}, {30, 46}}, false, 1}};
+    std::vector<ink::Stroke> crossing{
+        line(20.0f, 1),
+        line(20.4f, 0),
+        {ink::EdgeType::Crease, true, {{30, 2}, {30, 46}}, false, 1, {}}};
     ImageF c1, c2;
     Image<std::uint16_t> s1, s2;
     ink::draw_styled_strokes(crossing, pens, 64, 48, c1, s1, 1);
