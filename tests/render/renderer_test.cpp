@@ -308,8 +308,10 @@ TEST(Renderer, FeatureImageTableListsEachModesImages) {
         if (f.in(EdgeMode::Robust)) robust.push_back(f.name);
         if (f.in(EdgeMode::Ink)) ink.push_back(f.name);
     }
-    EXPECT_EQ(ink, (std::vector<std::string_view>{"depth", "normal", "edges", "cel", "object_id",
-                                                  "material_id"}));
+    EXPECT_EQ(ink, (std::vector<std::string_view>{
+                       "depth", "normal", "edges", "cel", "lines_silhouette", "lines_crease",
+                       "lines_material", "lines_border", "lines_intersection", "lines_polyline",
+                       "object_id", "material_id"}));
     EXPECT_EQ(classic, (std::vector<std::string_view>{"depth", "normal", "edges_depth",
                                                       "edges_normal", "edges", "cel"}));
     EXPECT_EQ(robust,
@@ -331,7 +333,8 @@ TEST(Renderer, FrameBufferBytesCountTheBuffersRendererHolds) {
     // The last case draws lines so wide that the full distance image is used.
     for (const Case& c : {Case{EdgeMode::Classic, 1, 2.0f}, Case{EdgeMode::Robust, 1, 2.0f},
                           Case{EdgeMode::Robust, 4, 2.0f}, Case{EdgeMode::Robust, 9, 2.0f},
-                          Case{EdgeMode::Robust, 4, 100.0f}}) {
+                          Case{EdgeMode::Robust, 4, 100.0f}, Case{EdgeMode::Ink, 1, 2.0f},
+                          Case{EdgeMode::Ink, 4, 2.0f}}) {
         RenderSettings settings;
         settings.edges = c.mode;
         settings.samples = c.samples;
@@ -351,6 +354,11 @@ TEST(Renderer, FrameBufferBytesCountTheBuffersRendererHolds) {
         for (const FeatureImage& f : feature_images())
             features += std::visit([&](auto m) { return bytes_of(r.aovs().*m); }, f.image);
         held += features;
+        if (c.mode == EdgeMode::Ink) {
+            const ink::InkLines& ink = r.ink_lines();
+            // The line layer, and the same again while each line type's feature image is drawn.
+            held += 2 * (bytes_of(ink.coverage) + bytes_of(ink.style));
+        }
         const bool full_distance = c.line_width > 50.0f;
         if (full_distance) {
             EXPECT_GT(line_distance_band(line_thickness(c.line_width, settings.height, 2)),
@@ -363,7 +371,11 @@ TEST(Renderer, FrameBufferBytesCountTheBuffersRendererHolds) {
         settings.feature_images = false;
         const std::uint64_t kept =
             c.mode == EdgeMode::Classic ? features - bytes_of(r.aovs().cel) : 0;
-        EXPECT_EQ(frame_buffer_bytes(settings), held - features + kept) << c.samples;
+        const std::uint64_t type_layer =
+            c.mode == EdgeMode::Ink
+                ? bytes_of(r.ink_lines().coverage) + bytes_of(r.ink_lines().style)
+                : 0;
+        EXPECT_EQ(frame_buffer_bytes(settings), held - features + kept - type_layer) << c.samples;
     }
     RenderSettings huge;
     huge.width = huge.height = 2147483647;
@@ -408,6 +420,24 @@ TEST(Renderer, InkLinesAreTheCoverageOverTheCelColours) {
     long line_pixels = 0;
     for (std::size_t i = 0; i < gray.size(); ++i) line_pixels += gray.data()[i] < 128;
     EXPECT_GT(line_pixels, 300);
+    // One image per line type: together (the darkest per pixel) they are the edges image, and
+    // the teapot (a mesh without normals, open at the spout's and lid's rims) has silhouettes,
+    // creases and borders.
+    const ImageGray8* types[] = {&r.aovs().lines_silhouette,   &r.aovs().lines_crease,
+                                 &r.aovs().lines_material,     &r.aovs().lines_border,
+                                 &r.aovs().lines_intersection, &r.aovs().lines_polyline};
+    std::vector<long> type_pixels(std::size(types), 0);
+    for (std::size_t i = 0; i < gray.size(); ++i) {
+        std::uint8_t darkest = 255;
+        for (std::size_t t = 0; t < std::size(types); ++t) {
+            ASSERT_EQ(types[t]->size(), gray.size());
+            darkest = std::min(darkest, types[t]->data()[i]);
+            type_pixels[t] += types[t]->data()[i] < 128;
+        }
+        ASSERT_EQ(darkest, gray.data()[i]) << i;
+    }
+    EXPECT_GT(type_pixels[0], 100);  // silhouettes
+    EXPECT_EQ(type_pixels[5], 0);    // no polylines in the scene
     // Hidden lines are found for SVG but not drawn; any thread count gives the same pixels.
     settings.hidden_lines = true;
     settings.threads = 1;

@@ -121,11 +121,14 @@ std::span<const FeatureImage> feature_images() {
         {"edges_normal", true, false, false, &Aovs::edges_normal},
         {"edges", true, true, true, &Aovs::edges},
         {"cel", true, true, true, &Aovs::cel},
-        {"lines_silhouette", false, true, false, &Aovs::lines_silhouette},
-        {"lines_crease", false, true, false, &Aovs::lines_crease},
+        {"lines_silhouette", false, true, true, &Aovs::lines_silhouette},
+        {"lines_crease", false, true, true, &Aovs::lines_crease},
         {"lines_depth", false, true, false, &Aovs::lines_depth},
         {"lines_object", false, true, false, &Aovs::lines_object},
-        {"lines_material", false, true, false, &Aovs::lines_material},
+        {"lines_material", false, true, true, &Aovs::lines_material},
+        {"lines_border", false, false, true, &Aovs::lines_border},
+        {"lines_intersection", false, false, true, &Aovs::lines_intersection},
+        {"lines_polyline", false, false, true, &Aovs::lines_polyline},
         {"object_id", false, true, true, &Aovs::object_id},
         {"material_id", false, true, true, &Aovs::material_id},
     };
@@ -165,11 +168,13 @@ std::uint64_t frame_buffer_bytes(const RenderSettings& settings) {
     const std::uint64_t samples = static_cast<std::uint64_t>(std::max(settings.samples, 1));
     const int sub = samples_per_side(settings.samples);
     if (settings.edges == EdgeMode::Ink) {
-        // The G-buffer, the line layer (coverage and style) and the final image. The edges,
-        // pieces and strokes grow with the scene, not the image: they are not counted here.
+        // The G-buffer, the line layer (coverage and style) and the final image; with feature
+        // images, also the layer one line type is drawn into. The edges, pieces and strokes
+        // grow with the scene, not the image: they are not counted here.
+        const std::uint64_t line_layer = sizeof(float) + sizeof(std::uint16_t);
         const std::uint64_t per_pixel =
-            sizeof(float) + sizeof(std::uint16_t) + final_image +
-            (settings.feature_images ? feature_bytes_per_pixel(EdgeMode::Ink) : 0);
+            line_layer + final_image +
+            (settings.feature_images ? feature_bytes_per_pixel(EdgeMode::Ink) + line_layer : 0);
         return mul_saturated(pixels, add_saturated(mul_saturated(gbuffer, samples), per_pixel));
     }
     const float thickness = line_thickness(settings.lines.width, settings.height, sub);
@@ -327,7 +332,29 @@ void Renderer::render_ink(const Scene& scene, const TriangleAccel& accel, const 
     ink::composite_styled_lines(ink_.coverage, ink_.style, ink_.pens, final_);
     if (features) {
         ink::coverage_to_gray(ink_.coverage, aovs_.edges);
+        ink_type_feature_images(settings, threads);
         gbuffer_feature_images(g, aovs_);
+    }
+}
+
+void Renderer::ink_type_feature_images(const RenderSettings& settings, int threads) {
+    // Indexed by ink::EdgeType.
+    static constexpr ImageGray8 Aovs::*kTypeImages[ink::kEdgeTypeCount] = {
+        &Aovs::lines_silhouette, &Aovs::lines_border,       &Aovs::lines_crease,
+        &Aovs::lines_material,   &Aovs::lines_intersection, &Aovs::lines_polyline};
+    // One line layer (coverage and style) for the types in turn, freed after: frame_buffer_bytes
+    // counts it.
+    ImageF coverage;
+    Image<std::uint16_t> style;
+    std::vector<ink::Stroke> strokes;
+    for (int type = 0; type < ink::kEdgeTypeCount; ++type) {
+        // The strokes of one type drawn with their own pens, exactly as in the frame's layer.
+        strokes.clear();
+        for (const ink::Stroke& s : ink_.strokes)
+            if (static_cast<int>(s.type) == type) strokes.push_back(s);
+        ink::draw_styled_strokes(strokes, ink_.pens, settings.width, settings.height, coverage,
+                                 style, threads);
+        ink::coverage_to_gray(coverage, aovs_.*kTypeImages[type]);
     }
 }
 

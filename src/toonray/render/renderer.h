@@ -77,7 +77,8 @@ struct Aovs {
     ImageGray8 edges;         ///< all lines: classic merged before blur; robust and ink coverage
     ImageRgb8 cel;            ///< colour without lines
     ImageGray8 lines_silhouette, lines_crease, lines_depth, lines_object,
-        lines_material;                ///< robust
+        lines_material;  ///< robust; ink: silhouette, crease and material
+    ImageGray8 lines_border, lines_intersection, lines_polyline;  ///< ink
     ImageRgb8 object_id, material_id;  ///< robust and ink: ids in false colour
 };
 
@@ -98,7 +99,8 @@ struct FeatureImage {
 /// edges_depth, edges_normal, edges (merged, before blur), cel. Robust: depth, normal, edges
 /// (line coverage), cel, lines_silhouette, lines_crease, lines_depth, lines_object,
 /// lines_material, object_id, material_id. Ink: depth, normal, edges (line coverage), cel,
-/// object_id, material_id.
+/// one coverage image per line type (lines_silhouette, lines_crease, lines_material,
+/// lines_border, lines_intersection, lines_polyline), object_id, material_id.
 std::span<const FeatureImage> feature_images();
 
 /// Bytes of the buffers Renderer keeps for a frame with `settings`: the G-buffer at the mode's
@@ -152,6 +154,7 @@ private:
     void render_robust(const RenderSettings& settings);
     void render_ink(const Scene& scene, const TriangleAccel& accel, const CameraSpec& camera,
                     const RenderSettings& settings);
+    void ink_type_feature_images(const RenderSettings& settings, int threads);
 
     GBuffer gbuffer_;
     Aovs aovs_;  ///< classic mode draws its lines from depth, normal and edges* here
