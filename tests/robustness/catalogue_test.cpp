@@ -141,8 +141,7 @@ std::vector<BadInput> catalogue() {
          "{data}/gltf_cycle.gltf: nodes[2].children: the node hierarchy has a cycle through "
          "nodes[1]"},
         {"GltfBase64Garbage", kRender + "gltf_base64.gltf" + kTo,
-         "{data}/gltf_base64.gltf: Failed to decode 'uri' : "
-         "data:application/octet-stream;base64,@@@@not base64@@@@ in Buffer"},
+         "{data}/gltf_base64.gltf: buffers[0].uri: the data URI's payload is not base64"},
         {"GltfTruncatedGlb", kRender + "gltf_truncated.glb" + kTo,
          "{data}/gltf_truncated.glb: byte 8: truncated GLB: the header says 540 bytes, the file "
          "has 520"},

@@ -157,7 +157,8 @@ TEST(GltfLoader, BadFilesNameTheFileAndJsonPath) {
         {"index.gltf", triangle_json(R"(, "uri": ")" + data_uri(triangle_bin(7)) + "\""),
          "index.gltf: meshes[0].primitives[0].indices: index 7 at element 2 is out of range (3 "
          "vertices)"},
-        {"base64.gltf", garbage, "base64.gltf: "},
+        {"base64.gltf", garbage,
+         "base64.gltf: buffers[0].uri: the data URI's payload is not base64"},
         {"cycle.gltf",
          triangle_json(uri, "", R"([{"mesh": 0}, {"children": [2]}, {"children": [1]}])"),
          "cycle.gltf: nodes[2].children: the node hierarchy has a cycle through nodes[1]"},

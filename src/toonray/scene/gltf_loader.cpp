@@ -1,10 +1,13 @@
 #include "toonray/scene/gltf_loader.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstring>
 #include <fmt/format.h>
 #include <map>
+#include <optional>
+#include <nlohmann/json.hpp>
 #include <tiny_gltf.h>
 
 #include "toonray/core/saturating.h"
@@ -969,6 +972,41 @@ private:
 };
 
 // tinygltf's first error, cut short: it may quote a whole data URI.
+// Whether a data URI's payload is base64 (RFC 4648 alphabet, '=' padding only at the end).
+bool is_base64(std::string_view text) {
+    std::size_t end = text.size();
+    int padding = 0;
+    while (end > 0 && text[end - 1] == '=' && padding < 2) --end, ++padding;
+    if (text.size() % 4 != 0) return false;
+    return std::all_of(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(end), [](char c) {
+        return std::isalnum(static_cast<unsigned char>(c)) || c == '+' || c == '/';
+    });
+}
+
+// tinygltf's message for a data URI that is not base64 names neither the buffer nor the image;
+// this finds it in the JSON text, for an error with its JSON path ("buffers[0].uri").
+std::optional<std::string> bad_data_uri(std::string_view json_text) {
+    const nlohmann::json doc =
+        nlohmann::json::parse(json_text, nullptr, /*allow_exceptions=*/false);
+    if (!doc.is_object()) return std::nullopt;
+    for (const char* array : {"buffers", "images"}) {
+        const auto found = doc.find(array);
+        if (found == doc.end() || !found->is_array()) continue;
+        for (std::size_t i = 0; i < found->size(); ++i) {
+            const nlohmann::json& item = (*found)[i];
+            if (!item.is_object() || !item.contains("uri") || !item["uri"].is_string()) continue;
+            const std::string& uri = item["uri"].get_ref<const std::string&>();
+            const std::size_t comma = uri.find(',');
+            if (uri.rfind("data:", 0) != 0 || comma == std::string::npos ||
+                uri.substr(0, comma).find(";base64") == std::string::npos)
+                continue;
+            if (!is_base64(std::string_view(uri).substr(comma + 1)))
+                return fmt::format("{}[{}].uri: the data URI's payload is not base64", array, i);
+        }
+    }
+    return std::nullopt;
+}
+
 std::string first_line(std::string text) {
     while (!text.empty() && (text.back() == '\n' || text.back() == ' ')) text.pop_back();
     if (auto nl = text.find('\n'); nl != std::string::npos) text.resize(nl);
@@ -1031,8 +1069,12 @@ GltfDocument parse_gltf(std::span<const std::uint8_t> bytes, const std::filesyst
     } catch (const std::exception& e) {
         throw Error(fmt::format("{}: {}", file, e.what()));
     }
-    if (!ok)
+    if (!ok) {
+        const std::string_view text(reinterpret_cast<const char*>(bytes.data()), bytes.size());
+        if (auto where = bad_data_uri(binary ? text.substr(20, read_u32(bytes.data() + 12)) : text))
+            throw Error(fmt::format("{}: {}", file, *where));
         throw Error(fmt::format("{}: {}", file, err.empty() ? "not a glTF file" : first_line(err)));
+    }
     DocumentReader reader(model, file, base_dir, warnings, options, context);
     return reader.read();
 }
