@@ -107,6 +107,16 @@ for frame, loc in ((1, (1.5, -6.5, 3.5)), (10, (-3.0, -5.5, 2.5))):
     cam.location = loc
     cam.keyframe_insert("location", frame=frame)
 cam_data.lens = 35.0
+# Blender's glTF exporter writes an object's own animation channels, not what a constraint adds:
+# bake the aim into rotation keys (and drop the constraint) so every route sees the same camera.
+aims = {}
+for frame in FRAMES:
+    scene.frame_set(frame)
+    aims[frame] = cam.matrix_world.to_euler("XYZ")
+cam.constraints.remove(track)
+for frame in FRAMES:
+    cam.rotation_euler = aims[frame]
+    cam.keyframe_insert("rotation_euler", frame=frame)
 for fc in (cam.animation_data.action.fcurves if cam.animation_data else []):
     for k in fc.keyframe_points:
         k.interpolation = "LINEAR"
@@ -121,6 +131,13 @@ for frame in FRAMES:
         directory=frames_dir, name="lit", frame_start=frame, frame_end=frame, frame_step=1)
     if "FINISHED" not in result:
         fail("export returned %s" % result)
+
+# ---- the same scene through Blender's own glTF exporter, its sun as KHR_lights_punctual ----
+result = bpy.ops.export_scene.gltf(filepath=os.path.join(WORK, "scene.glb"), export_format="GLB",
+                                   export_cameras=True, export_lights=True,
+                                   export_animations=True, export_yup=True)
+if "FINISHED" not in result:
+    fail("glTF export returned %s" % result)
 
 # ---- Cycles: n.l of the sun at pixel centres, and the object ids ----
 r.engine = "CYCLES"
