@@ -10,7 +10,7 @@
 # Environment: TOONRAY_BUILD_DIR (default build), TOONRAY_ASAN_BUILD_DIR (build-asan),
 # TOONRAY_FUZZ_BUILD_DIR (build-fuzz); TOONRAY_TEST_PORTABILITY=0 skips the clang, aarch64 and
 # frame comparison stages (the presets' build-clang and build-aarch64); TOONRAY_FUZZ_SECONDS, each target's fuzzing time (default
-# 45: ten targets, two at a time, about 4 minutes); TOONRAY_TEST_HARDENING=0 skips the
+# 45: thirteen targets, two at a time, about 5 minutes); TOONRAY_TEST_HARDENING=0 skips the
 # sanitizer and fuzz stages (15 to 20 minutes on an idle 2-core machine, mostly building) for a
 # quick local run.
 set -euo pipefail
