@@ -72,11 +72,21 @@ void RenderArgs::add_to(CLI::App& app) {
         ->capture_default_str();
     app.add_option("--line-color", line_colour, "Robust: line colour r,g,b in [0,1] or #rrggbb")
         ->capture_default_str();
-    app.add_option(
-           "--samples", samples,
-           "Robust: samples per pixel on a regular grid (1, 4, 9 or 16); lines and colours are "
-           "filtered down from it")
+    app.add_option("--samples", samples,
+                   "Robust and ink: samples per pixel on a regular grid (1, 4, 9 or 16); lines and "
+                   "colours are filtered down from it")
         ->check(CLI::IsMember({1, 4, 9, 16}))
+        ->capture_default_str();
+    app.add_option("--adaptive", adaptive,
+                   "Robust and ink: on traces one sample per pixel and the rest of the grid only "
+                   "where neighbours differ (colour, and for robust lines ids, normals, depth "
+                   "steps); off traces every sample of every pixel (full supersampling)")
+        ->check(CLI::IsMember({"on", "off"}))
+        ->capture_default_str();
+    app.add_option("--tile-size", tile_size,
+                   "Robust and ink: pixels per side of the buckets a frame is rendered in; "
+                   "memory follows the bucket, and the image is the same for any size")
+        ->check(CLI::Range(1, 4096))
         ->capture_default_str();
     app.add_option(
            "--depth-threshold", depth_threshold,
@@ -161,6 +171,8 @@ FrameOptions RenderArgs::resolve() const {
     o.settings.lines.width = line_width;
     o.settings.lines.colour = parse_colour(line_colour, "--line-color");
     o.settings.samples = samples;
+    o.settings.adaptive = adaptive == "on";
+    o.settings.tile_size = tile_size;
     o.settings.depth_threshold = depth_threshold;
     o.settings.normal_threshold = normal_threshold;
     o.settings.threads = threads;

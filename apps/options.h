@@ -34,6 +34,8 @@ struct RenderArgs {
     float line_width = RobustLineSettings{}.width;
     std::string line_colour = "0,0,0";
     int samples = RenderSettings{}.samples;
+    std::string adaptive = "on";
+    int tile_size = RenderSettings{}.tile_size;
     int threads = 0;
     int leaf_size = Bvh::Config{}.max_leaf_size;
     int png_level = PngOptions{}.level;

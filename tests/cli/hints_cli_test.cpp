@@ -68,7 +68,7 @@ TEST(HintsCli, LimitsNameOnlyTheOptionsOfTheCommand) {
         << error;
     // `piano` has: its frames in flight can be fewer.
     r = run_toonray("piano -o " + (dir / "p").string() +
-                    " --seconds 1 --size 1024x1024 --jobs 8 --max-memory 1G");
+                    " --seconds 1 --size 1024x1024 --jobs 8 --max-memory 64M");
     EXPECT_EQ(r.exit_code, 1);
     error = error_line(r.output);
     EXPECT_EQ(error.rfind("8 frames at once", 0), 0u) << error;

@@ -15,6 +15,7 @@
 #include "toonray/io/exr.h"
 #include "toonray/io/png.h"
 #include "toonray/scene/obj_loader.h"
+#include "support/test_scenes.h"
 #include "support/test_support.h"
 
 #if TOONRAY_WITH_OPENEXR
@@ -29,12 +30,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-Scene load(const std::string& name) {
-    Scene scene;
-    Warnings w;
-    load_obj(std::string(TOONRAY_TEST_DATA_DIR) + "/" + name, scene, w);
-    return scene;
-}
+Scene load(const std::string& name) { return test_support::load_test_scene(name); }
 
 // Renders the spot model with both PNG feature images and the EXR; returns the EXR's path.
 fs::path render_both(const fs::path& dir, EdgeMode mode) {

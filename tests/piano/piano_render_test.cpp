@@ -24,11 +24,16 @@ namespace fs = std::filesystem;
 
 bool same_bits(const Vec3f& a, const Vec3f& b) { return std::memcmp(&a, &b, sizeof(Vec3f)) == 0; }
 
-TEST(PianoRender, PosedPianoRoundTripsThroughObj) {
+// Forty overlapping notes over four seconds.
+Score forty_notes() {
     Score score;
     for (int i = 0; i < 40; ++i)
         score.notes.push_back({0.1 * i, 0.1 * i + 0.25, 40 + (i * 5) % 40, 80, 0});
-    const PianoPlayback play(score);
+    return score;
+}
+
+TEST(PianoRender, PosedPianoRoundTripsThroughObj) {
+    const PianoPlayback play(forty_notes());
     PianoOptions options;
     options.hole_capacity = play.hole_capacity();
     const PianoModel model = build_piano(options);
@@ -159,4 +164,39 @@ TEST(PianoRender, EverySurfaceSeenFromOutsideFacesTheViewer) {
 }
 
 }  // namespace
+// A piano frame adaptively sampled against full supersampling (--adaptive off): at most 0.5% of
+// pixels may differ by more than 2/255.
+TEST(PianoRender, AdaptiveSamplingStaysWithinFullSupersampling) {
+    const PianoPlayback play(forty_notes());
+    PianoOptions options;
+    options.hole_capacity = play.hole_capacity();
+    const PianoModel model = build_piano(options);
+    Scene scene = model.scene;
+    pose_piano(model, play.pose_at(1.25), &play.roll(), scene);
+    TriangleAccel accel;
+    accel.build(scene.positions, scene.tri_positions);
+    for (EdgeMode mode : {EdgeMode::Ink, EdgeMode::Robust}) {
+        RenderSettings settings;
+        settings.edges = mode;
+        settings.width = 640;
+        settings.height = 360;
+        Renderer adaptive, full;
+        const ImageRgb8 a = adaptive.render(scene, accel, *scene.camera, settings);
+        settings.adaptive = false;
+        const ImageRgb8& b = full.render(scene, accel, *scene.camera, settings);
+        std::size_t differing = 0;
+        for (std::size_t i = 0; i < a.size(); ++i) {
+            bool differs = false;
+            for (int c = 0; c < 3; ++c) differs |= std::abs(a.data()[i][c] - b.data()[i][c]) > 2;
+            differing += differs;
+        }
+        const double share = static_cast<double>(differing) / static_cast<double>(a.size());
+        std::printf("piano, %s: %.3f%% of pixels differ by more than 2/255; %.1f%% refined\n",
+                    mode == EdgeMode::Ink ? "ink" : "robust", 100 * share,
+                    100.0 * static_cast<double>(adaptive.refined_pixels()) / a.size());
+        EXPECT_LE(share, 0.005);
+        EXPECT_LT(adaptive.refined_pixels(), a.size() / 2);
+    }
+}
+
 }  // namespace toonray

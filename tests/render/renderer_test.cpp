@@ -11,6 +11,7 @@
 #include "toonray/io/png.h"
 #include "toonray/render/classic.h"
 #include "toonray/scene/obj_loader.h"
+#include "support/test_scenes.h"
 #include "support/test_support.h"
 
 using namespace toonray;
@@ -18,12 +19,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-Scene load(const std::string& name) {
-    Scene scene;
-    Warnings w;
-    load_obj(std::string(TOONRAY_TEST_DATA_DIR) + "/" + name, scene, w);
-    return scene;
-}
+Scene load(const std::string& name) { return test_support::load_test_scene(name); }
 
 // A square in the plane z = 0 from (-a,-a) to (a,a), facing +z, with the given Kd.
 Scene square(float a, Vec3f kd) {
@@ -39,10 +35,7 @@ Scene square(float a, Vec3f kd) {
 
 // The automatic camera for a whole scene at the settings' size.
 CameraSpec framing_camera(const Scene& s, const RenderSettings& settings) {
-    std::vector<Vec3f> used;
-    for (const auto& tri : s.tri_positions)
-        for (std::uint32_t v : tri) used.push_back(s.positions[v]);
-    return auto_camera(used, settings.width, settings.height);
+    return test_support::framing_camera(s, settings.width, settings.height);
 }
 
 template <typename T>
@@ -320,7 +313,8 @@ TEST(Renderer, FeatureImageTableListsEachModesImages) {
                                              "lines_material", "object_id", "material_id"}));
 }
 
-// frame_buffer_bytes counts exactly the buffers a renderer holds after a frame.
+// frame_buffer_bytes counts the buffers a renderer holds after a frame: exactly the frame-sized
+// ones, and per thread at most bucket_buffer_bytes (which every sample of a bucket reaches).
 TEST(Renderer, FrameBufferBytesCountTheBuffersRendererHolds) {
     Scene s = load("spot.obj");
     TriangleAccel accel;
@@ -330,7 +324,7 @@ TEST(Renderer, FrameBufferBytesCountTheBuffersRendererHolds) {
         int samples;
         float line_width;
     };
-    // The last case draws lines so wide that the full distance image is used.
+    // The last robust case draws lines so wide that each bucket uses the full distance image.
     for (const Case& c : {Case{EdgeMode::Classic, 1, 2.0f}, Case{EdgeMode::Robust, 1, 2.0f},
                           Case{EdgeMode::Robust, 4, 2.0f}, Case{EdgeMode::Robust, 9, 2.0f},
                           Case{EdgeMode::Robust, 4, 100.0f}, Case{EdgeMode::Ink, 1, 2.0f},
@@ -342,31 +336,41 @@ TEST(Renderer, FrameBufferBytesCountTheBuffersRendererHolds) {
         settings.width = 96;
         settings.height = 720;  // tall enough that 100-pixel lines need the full distance image
         settings.feature_images = true;
+        settings.adaptive = false;  // every sample traced: the buckets' largest buffers
+        settings.threads = 1;
         const CameraSpec cam = framing_camera(s, settings);
         Renderer r;
         const ImageRgb8& out = r.render(s, accel, cam, settings);
         const GBuffer& g = r.gbuffer();
         std::uint64_t held = bytes_of(out) + bytes_of(g.distance) + bytes_of(g.normal) +
                              bytes_of(g.view_depth) + bytes_of(g.geometric_normal) +
-                             bytes_of(g.colour) + bytes_of(g.material) + bytes_of(g.object) +
-                             bytes_of(r.line_seeds());
+                             bytes_of(g.colour) + bytes_of(g.material) + bytes_of(g.object);
         std::uint64_t features = 0;
         for (const FeatureImage& f : feature_images())
             features += std::visit([&](auto m) { return bytes_of(r.aovs().*m); }, f.image);
         held += features;
+        if (c.mode != EdgeMode::Classic) {
+            // The first samples' depths the depth feature image is scaled by.
+            features += static_cast<std::uint64_t>(settings.width) * settings.height * 4;
+            held += static_cast<std::uint64_t>(settings.width) * settings.height * 4;
+        }
         if (c.mode == EdgeMode::Ink) {
             const ink::InkLines& ink = r.ink_lines();
             // The line layer, and the same again while each line type's feature image is drawn.
             held += 2 * (bytes_of(ink.coverage) + bytes_of(ink.style));
         }
-        const bool full_distance = c.line_width > 50.0f;
-        if (full_distance) {
+        if (c.line_width > 50.0f) {
             EXPECT_GT(line_distance_band(line_thickness(c.line_width, settings.height, 2)),
                       kMaxDistanceBand);
-            held +=
-                bytes_of(g.colour) / sizeof(Vec3f) * sizeof(float);  // allocated while resolving
         }
-        EXPECT_EQ(frame_buffer_bytes(settings), held) << c.samples;
+        const std::uint64_t buckets =
+            c.mode == EdgeMode::Classic ? 0 : bucket_buffer_bytes(settings);
+        if (c.mode != EdgeMode::Classic) {
+            EXPECT_GT(r.bucket_bytes(), 0u);
+            EXPECT_LE(r.bucket_bytes(), buckets) << c.samples;
+            EXPECT_GT(r.bucket_bytes(), buckets / 2) << c.samples;  // not a loose bound
+        }
+        EXPECT_EQ(frame_buffer_bytes(settings), held + buckets) << c.samples;
         // Without feature images: classic keeps the maps its lines come from, less cel.
         settings.feature_images = false;
         const std::uint64_t kept =
@@ -375,11 +379,13 @@ TEST(Renderer, FrameBufferBytesCountTheBuffersRendererHolds) {
             c.mode == EdgeMode::Ink
                 ? bytes_of(r.ink_lines().coverage) + bytes_of(r.ink_lines().style)
                 : 0;
-        EXPECT_EQ(frame_buffer_bytes(settings), held - features + kept - type_layer) << c.samples;
+        EXPECT_EQ(frame_buffer_bytes(settings), held + buckets - features + kept - type_layer)
+            << c.samples;
     }
     RenderSettings huge;
     huge.width = huge.height = 2147483647;
-    huge.samples = 16;
+    huge.edges = EdgeMode::Ink;
+    huge.feature_images = true;
     EXPECT_EQ(frame_buffer_bytes(huge), UINT64_MAX);
 }
 

@@ -51,11 +51,16 @@ public:
     void reshape(int width, int height) {
         width_ = width;
         height_ = height;
-        pixels_.resize(static_cast<std::size_t>(width) * height);
+        const std::size_t n = static_cast<std::size_t>(width) * height;
+        // Exactly n when it grows (resize alone may take up to twice what is held).
+        if (n > pixels_.capacity()) pixels_.reserve(n);
+        pixels_.resize(n);
     }
     [[nodiscard]] int width() const { return width_; }
     [[nodiscard]] int height() const { return height_; }
     [[nodiscard]] std::size_t size() const { return pixels_.size(); }
+    /// Pixels the allocation holds (at least size(): it is kept when the image shrinks).
+    [[nodiscard]] std::size_t capacity() const { return pixels_.capacity(); }
     T& operator()(int x, int y) { return pixels_[static_cast<std::size_t>(y) * width_ + x]; }
     const T& operator()(int x, int y) const {
         return pixels_[static_cast<std::size_t>(y) * width_ + x];

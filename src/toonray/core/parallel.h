@@ -4,6 +4,8 @@
 
 #include <functional>
 
+#include <tbb/enumerable_thread_specific.h>
+
 namespace toonray {
 
 /// Runs body(begin, end) over [0, count) in chunks of `grain`, on at most `threads` threads
@@ -12,5 +14,23 @@ void parallel_for(int count, int grain, int threads, const std::function<void(in
 
 /// Hardware threads available to this process.
 int hardware_threads();
+
+/// One T for each thread that runs parallel_for bodies, made on its first use there and kept,
+/// so that per-thread buffers are allocated once for a whole animation. What a T holds must not
+/// decide any result (which thread runs which work varies from run to run).
+template <typename T>
+class PerThread {
+public:
+    /// The calling thread's T.
+    T& local() { return values_.local(); }
+    /// Every T made so far.
+    template <typename F>
+    void for_each(F&& f) const {
+        for (const T& value : values_) f(value);
+    }
+
+private:
+    tbb::enumerable_thread_specific<T> values_;
+};
 
 }  // namespace toonray

@@ -185,17 +185,17 @@ void compose_row(const float* colour, const float* weight3, int values, std::uin
     for (; i < values; ++i) out[i] = to_byte(colour[i] * weight3[i]);
 }
 
-// out = to_byte(colour) over a row's 3w channel values.
-void cel_row(const float* colour, int values, std::uint8_t* out) {
-    int i = 0;
-    for (; i + 16 <= values; i += 16) {
-        auto plain = [&](int j) { return to_byte_x4(_mm_loadu_ps(colour + i + j)); };
-        store_bytes_x16(out + i, plain(0), plain(4), plain(8), plain(12));
-    }
-    for (; i < values; ++i) out[i] = to_byte(colour[i]);
-}
 
 }  // namespace
+
+void to_bytes(const float* values, int n, std::uint8_t* bytes) {
+    int i = 0;
+    for (; i + 16 <= n; i += 16) {
+        auto plain = [&](int j) { return to_byte_x4(_mm_loadu_ps(values + i + j)); };
+        store_bytes_x16(bytes + i, plain(0), plain(4), plain(8), plain(12));
+    }
+    for (; i < n; ++i) bytes[i] = to_byte(values[i]);
+}
 
 float classic_cel_level(float l_dot_n) {
     static constexpr float kRamp[16] = {0.5f, 0.5f, 0.5f, 0.5f, 0.75f, 0.75f, 0.75f, 0.75f,
@@ -306,7 +306,7 @@ void compose_lines(const Image<Vec3f>& colour, const ImageGray8& edges, ImageRgb
             blur_weight_row(rows.up, rows.mid, rows.down, w, column.data(), weight3.data());
             const float* c = &colour.row(y)->x;
             compose_row(c, weight3.data(), 3 * w, out.row(y)->data());
-            if (cel) cel_row(c, 3 * w, cel->row(y)->data());
+            if (cel) to_bytes(c, 3 * w, cel->row(y)->data());
         }
     });
 }

@@ -59,4 +59,7 @@ inline std::uint8_t to_byte(float c) {
     return static_cast<std::uint8_t>(c * 255.0f + 0.5f);
 }
 
+/// to_byte over n values, sixteen at a time (the same bytes).
+void to_bytes(const float* values, int n, std::uint8_t* bytes);
+
 }  // namespace toonray

@@ -1,5 +1,6 @@
 #include "toonray/render/renderer.h"
 
+#include <atomic>
 #include <cmath>
 #include <limits>
 
@@ -8,7 +9,9 @@
 #include "toonray/core/error.h"
 #include "toonray/core/parallel.h"
 #include "toonray/core/saturating.h"
+#include "toonray/core/portable_math.h"
 #include "toonray/render/classic.h"
+#include "toonray/render/sampler.h"
 #include "toonray/render/trace.h"
 
 namespace toonray {
@@ -24,60 +27,32 @@ Rgb8 id_colour(std::uint32_t id) {
             static_cast<std::uint8_t>(64 + ((h >> 16) & 127))};
 }
 
-// Depth, normal and id images at pixel resolution from the first sample of each pixel.
-void gbuffer_feature_images(const GBuffer& g, Aovs& aovs) {
-    const int sub = g.sub;
-    const int w = g.view_depth.width() / sub, h = g.view_depth.height() / sub;
-    float z_max = 0.0f;
-    for (std::size_t i = 0; i < g.view_depth.size(); ++i)
-        if (std::isfinite(g.view_depth.data()[i])) z_max = std::max(z_max, g.view_depth.data()[i]);
-    aovs.depth.resize(w, h);
-    aovs.normal.resize(w, h);
-    aovs.object_id.resize(w, h);
-    aovs.material_id.resize(w, h);
-    for (int y = 0; y < h; ++y)
-        for (int x = 0; x < w; ++x) {
-            int fx = x * sub, fy = y * sub;
-            float z = g.view_depth(fx, fy);
-            aovs.depth(x, y) = std::isfinite(z) && z_max > 0
-                                   ? static_cast<std::uint8_t>(std::lround(z / z_max * 255.0f))
-                                   : 255;
-            Vec3f n = g.geometric_normal(fx, fy);
-            aovs.normal(x, y) = std::isfinite(z)
-                                    ? Rgb8{to_byte(n.x * 0.5f + 0.5f), to_byte(n.y * 0.5f + 0.5f),
-                                           to_byte(n.z * 0.5f + 0.5f)}
-                                    : Rgb8{0, 0, 0};
-            aovs.object_id(x, y) = id_colour(g.object(fx, fy));
-            aovs.material_id(x, y) = id_colour(g.material(fx, fy));
-        }
+// A feature image's byte for a normal: each channel's n * 0.5 + 0.5.
+Rgb8 normal_colour(const Vec3f& n) {
+    return {to_byte(n.x * 0.5f + 0.5f), to_byte(n.y * 0.5f + 0.5f), to_byte(n.z * 0.5f + 0.5f)};
 }
 
-// gbuffer_feature_images, and the line seeds of each type filtered down.
-void robust_feature_images(const GBuffer& g, const Image<std::uint8_t>& seeds, Aovs& aovs,
-                           int threads) {
-    gbuffer_feature_images(g, aovs);
-    resolve_seed_type(seeds, kLineSilhouette, g.sub, aovs.lines_silhouette, threads);
-    resolve_seed_type(seeds, kLineCrease, g.sub, aovs.lines_crease, threads);
-    resolve_seed_type(seeds, kLineDepth, g.sub, aovs.lines_depth, threads);
-    resolve_seed_type(seeds, kLineObject, g.sub, aovs.lines_object, threads);
-    resolve_seed_type(seeds, kLineMaterial, g.sub, aovs.lines_material, threads);
+// The depth feature image from each pixel's view depth: lighter is farther, scaled by the
+// farthest surface of the frame; 255 where nothing is seen.
+void depth_feature_image(const ImageF& depth, ImageGray8& out) {
+    const float z_max = largest_finite(depth);
+    out.reshape(depth.width(), depth.height());
+    for (std::size_t i = 0; i < depth.size(); ++i) {
+        const float z = depth.data()[i];
+        out.data()[i] = std::isfinite(z) && z_max > 0
+                            ? static_cast<std::uint8_t>(std::lround(z / z_max * 255.0f))
+                            : 255;
+    }
 }
 
-// The mean colour of each pixel's sub x sub samples, as bytes.
-void average_samples(const Image<Vec3f>& fine, int sub, ImageRgb8& out, int threads) {
-    const int w = fine.width() / sub, h = fine.height() / sub;
-    out.reshape(w, h);
-    const float inv_n = 1.0f / static_cast<float>(sub * sub);
-    parallel_for(h, 8, threads, [&](int y0, int y1) {
-        for (int y = y0; y < y1; ++y)
-            for (int x = 0; x < w; ++x) {
-                Vec3f sum(0.0f);
-                for (int j = 0; j < sub; ++j)
-                    for (int i = 0; i < sub; ++i) sum += fine(x * sub + i, y * sub + j);
-                out(x, y) = {to_byte(sum.x * inv_n), to_byte(sum.y * inv_n),
-                             to_byte(sum.z * inv_n)};
-            }
-    });
+// Copies the pixels of `to_rect` from `from`, whose pixel (0, 0) is pixel (from_x0, from_y0) of
+// the frame, into the frame image `to`.
+template <typename T>
+void copy_rect(const Image<T>& from, int from_x0, int from_y0, const PixelRect& to_rect,
+               Image<T>& to) {
+    for (int y = to_rect.y0; y < to_rect.y1; ++y)
+        std::copy_n(from.row(y - from_y0) + (to_rect.x0 - from_x0), to_rect.width(),
+                    to.row(y) + to_rect.x0);
 }
 
 }  // namespace
@@ -148,42 +123,85 @@ std::uint64_t feature_bytes_per_pixel(EdgeMode mode) {
 
 }  // namespace
 
+int robust_halo(float thickness, int sub) {
+    const float reach = thickness > 0.0f ? thickness * 0.5f + 0.5f : 0.0f;
+    const int fine = static_cast<int>(std::ceil(reach)) + 1;
+    return (fine + sub - 1) / sub;
+}
+
+std::uint64_t bucket_buffer_bytes(const RenderSettings& settings) {
+    const int sub = samples_per_side(settings.samples);
+    const bool robust = settings.edges == EdgeMode::Robust;
+    const float thickness =
+        robust ? line_thickness(settings.lines.width, settings.height, sub) : 0.0f;
+    const std::uint64_t halo = robust ? static_cast<std::uint64_t>(robust_halo(thickness, sub)) : 0;
+    // The largest bucket, grown by the halo (and one pixel more for the first samples) within
+    // the image.
+    const std::uint64_t tile = static_cast<std::uint64_t>(std::max(settings.tile_size, 1));
+    const std::uint64_t w = static_cast<std::uint64_t>(std::max(settings.width, 0));
+    const std::uint64_t h = static_cast<std::uint64_t>(std::max(settings.height, 0));
+    auto side = [&](std::uint64_t image, std::uint64_t grow) {
+        return std::min(image, std::min(tile, image) + 2 * grow);
+    };
+    const std::uint64_t decided = mul_saturated(side(w, halo), side(h, halo));
+    const std::uint64_t traced = mul_saturated(side(w, halo + 1), side(h, halo + 1));
+    const std::uint64_t samples = static_cast<std::uint64_t>(sub) * sub;
+    // A sample's colour, view depth, normal, ids and hit flag; while traced also its direction,
+    // hit and found flag.
+    const std::uint64_t surface = 2 * sizeof(Vec3f) + sizeof(float) + 2 * sizeof(std::uint32_t) + 1;
+    const std::uint64_t ray = sizeof(Vec3f) + sizeof(Hit) + 1;
+    // The rays of one traced tile and their sample columns and rows.
+    const std::uint64_t tile_rays = TriangleAccel::kTileSize * TriangleAccel::kTileSize;
+    std::uint64_t bytes =
+        tile_rays * ray + 2 * TriangleAccel::kTileSize * sizeof(int) + 3 * TriangleAccel::kTileSize;
+    // The first samples, with their colour keys and the differences to their neighbours.
+    bytes = add_saturated(bytes, mul_saturated(traced, surface + sizeof(std::uint32_t) + 2));
+    // Every other sample of every decided pixel, with its slot and flag.
+    bytes = add_saturated(
+        bytes, mul_saturated(decided, add_saturated(mul_saturated(samples - 1, surface + ray),
+                                                    1 + 2 * sizeof(std::uint32_t))));
+    if (robust) {
+        // The fine grid of decided pixels (depth, normal, colour, ids, seed), the resolved
+        // pixels (final, cel, edges, one line type) and, for very wide lines, the distances.
+        const std::uint64_t fine =
+            sizeof(float) + 2 * sizeof(Vec3f) + 2 * sizeof(std::uint32_t) + 1 +
+            (line_distance_band(thickness) > kMaxDistanceBand ? sizeof(float) : 0);
+        bytes = add_saturated(bytes, mul_saturated(mul_saturated(decided, samples), fine));
+        bytes = add_saturated(bytes, mul_saturated(decided, 2 * sizeof(Rgb8) + 2));
+    }
+    return bytes;
+}
+
 std::uint64_t frame_buffer_bytes(const RenderSettings& settings) {
     const std::uint64_t pixels =
         mul_saturated(static_cast<std::uint64_t>(std::max(settings.width, 0)),
                       static_cast<std::uint64_t>(std::max(settings.height, 0)));
     const std::uint64_t final_image = sizeof(Rgb8);
-    // Per sample, the G-buffer of prepare_gbuffer: colour, material and object, and the mode's
-    // depth and normal.
-    const std::uint64_t gbuffer =
-        sizeof(float) + sizeof(Vec3f) + sizeof(Vec3f) + 2 * sizeof(std::uint32_t);
     if (settings.edges == EdgeMode::Classic) {
-        // The maps the lines are drawn from (depth, normal, edges_depth, edges_normal, edges);
-        // cel only as a feature image.
+        // The G-buffer of prepare_gbuffer (distance, normal, colour, material, object), the
+        // maps the lines are drawn from (depth, normal, edges_depth, edges_normal, edges); cel
+        // only as a feature image.
+        const std::uint64_t gbuffer = sizeof(float) + 2 * sizeof(Vec3f) + 2 * sizeof(std::uint32_t);
         const std::uint64_t maps = 1 + sizeof(Rgb8) + 3;
         const std::uint64_t per_pixel =
             gbuffer + maps + final_image + (settings.feature_images ? sizeof(Rgb8) : 0);
         return mul_saturated(pixels, per_pixel);
     }
-    const std::uint64_t samples = static_cast<std::uint64_t>(std::max(settings.samples, 1));
-    const int sub = samples_per_side(settings.samples);
+    const int threads = settings.threads > 0 ? settings.threads : hardware_threads();
+    const std::uint64_t buckets = mul_saturated(static_cast<std::uint64_t>(std::max(threads, 1)),
+                                                bucket_buffer_bytes(settings));
+    // Feature images: the images themselves and the first samples' depths they are scaled by.
+    const std::uint64_t features =
+        settings.feature_images ? feature_bytes_per_pixel(settings.edges) + sizeof(float) : 0;
+    std::uint64_t per_pixel = final_image + features;
     if (settings.edges == EdgeMode::Ink) {
-        // The G-buffer, the line layer (coverage and style) and the final image; with feature
-        // images, also the layer one line type is drawn into. The edges, pieces and strokes
-        // grow with the scene, not the image: they are not counted here.
+        // The line layer (coverage and style); with feature images also the layer one line type
+        // is drawn into. The edges, pieces and strokes grow with the scene, not the image: they
+        // are not counted here.
         const std::uint64_t line_layer = sizeof(float) + sizeof(std::uint16_t);
-        const std::uint64_t per_pixel =
-            line_layer + final_image +
-            (settings.feature_images ? feature_bytes_per_pixel(EdgeMode::Ink) + line_layer : 0);
-        return mul_saturated(pixels, add_saturated(mul_saturated(gbuffer, samples), per_pixel));
+        per_pixel += line_layer + (settings.feature_images ? line_layer : 0);
     }
-    const float thickness = line_thickness(settings.lines.width, settings.height, sub);
-    const std::uint64_t per_sample =
-        gbuffer + 1 /* line seed */ +
-        (line_distance_band(thickness) > kMaxDistanceBand ? sizeof(float) : 0);
-    const std::uint64_t per_pixel =
-        final_image + (settings.feature_images ? feature_bytes_per_pixel(EdgeMode::Robust) : 0);
-    return mul_saturated(pixels, add_saturated(mul_saturated(per_sample, samples), per_pixel));
+    return add_saturated(mul_saturated(pixels, per_pixel), buckets);
 }
 
 void prepare_gbuffer(GBuffer& g, int width, int height, int sub, EdgeMode mode) {
@@ -261,11 +279,45 @@ void shade_tile(const ShadingContext& ctx, const ViewPlane& view, const RenderSe
     else shade_tile_rows<false>(ctx, view, settings.background, tile, g);
 }
 
+struct Renderer::Bucket {
+    PixelRect pixels;   ///< the bucket's own pixels
+    PixelRect decided;  ///< and the halo the robust lines need
+};
+
+/// One thread's buffers for its buckets.
+struct Renderer::BucketBuffers {
+    BucketSampler sampler;
+    GBuffer fine;  ///< robust lines: the fine grid of the bucket and its halo
+    Image<std::uint8_t> seeds;
+    ImageRgb8 resolved, cel;
+    ImageGray8 edges, lines;
+
+    [[nodiscard]] std::uint64_t bytes() const {
+        auto of = [](const auto& image) {
+            return static_cast<std::uint64_t>(image.capacity()) * sizeof(*image.data());
+        };
+        return sampler.bytes() + of(fine.view_depth) + of(fine.geometric_normal) + of(fine.colour) +
+               of(fine.material) + of(fine.object) + of(seeds) + of(resolved) + of(cel) +
+               of(edges) + of(lines);
+    }
+};
+
+Renderer::Renderer() : buckets_(std::make_unique<PerThread<BucketBuffers>>()) {}
+Renderer::~Renderer() = default;
+Renderer::Renderer(Renderer&&) noexcept = default;
+Renderer& Renderer::operator=(Renderer&&) noexcept = default;
+
+std::uint64_t Renderer::bucket_bytes() const {
+    std::uint64_t bytes = 0;
+    buckets_->for_each([&](const BucketBuffers& b) { bytes += b.bytes(); });
+    return bytes;
+}
+
 void Renderer::trace(const Scene& scene, const TriangleAccel& accel, const ViewPlane& view,
-                     const RenderSettings& settings, int sub, const TextureSet* textures) {
+                     const RenderSettings& settings, const TextureSet* textures) {
     const ShadingContext shading{scene, accel, settings.shading, lights_, textures};
-    prepare_gbuffer(gbuffer_, settings.width, settings.height, sub, settings.edges);
-    trace_primary(accel, view, settings.width, settings.height, sub, settings.threads,
+    prepare_gbuffer(gbuffer_, settings.width, settings.height, 1, settings.edges);
+    trace_primary(accel, view, settings.width, settings.height, 1, settings.threads,
                   [&](const SampleTile& t) { shade_tile(shading, view, settings, t, gbuffer_); });
 }
 
@@ -281,17 +333,17 @@ const ImageRgb8& Renderer::render(const Scene& scene, const TriangleAccel& accel
     light_ = settings.light ? *settings.light : default_light(scene, view);
     lights_ = settings.shading.lights;
     feature_images_ = settings.feature_images;
+    refined_pixels_ = 0;
     if (lights_.empty()) lights_.push_back(Light{Light::Kind::Point, light_, 1.0f});
     if (settings.edges == EdgeMode::Classic) {
-        trace(scene, accel, view, settings, 1, textures);
+        trace(scene, accel, view, settings, textures);
         render_classic(settings);
-    } else if (settings.edges == EdgeMode::Ink) {
-        trace(scene, accel, view, settings, samples_per_side(settings.samples), textures);
-        render_ink(scene, accel, camera, settings);
-    } else {
-        trace(scene, accel, view, settings, samples_per_side(settings.samples), textures);
-        render_robust(settings);
+        return final_;
     }
+    // The other modes keep no frame-sized G-buffer: they render bucket by bucket.
+    prepare_gbuffer(gbuffer_, 0, 0, 1, settings.edges);
+    render_buckets(scene, accel, view, settings, textures);
+    if (settings.edges == EdgeMode::Ink) render_ink(scene, accel, camera, settings);
     return final_;
 }
 
@@ -306,25 +358,122 @@ void Renderer::render_classic(const RenderSettings& settings) {
                   settings.feature_images ? &aovs_.cel : nullptr);
 }
 
-void Renderer::render_robust(const RenderSettings& settings) {
-    const int threads = settings.threads;
-    const GBuffer& g = gbuffer_;
-    FineBuffers fine{g.view_depth, g.geometric_normal, g.object, g.material};
-    find_line_seeds(fine, settings.lines, seeds_, threads);
-    float thickness = line_thickness(settings.lines.width, settings.height, g.sub);
-    // Distance to the seeds and line coverage in one banded pass: no full-size distance image.
+void Renderer::render_buckets(const Scene& scene, const TriangleAccel& accel, const ViewPlane& view,
+                              const RenderSettings& settings, const TextureSet* textures) {
+    const int w = settings.width, h = settings.height;
+    const int sub = samples_per_side(settings.samples);
+    const bool robust = settings.edges == EdgeMode::Robust;
     const bool features = settings.feature_images;
-    resolve_lines_from_seeds(g.colour, seeds_, thickness, g.sub, settings.lines.colour, final_,
-                             features ? &aovs_.cel : nullptr, features ? &aovs_.edges : nullptr,
-                             threads);
-    if (features) robust_feature_images(g, seeds_, aovs_, threads);
+    const ShadingContext shading{scene, accel, settings.shading, lights_, textures};
+    RefineRule rule;
+    if (robust) {
+        // The robust lines look for creases, depth steps and id changes between samples:
+        // pixels next to any of them take all samples. The thresholds are lower than the
+        // lines' (a quarter of the crease angle, half the depth step) because first samples
+        // are a pixel apart: on the piano's mouldings half the crease angle let through thin
+        // chamfers and left 0.5% of pixels off full supersampling, a quarter 0.1%.
+        rule.surface = true;
+        rule.cos_normal = portable::cos(settings.lines.crease_angle * 0.25f * 3.14159265f / 180.0f);
+        rule.depth_step = settings.lines.depth_threshold * 0.5f;
+    }
+    const SamplerFrame frame{accel, shading, view,    settings.background,
+                             w,     h,       sub,     settings.adaptive,
+                             rule,  robust,  features};
+    const float thickness = robust ? line_thickness(settings.lines.width, h, sub) : 0.0f;
+    const int halo = robust ? robust_halo(thickness, sub) : 0;
+
+    final_.reshape(w, h);
+    if (features) {
+        first_depth_.reshape(w, h);
+        aovs_.normal.reshape(w, h);
+        aovs_.object_id.reshape(w, h);
+        aovs_.material_id.reshape(w, h);
+        if (robust) {
+            aovs_.cel.reshape(w, h);
+            aovs_.edges.reshape(w, h);
+            for (ImageGray8 Aovs::*type :
+                 {&Aovs::lines_silhouette, &Aovs::lines_crease, &Aovs::lines_depth,
+                  &Aovs::lines_object, &Aovs::lines_material})
+                (aovs_.*type).reshape(w, h);
+        }
+    } else {
+        first_depth_.reshape(0, 0);
+    }
+    const BucketGrid grid{w, h, std::max(settings.tile_size, 1)};
+    std::atomic<std::uint64_t> refined{0};
+    parallel_for(grid.count(), 1, settings.threads, [&](int begin, int end) {
+        BucketBuffers& b = buckets_->local();
+        for (int index = begin; index < end; ++index) {
+            Bucket bucket;
+            bucket.pixels = grid.bucket(index);
+            bucket.decided = bucket.pixels.grown(halo, w, h);
+            b.sampler.sample(frame, bucket.decided.grown(1, w, h), bucket.decided);
+            if (robust) resolve_robust_bucket(bucket, b, settings);
+            else resolve_ink_bucket(bucket, b);
+            if (features) first_sample_features(bucket, b);
+            std::uint64_t count = 0;
+            for (int y = bucket.pixels.y0; y < bucket.pixels.y1; ++y)
+                for (int x = bucket.pixels.x0; x < bucket.pixels.x1; ++x)
+                    count += b.sampler.refined(x, y) ? 1 : 0;
+            refined += count;
+        }
+    });
+    refined_pixels_ = refined;
+    if (features) depth_feature_image(first_depth_, aovs_.depth);
+}
+
+void Renderer::resolve_robust_bucket(const Bucket& bucket, BucketBuffers& b,
+                                     const RenderSettings& settings) {
+    const int sub = samples_per_side(settings.samples);
+    GBuffer& g = b.fine;
+    g.sub = sub;
+    b.sampler.fill_fine(g.view_depth, g.geometric_normal, g.colour, g.material, g.object);
+    find_line_seeds(FineBuffers{g.view_depth, g.geometric_normal, g.object, g.material},
+                    settings.lines, b.seeds, 1);
+    const float thickness = line_thickness(settings.lines.width, settings.height, sub);
+    const bool features = settings.feature_images;
+    // Distance to the seeds and line coverage in one banded pass, over the bucket and its
+    // halo; the bucket's own pixels are exact (robust_halo).
+    resolve_lines_from_seeds(g.colour, b.seeds, thickness, sub, settings.lines.colour, b.resolved,
+                             features ? &b.cel : nullptr, features ? &b.edges : nullptr, 1);
+    const int x0 = bucket.decided.x0, y0 = bucket.decided.y0;
+    copy_rect(b.resolved, x0, y0, bucket.pixels, final_);
+    if (!features) return;
+    copy_rect(b.cel, x0, y0, bucket.pixels, aovs_.cel);
+    copy_rect(b.edges, x0, y0, bucket.pixels, aovs_.edges);
+    static constexpr std::pair<unsigned, ImageGray8 Aovs::*> kTypes[] = {
+        {kLineSilhouette, &Aovs::lines_silhouette},
+        {kLineCrease, &Aovs::lines_crease},
+        {kLineDepth, &Aovs::lines_depth},
+        {kLineObject, &Aovs::lines_object},
+        {kLineMaterial, &Aovs::lines_material}};
+    for (const auto& [type, image] : kTypes) {
+        resolve_seed_type(b.seeds, type, sub, b.lines, 1);
+        copy_rect(b.lines, x0, y0, bucket.pixels, aovs_.*image);
+    }
+}
+
+void Renderer::resolve_ink_bucket(const Bucket& bucket, const BucketBuffers& b) {
+    b.sampler.resolve_colours(bucket.pixels, final_, 0, 0);
+}
+
+void Renderer::first_sample_features(const Bucket& bucket, const BucketBuffers& b) {
+    const SurfaceSamples& first = b.sampler.first();
+    for (int y = bucket.pixels.y0; y < bucket.pixels.y1; ++y)
+        for (int x = bucket.pixels.x0; x < bucket.pixels.x1; ++x) {
+            const std::size_t i = b.sampler.first_index(x, y);
+            const bool found = first.found[i] != 0;
+            first_depth_(x, y) =
+                found ? first.view_depth[i] : std::numeric_limits<float>::infinity();
+            aovs_.normal(x, y) = found ? normal_colour(first.normal[i]) : Rgb8{0, 0, 0};
+            aovs_.object_id(x, y) = id_colour(found ? first.object[i] : kNoIndex);
+            aovs_.material_id(x, y) = id_colour(found ? first.material[i] : kNoIndex);
+        }
 }
 
 void Renderer::render_ink(const Scene& scene, const TriangleAccel& accel, const CameraSpec& camera,
                           const RenderSettings& settings) {
     const int threads = settings.threads;
-    const GBuffer& g = gbuffer_;
-    average_samples(g.colour, g.sub, final_, threads);
     const bool features = settings.feature_images;
     if (features) aovs_.cel = final_;
     ink::draw_ink_lines(scene, accel, camera, settings.width, settings.height,
@@ -333,7 +482,6 @@ void Renderer::render_ink(const Scene& scene, const TriangleAccel& accel, const 
     if (features) {
         ink::coverage_to_gray(ink_.coverage, aovs_.edges);
         ink_type_feature_images(settings, threads);
-        gbuffer_feature_images(g, aovs_);
     }
 }
 

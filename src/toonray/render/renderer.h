@@ -2,6 +2,7 @@
 /// Renders a scene to a cel-shaded, outlined image and its feature images (AOVs).
 
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <span>
 #include <string_view>
@@ -9,6 +10,7 @@
 
 #include "toonray/accel/triangle_accel.h"
 #include "toonray/core/image.h"
+#include "toonray/core/parallel.h"
 #include "toonray/ink/ink.h"
 #include "toonray/render/robust.h"
 #include "toonray/render/shading.h"
@@ -38,6 +40,13 @@ struct RenderSettings {
     float normal_threshold = 4.0f;  ///< classic: Sobel magnitude on the 8-bit normal map
     RobustLineSettings lines;       ///< robust and ink: line types, crease angle, width, colour
     int samples = 4;  ///< robust and ink: samples per pixel on a regular grid (1, 4, 9 or 16)
+    /// Robust and ink: adaptive sampling (render/sampler.h): one sample per pixel, and the
+    /// whole grid only where neighbours differ. false: every pixel takes every sample (full
+    /// supersampling, the reference the adaptive frames are measured against).
+    bool adaptive = true;
+    /// Robust and ink: pixels per side of the buckets the frame is rendered in. Memory follows
+    /// the bucket, not the image; the frame is the same for any size.
+    int tile_size = 64;
     int threads = 0;  ///< 0 = all hardware threads
     /// Also compute the feature images (Renderer::aovs). The final image is the same either way.
     bool feature_images = false;
@@ -54,8 +63,9 @@ struct RenderSettings {
 /// ("N samples per pixel: ...") otherwise.
 int samples_per_side(int samples);
 
-/// Per-sample results of the primary rays. Classic mode fills distance and normal; robust mode
-/// fills view_depth and geometric_normal, on a grid `sub` times finer than the image.
+/// Per-sample results of the primary rays. Classic mode fills distance and normal, one sample
+/// per pixel, for the whole frame; the robust lines fill view_depth and geometric_normal, on a
+/// grid `sub` times finer than the image, one bucket (and its halo) at a time.
 struct GBuffer {
     int sub = 1;                    ///< samples per pixel side
     ImageF distance;                ///< Euclidean distance from the eye; +inf where the ray misses
@@ -103,12 +113,23 @@ struct FeatureImage {
 /// lines_border, lines_intersection, lines_polyline), object_id, material_id.
 std::span<const FeatureImage> feature_images();
 
-/// Bytes of the buffers Renderer keeps for a frame with `settings`: the G-buffer at the mode's
-/// samples, the line seeds and (for very wide lines) the full distance image in robust mode,
-/// classic mode's maps, the final image, and the feature images when settings.feature_images
-/// asks for them. Per-thread scratch rows and tiles are not counted. Saturates at UINT64_MAX;
-/// throws Error for a robust sample count that samples_per_side rejects.
+/// Bytes of the buffers Renderer keeps for a frame with `settings`: classic mode's G-buffer and
+/// maps; for robust and ink lines each thread's bucket buffers (at most every sample of a
+/// bucket, its halo and, for very wide robust lines, its distance image) and the ink line
+/// layer; the final image, and the feature images when settings.feature_images asks for them.
+/// Per-thread scratch rows are not counted. Saturates at UINT64_MAX; throws Error for a sample
+/// count that samples_per_side rejects.
 [[nodiscard]] std::uint64_t frame_buffer_bytes(const RenderSettings& settings);
+
+/// Bytes of one thread's bucket buffers for `settings` (robust and ink), at most: what they
+/// reach when every sample of the largest bucket is traced. Throws Error for a sample count
+/// that samples_per_side rejects.
+[[nodiscard]] std::uint64_t bucket_buffer_bytes(const RenderSettings& settings);
+
+/// Robust lines: pixels around a bucket whose samples its lines depend on. A line covers fine
+/// samples nearer than thickness / 2 + 0.5 to its seeds, and a seed depends on the samples next
+/// to it, so the bucket's fine grid is grown by that reach plus one sample, in whole pixels.
+[[nodiscard]] int robust_halo(float thickness, int sub);
 
 /// The ink lines' settings from a frame's: crease angle and width from `lines`, and its types
 /// mapped to the ink's: silhouette -> silhouettes and borders, crease -> creases, material ->
@@ -129,6 +150,11 @@ void shade_tile(const ShadingContext& ctx, const ViewPlane& view, const RenderSe
 /// Renders frames, keeping its buffers between calls so an animation allocates once.
 class Renderer {
 public:
+    Renderer();
+    ~Renderer();
+    Renderer(Renderer&&) noexcept;
+    Renderer& operator=(Renderer&&) noexcept;
+
     /// Renders the final image. `textures` are the decoded textures of the scene's materials
     /// (null: none). Never throws for a valid scene, camera and settings; the camera must
     /// already have been validated (make_view_plane throws on a bad one).
@@ -136,22 +162,33 @@ public:
                             const CameraSpec& camera, const RenderSettings& settings,
                             const TextureSet* textures = nullptr);
 
-    /// Valid after render(): the G-buffer of the last frame.
+    /// Classic mode, after render(): the G-buffer of the last frame (empty in the other modes,
+    /// which keep no frame-sized G-buffer).
     [[nodiscard]] const GBuffer& gbuffer() const { return gbuffer_; }
+    /// Robust and ink: the pixels of the last frame that took all their samples.
+    [[nodiscard]] std::uint64_t refined_pixels() const { return refined_pixels_; }
+    /// Bytes held now by the per-thread bucket buffers (for memory accounting).
+    [[nodiscard]] std::uint64_t bucket_bytes() const;
     /// The feature images of the last frame; all empty unless its settings.feature_images.
     [[nodiscard]] const Aovs& aovs() const;
     /// The single point light of the last frame (settings.light or the default).
     [[nodiscard]] Vec3f light() const { return light_; }
-    /// Robust mode: the line seeds of the last frame on the fine grid (LineType bits).
-    [[nodiscard]] const Image<std::uint8_t>& line_seeds() const { return seeds_; }
     /// Ink mode: the last frame's feature edges, pieces, strokes (for SVG) and line coverage.
     [[nodiscard]] const ink::InkLines& ink_lines() const { return ink_; }
 
 private:
+    struct Bucket;
+    struct BucketBuffers;
+
     void trace(const Scene& scene, const TriangleAccel& accel, const ViewPlane& view,
-               const RenderSettings& settings, int sub, const TextureSet* textures);
+               const RenderSettings& settings, const TextureSet* textures);
     void render_classic(const RenderSettings& settings);
-    void render_robust(const RenderSettings& settings);
+    void render_buckets(const Scene& scene, const TriangleAccel& accel, const ViewPlane& view,
+                        const RenderSettings& settings, const TextureSet* textures);
+    void resolve_robust_bucket(const Bucket& bucket, BucketBuffers& b,
+                               const RenderSettings& settings);
+    void resolve_ink_bucket(const Bucket& bucket, const BucketBuffers& b);
+    void first_sample_features(const Bucket& bucket, const BucketBuffers& b);
     void render_ink(const Scene& scene, const TriangleAccel& accel, const CameraSpec& camera,
                     const RenderSettings& settings);
     void ink_type_feature_images(const RenderSettings& settings, int threads);
@@ -160,7 +197,9 @@ private:
     Aovs aovs_;  ///< classic mode draws its lines from depth, normal and edges* here
     bool feature_images_ = false;
     ImageRgb8 final_;
-    Image<std::uint8_t> seeds_;
+    ImageF first_depth_;  ///< feature images: each pixel's first sample's view depth
+    std::unique_ptr<PerThread<BucketBuffers>> buckets_;
+    std::uint64_t refined_pixels_ = 0;
     ink::InkLines ink_;
     Vec3f light_;
     std::vector<Light> lights_;

@@ -1,7 +1,9 @@
 #pragma once
-/// Primary rays: one per sample on a regular grid, traced tile by tile. Each finished tile is
-/// handed to a callback that shades it, so tracing can batch rays however it likes (packets,
-/// frustums) while shading stays per sample.
+/// Primary rays: one per sample on a regular grid of sub x sub samples per pixel. Sample
+/// (x, y) of the fine grid goes through view.pixel_point((x + 0.5) / sub, (y + 0.5) / sub)
+/// (exactly the pixel centre when sub = 1) from view.eye, with a unit direction. Tracing runs
+/// tile by tile; each finished tile is handed to a callback that shades it, so tracing can
+/// batch rays however it likes (packets, frustums) while shading stays per sample.
 
 #include <functional>
 
@@ -23,9 +25,17 @@ struct SampleTile {
 
 using TileShader = std::function<void(const SampleTile&)>;
 
-/// Traces the samples of a width x height image with sub x sub samples per pixel. Sample
-/// (x, y) of the fine grid goes through view.pixel_point((x + 0.5) / sub, (y + 0.5) / sub)
-/// (exactly the pixel centre when sub = 1) from view.eye, with a unit direction. Tiles run
+/// The unit direction of fine-grid sample (x, y) with `sub` samples per pixel side:
+/// normalize(view.pixel_point(fx, fy) - view.eye), fx = (x + 0.5) / sub (x + 0.5 when sub is
+/// 1), rounded exactly as every other way this file makes directions.
+Vec3f sample_direction(const ViewPlane& view, int x, int y, int sub);
+
+/// The directions of every fine-grid sample (xs[i], ys[j]), row by row (j outer), into dirs
+/// (nx * ny of them): bit-identical to sample_direction, four at a time.
+void grid_directions(const ViewPlane& view, int sub, const int* xs, int nx, const int* ys, int ny,
+                     Vec3f* dirs);
+
+/// Traces the samples of a width x height image with sub x sub samples per pixel. Tiles run
 /// in parallel on `threads` threads (0 = all); each is shaded by exactly one call, so results
 /// never depend on the thread count.
 void trace_primary(const TriangleAccel& accel, const ViewPlane& view, int width, int height,

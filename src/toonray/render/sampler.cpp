@@ -1,0 +1,355 @@
+#include "toonray/render/sampler.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "toonray/render/classic.h"
+#include "toonray/render/trace.h"
+
+namespace toonray {
+namespace {
+
+constexpr float kInf = std::numeric_limits<float>::infinity();
+constexpr int kTile = TriangleAccel::kTileSize;
+// Refined samples are traced as a grid this many rays wide, so that each 4 x 2 packet of
+// intersect_tile holds 8 consecutive samples of the list (neighbouring pixels' samples).
+constexpr int kListWidth = 4;
+
+// Shades n traced samples into out[offset, offset + n): the colour always, and the view depth,
+// geometric normal and ids when `surface`. The per-sample work of the renderer's G-buffer
+// (shade_tile in renderer.cpp does the same for whole tiles).
+void shade_samples(const SamplerFrame& f, int n, const Vec3f* dirs, const Hit* hits,
+                   const bool* found, SurfaceSamples& out, std::size_t offset, bool surface) {
+    const ShadingContext& ctx = f.shading;
+    const Scene& scene = ctx.scene;
+    const Light* plain = plain_point_light(ctx);  // the common case, shaded inline below
+    Vec3f* colour = out.colour.data() + offset;
+    std::uint8_t* hit_found = out.found.data() + offset;
+    for (int i = 0; i < n; ++i) {
+        hit_found[i] = found[i] ? 1 : 0;
+        if (!found[i]) {
+            colour[i] = f.background;
+            if (surface) {
+                out.view_depth[offset + i] = kInf;
+                out.normal[offset + i] = Vec3f(0.0f);
+                out.material[offset + i] = kNoIndex;
+                out.object[offset + i] = kNoIndex;
+            }
+            continue;
+        }
+        const Hit& hit = hits[i];
+        const Vec3f& dir = dirs[i];
+        const Vec3f normal = shading_normal(scene, hit, dir);
+        const std::uint32_t m = scene.tri_material[hit.prim];
+        colour[i] = plain && !material_texture(ctx, m)
+                        ? shade_plain(ctx, *plain, hit, f.view.eye, dir, normal)
+                        : shade_hit(ctx, hit, f.view.eye, dir, normal);
+        if (surface) {
+            out.view_depth[offset + i] = hit.t * dot(dir, f.view.forward);
+            out.normal[offset + i] = geometric_normal(scene, hit, dir);
+            out.material[offset + i] = m;
+            out.object[offset + i] = scene.tri_object[hit.prim];
+        }
+    }
+}
+
+}  // namespace
+
+PixelRect PixelRect::grown(int by, int width, int height) const {
+    return {std::max(0, x0 - by), std::max(0, y0 - by), std::min(width, x1 + by),
+            std::min(height, y1 + by)};
+}
+
+PixelRect BucketGrid::bucket(int index) const {
+    const int cx = index % columns(), cy = index / columns();
+    return {cx * size, cy * size, std::min(width, (cx + 1) * size),
+            std::min(height, (cy + 1) * size)};
+}
+
+namespace {
+
+// v.resize(n), allocating exactly n when it grows (resize alone may take up to twice what is
+// held), so that the buffers' size is what frame_buffer_bytes expects.
+template <typename T>
+void resize_exact(std::vector<T>& v, std::size_t n) {
+    if (n > v.capacity()) v.reserve(n);
+    v.resize(n);
+}
+
+}  // namespace
+
+void SurfaceSamples::resize(std::size_t n) {
+    resize_exact(colour, n);
+    resize_exact(view_depth, n);
+    resize_exact(normal, n);
+    resize_exact(material, n);
+    resize_exact(object, n);
+    resize_exact(found, n);
+}
+
+std::uint64_t SurfaceSamples::bytes() const {
+    return colour.capacity() * sizeof(Vec3f) + view_depth.capacity() * sizeof(float) +
+           normal.capacity() * sizeof(Vec3f) + material.capacity() * sizeof(std::uint32_t) +
+           object.capacity() * sizeof(std::uint32_t) + found.capacity();
+}
+
+std::uint64_t BucketSampler::bytes() const {
+    return first_.bytes() + rest_.bytes() + refine_.capacity() +
+           (refined_pixels_.capacity() + refined_slot_.capacity()) * sizeof(std::uint32_t) +
+           (dirs_.capacity() + rest_dirs_.capacity()) * sizeof(Vec3f) +
+           hits_.capacity() * sizeof(Hit) + hit_found_size_ +
+           (columns_.capacity() + rows_.capacity()) * sizeof(int);
+}
+
+void BucketSampler::sample(const SamplerFrame& frame, const PixelRect& traced,
+                           const PixelRect& decided) {
+    frame_ = &frame;
+    traced_ = traced;
+    decided_ = decided;
+    sub_ = frame.sub;
+    trace_first(frame);
+    decide(frame);
+    trace_refined(frame);
+}
+
+void BucketSampler::trace_first(const SamplerFrame& frame) {
+    const int tw = traced_.width(), th = traced_.height();
+    first_.resize(static_cast<std::size_t>(tw) * th);
+    resize_exact(key_, static_cast<std::size_t>(tw) * th);
+    resize_exact(key_bytes_, 3 * kTile);
+    resize_exact(dirs_, kTile * kTile);
+    resize_exact(hits_, std::max<std::size_t>(hits_.size(), kTile * kTile));
+    if (hit_found_size_ < static_cast<std::size_t>(kTile * kTile)) {
+        hit_found_size_ = kTile * kTile;
+        hit_found_ = std::make_unique<bool[]>(hit_found_size_);
+    }
+    resize_exact(columns_, kTile);
+    resize_exact(rows_, kTile);
+    const bool surface = frame.rule.surface || frame.surface_of_all || frame.surface_of_first;
+    for (int ty = traced_.y0; ty < traced_.y1; ty += kTile) {
+        const int rows = std::min(kTile, traced_.y1 - ty);
+        for (int j = 0; j < rows; ++j) rows_[j] = (ty + j) * sub_;
+        for (int tx = traced_.x0; tx < traced_.x1; tx += kTile) {
+            const int cols = std::min(kTile, traced_.x1 - tx);
+            for (int i = 0; i < cols; ++i) columns_[i] = (tx + i) * sub_;
+            grid_directions(frame.view, sub_, columns_.data(), cols, rows_.data(), rows,
+                            dirs_.data());
+            frame.accel.intersect_tile(frame.view.eye, dirs_.data(), cols, rows, hits_.data(),
+                                       hit_found_.get());
+            for (int j = 0; j < rows; ++j) {
+                const std::size_t at = static_cast<std::size_t>(j) * cols;
+                const std::size_t to = first_index(tx, ty + j);
+                shade_samples(frame, cols, dirs_.data() + at, hits_.data() + at,
+                              hit_found_.get() + at, first_, to, surface);
+                to_bytes(&first_.colour[to].x, 3 * cols, key_bytes_.data());
+                for (int i = 0; i < cols; ++i) {
+                    const std::uint8_t* b = key_bytes_.data() + 3 * i;
+                    key_[to + i] = b[0] | (b[1] << 8) | (b[2] << 16) |
+                                   (first_.found[to + i] ? 0u : 1u << 24);
+                }
+            }
+        }
+    }
+}
+
+namespace {
+
+// Whether the surfaces seen by first samples a and b differ (for robust lines): both hit, and
+// their ids or normals differ. Whether they hit at all is in their colour keys.
+inline bool surfaces_differ(const SurfaceSamples& s, std::size_t a, std::size_t b,
+                            const RefineRule& rule) {
+    return (s.found[a] & s.found[b]) &
+           ((s.object[a] != s.object[b]) | (s.material[a] != s.material[b]) |
+            (dot(s.normal[a], s.normal[b]) < rule.cos_normal));
+}
+
+}  // namespace
+
+bool BucketSampler::depth_step(const SamplerFrame& frame, int x, int y) const {
+    const SurfaceSamples& s = first_;
+    const std::size_t centre = first_index(x, y);
+    if (!s.found[centre]) return false;
+    const float inv = 1.0f / s.view_depth[centre];
+    auto step = [&](int dx, int dy) {
+        const int ax = x - dx, ay = y - dy, bx = x + dx, by = y + dy;
+        if (ax < 0 || ay < 0 || bx >= frame.width || by >= frame.height) return false;
+        const std::size_t a = first_index(ax, ay), b = first_index(bx, by);
+        if (!s.found[a] || !s.found[b]) return false;  // silhouettes differ in found
+        const float second = 1.0f / s.view_depth[a] - 2.0f * inv + 1.0f / s.view_depth[b];
+        return std::abs(second) > frame.rule.depth_step * inv;
+    };
+    return step(1, 0) || step(0, 1);
+}
+
+void BucketSampler::mark_differences(const RefineRule& rule) {
+    // Each pair of 4-neighbours of the traced pixels once: with the pixel to the right, and
+    // with the one below. Pixels at the traced rectangle's edge have no pair beyond it.
+    const int tw = traced_.width(), th = traced_.height();
+    const std::size_t n = static_cast<std::size_t>(tw) * th;
+    differs_right_.assign(n, 0);
+    differs_below_.assign(n, 0);
+    const std::uint32_t* key = key_.data();
+    for (int y = 0; y < th; ++y) {
+        const std::size_t row = static_cast<std::size_t>(y) * tw;
+        std::uint8_t* right = differs_right_.data() + row;
+        for (int x = 0; x + 1 < tw; ++x) right[x] = key[row + x] != key[row + x + 1];
+        if (y + 1 == th) continue;
+        std::uint8_t* below = differs_below_.data() + row;
+        for (int x = 0; x < tw; ++x) below[x] = key[row + x] != key[row + x + tw];
+        if (!rule.surface) continue;
+        for (int x = 0; x + 1 < tw; ++x) right[x] |= surfaces_differ(first_, row + x, row + x + 1, rule);
+        for (int x = 0; x < tw; ++x) below[x] |= surfaces_differ(first_, row + x, row + x + tw, rule);
+    }
+}
+
+void BucketSampler::decide(const SamplerFrame& frame) {
+    const int dw = decided_.width(), dh = decided_.height();
+    const bool all = !frame.adaptive && sub_ > 1;
+    refine_.assign(static_cast<std::size_t>(dw) * dh, all ? 1 : 0);
+    if (all || sub_ == 1) return;
+    mark_differences(frame.rule);
+    // A pixel takes all its samples when it differs from a neighbour (which the precondition
+    // on `decided` puts inside `traced` whenever it is inside the image).
+    const int tw = traced_.width();
+    for (int y = decided_.y0; y < decided_.y1; ++y)
+        for (int x = decided_.x0; x < decided_.x1; ++x) {
+            const std::size_t i = first_index(x, y);
+            bool refine = differs_right_[i] | differs_below_[i];
+            if (x > traced_.x0) refine |= differs_right_[i - 1] != 0;
+            if (y > traced_.y0) refine |= differs_below_[i - tw] != 0;
+            if (!refine && frame.rule.surface) refine = depth_step(frame, x, y);
+            refine_[static_cast<std::size_t>(y - decided_.y0) * dw + (x - decided_.x0)] = refine;
+        }
+}
+
+void BucketSampler::trace_refined(const SamplerFrame& frame) {
+    const int dw = decided_.width();
+    const int per_pixel = sub_ * sub_ - 1;
+    // Sized before filling (not grown), so that the buffers hold no more than they need.
+    resize_exact(refined_pixels_, static_cast<std::size_t>(std::count(refine_.begin(), refine_.end(), 1)));
+    refined_slot_.assign(refine_.size(), kNoIndex);
+    std::size_t count = 0;
+    for (std::size_t p = 0; p < refine_.size(); ++p)
+        if (refine_[p]) {
+            refined_slot_[p] = static_cast<std::uint32_t>(count * per_pixel);
+            refined_pixels_[count++] = static_cast<std::uint32_t>(p);
+        }
+    const std::size_t n = refined_pixels_.size() * per_pixel;
+    rest_.resize(n);
+    if (n == 0) return;
+    const std::size_t padded = (n + kListWidth - 1) / kListWidth * kListWidth;
+    resize_exact(rest_dirs_, padded);
+    std::size_t k = 0;
+    for (std::uint32_t p : refined_pixels_) {
+        const int x = decided_.x0 + static_cast<int>(p % dw), y = decided_.y0 + static_cast<int>(p / dw);
+        for (int j = 0; j < sub_; ++j)
+            for (int i = 0; i < sub_; ++i)
+                if (i != 0 || j != 0)
+                    rest_dirs_[k++] = sample_direction(frame.view, x * sub_ + i, y * sub_ + j, sub_);
+    }
+    std::fill(rest_dirs_.begin() + static_cast<std::ptrdiff_t>(n), rest_dirs_.end(), rest_dirs_[n - 1]);
+    resize_exact(hits_, padded);
+    if (hit_found_size_ < padded) {
+        hit_found_size_ = padded;
+        hit_found_ = std::make_unique<bool[]>(hit_found_size_);
+    }
+    frame.accel.intersect_tile(frame.view.eye, rest_dirs_.data(), kListWidth,
+                               static_cast<int>(padded / kListWidth), hits_.data(),
+                               hit_found_.get());
+    shade_samples(frame, static_cast<int>(n), rest_dirs_.data(), hits_.data(), hit_found_.get(),
+                  rest_, 0, frame.rule.surface || frame.surface_of_all);
+}
+
+void BucketSampler::resolve_colours(const PixelRect& rect, ImageRgb8& out, int out_x0,
+                                    int out_y0) const {
+    const int n = sub_ * sub_;
+    const float inv_n = 1.0f / static_cast<float>(n);
+    const int dw = decided_.width();
+    for (int y = rect.y0; y < rect.y1; ++y) {
+        Rgb8* row = out.row(y - out_y0) + (rect.x0 - out_x0);
+        const std::size_t first_row = first_index(rect.x0, y);
+        const std::size_t decided_row =
+            static_cast<std::size_t>(y - decided_.y0) * dw + (rect.x0 - decided_.x0);
+        for (int i = 0; i < rect.width(); ++i) {
+            const std::uint32_t key = key_[first_row + i];
+            row[i] = {static_cast<std::uint8_t>(key), static_cast<std::uint8_t>(key >> 8),
+                      static_cast<std::uint8_t>(key >> 16)};
+        }
+        for (int i = 0; i < rect.width(); ++i) {
+            const std::size_t p = decided_row + i;
+            if (!refine_[p]) continue;
+            // Summed in the order full supersampling sums a pixel's samples (row by row).
+            Vec3f sum = first_.colour[first_row + i];
+            const Vec3f* rest = rest_.colour.data() + refined_slot_[p];
+            for (int k = 0; k + 1 < n; ++k) sum += rest[k];
+            sum = sum * inv_n;
+            row[i] = {to_byte(sum.x), to_byte(sum.y), to_byte(sum.z)};
+        }
+    }
+}
+
+void BucketSampler::fill_fine(ImageF& view_depth, Image<Vec3f>& normal, Image<Vec3f>& colour,
+                              Image<std::uint32_t>& material,
+                              Image<std::uint32_t>& object) const {
+    const SamplerFrame& f = *frame_;
+    const int dw = decided_.width(), dh = decided_.height(), sub = sub_;
+    view_depth.reshape(dw * sub, dh * sub);
+    normal.reshape(dw * sub, dh * sub);
+    colour.reshape(dw * sub, dh * sub);
+    material.reshape(dw * sub, dh * sub);
+    object.reshape(dw * sub, dh * sub);
+    const Vec3f& forward = f.view.forward;
+    for (int y = decided_.y0; y < decided_.y1; ++y)
+        for (int x = decided_.x0; x < decided_.x1; ++x) {
+            const std::size_t a = first_index(x, y);
+            const std::size_t p = static_cast<std::size_t>(y - decided_.y0) * dw + (x - decided_.x0);
+            const int fx0 = (x - decided_.x0) * sub, fy0 = (y - decided_.y0) * sub;
+            if (refine_[p]) {
+                std::size_t r = refined_slot_[p];
+                for (int j = 0; j < sub; ++j)
+                    for (int i = 0; i < sub; ++i) {
+                        const bool is_first = i == 0 && j == 0;
+                        const SurfaceSamples& s = is_first ? first_ : rest_;
+                        const std::size_t k = is_first ? a : r++;
+                        view_depth(fx0 + i, fy0 + j) = s.view_depth[k];
+                        normal(fx0 + i, fy0 + j) = s.normal[k];
+                        colour(fx0 + i, fy0 + j) = s.colour[k];
+                        material(fx0 + i, fy0 + j) = s.material[k];
+                        object(fx0 + i, fy0 + j) = s.object[k];
+                    }
+                continue;
+            }
+            // An unrefined pixel: its first sample everywhere, with the depth of that sample's
+            // plane along each ray: z_k = z_0 (n.D_0 / f.D_0) (f.D_k / n.D_k) for rays D through
+            // the image plane (unnormalised), n the plane's normal and f the view direction.
+            const float z0 = first_.view_depth[a];
+            const Vec3f n = first_.normal[a];
+            float plane = 0.0f;
+            if (first_.found[a]) {
+                const Vec3f d0 = f.view.pixel_point((static_cast<float>(x * sub) + 0.5f) / sub,
+                                                    (static_cast<float>(y * sub) + 0.5f) / sub) -
+                                 f.view.eye;
+                plane = z0 * (dot(n, d0) / dot(forward, d0));
+            }
+            for (int j = 0; j < sub; ++j)
+                for (int i = 0; i < sub; ++i) {
+                    float z = z0;
+                    if (first_.found[a] && (i != 0 || j != 0)) {
+                        const Vec3f d = f.view.pixel_point(
+                                            (static_cast<float>(x * sub + i) + 0.5f) / sub,
+                                            (static_cast<float>(y * sub + j) + 0.5f) / sub) -
+                                        f.view.eye;
+                        const float along = plane * (dot(forward, d) / dot(n, d));
+                        if (std::isfinite(along) && along > 0.0f) z = along;
+                    }
+                    view_depth(fx0 + i, fy0 + j) = z;
+                    normal(fx0 + i, fy0 + j) = n;
+                    colour(fx0 + i, fy0 + j) = first_.colour[a];
+                    material(fx0 + i, fy0 + j) = first_.material[a];
+                    object(fx0 + i, fy0 + j) = first_.object[a];
+                }
+        }
+}
+
+}  // namespace toonray

@@ -1,0 +1,151 @@
+#pragma once
+/// Adaptive supersampling of one bucket of pixels. Every pixel gets one sample first, the first
+/// of its regular sub x sub grid; a pixel then gets the rest of its grid only where it differs
+/// from a 4-neighbour in what its line mode draws from (colour, and for robust lines also
+/// coverage, surface ids, normals and depth steps). Sample positions are fixed and each pixel's
+/// choice depends only on its own and its neighbours' first samples, so a frame is the same
+/// whatever the bucket size, the bucket order and the thread count. A pixel that takes all its
+/// samples gets exactly the values full supersampling gives it.
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "toonray/accel/triangle_accel.h"
+#include "toonray/core/image.h"
+#include "toonray/render/shading.h"
+#include "toonray/scene/camera.h"
+
+namespace toonray {
+
+/// A rectangle of pixels [x0, x1) x [y0, y1).
+struct PixelRect {
+    int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+
+    [[nodiscard]] int width() const { return x1 - x0; }
+    [[nodiscard]] int height() const { return y1 - y0; }
+    [[nodiscard]] bool empty() const { return x1 <= x0 || y1 <= y0; }
+    [[nodiscard]] bool contains(int x, int y) const {
+        return x >= x0 && x < x1 && y >= y0 && y < y1;
+    }
+    /// Grown by `by` pixels on every side, then clipped to a width x height image.
+    [[nodiscard]] PixelRect grown(int by, int width, int height) const;
+    bool operator==(const PixelRect&) const = default;
+};
+
+/// The buckets of a width x height image, `size` x `size` pixels each (smaller at the right and
+/// bottom edges), numbered row by row.
+struct BucketGrid {
+    int width, height, size;
+
+    [[nodiscard]] int columns() const { return (width + size - 1) / size; }
+    [[nodiscard]] int count() const { return columns() * ((height + size - 1) / size); }
+    [[nodiscard]] PixelRect bucket(int index) const;
+};
+
+/// Per sample, what the renderer keeps of a surface seen there, in separate arrays.
+struct SurfaceSamples {
+    std::vector<Vec3f> colour;          ///< toon colour; the background where the ray misses
+    std::vector<float> view_depth;      ///< along the view direction; +inf where it misses
+    std::vector<Vec3f> normal;          ///< geometric, unit, facing the viewer; 0 on a miss
+    std::vector<std::uint32_t> material, object;  ///< kNoIndex where the ray misses
+    std::vector<std::uint8_t> found;    ///< 1 where the ray hits
+
+    void resize(std::size_t n);
+    [[nodiscard]] std::uint64_t bytes() const;
+};
+
+/// What makes a pixel take all its samples: a 4-neighbour whose first sample differs from its
+/// own in whether it hits, or in its colour as 8-bit values, or by one of these.
+struct RefineRule {
+    /// Also compare the surfaces (robust lines): object and material ids, geometric normals
+    /// (cos of the angle between them below cos_normal), and depth steps: a second difference
+    /// of 1/z across the pixel, relative to its own 1/z, above depth_step.
+    bool surface = false;
+    float cos_normal = 1.0f;
+    float depth_step = 0.0f;
+};
+
+/// Everything the sampler needs of a frame.
+struct SamplerFrame {
+    const TriangleAccel& accel;
+    const ShadingContext& shading;
+    const ViewPlane& view;
+    Vec3f background;
+    int width, height;  ///< of the image, in pixels
+    int sub;            ///< samples per pixel side
+    bool adaptive;      ///< false: every pixel takes all its samples
+    RefineRule rule;
+    /// Keep view depth, normal and ids of every sample (robust lines, feature images), not
+    /// only of first samples.
+    bool surface_of_all = false;
+    /// Keep view depth, normal and ids of first samples (feature images).
+    bool surface_of_first = false;
+};
+
+/// Samples buckets one after another, keeping its buffers. One per thread.
+class BucketSampler {
+public:
+    /// Traces the first sample of every pixel of `traced`, decides which pixels of `decided`
+    /// take all their samples, and traces those. `decided` must lie within `traced` shrunk by
+    /// one pixel, except along the image's own edges.
+    void sample(const SamplerFrame& frame, const PixelRect& traced, const PixelRect& decided);
+
+    /// The first sample of pixel (x, y) of `traced`: index into first().
+    [[nodiscard]] std::size_t first_index(int x, int y) const {
+        return static_cast<std::size_t>(y - traced_.y0) * traced_.width() + (x - traced_.x0);
+    }
+    [[nodiscard]] const SurfaceSamples& first() const { return first_; }
+    /// Whether pixel (x, y) of `decided` took all its samples.
+    [[nodiscard]] bool refined(int x, int y) const {
+        return refine_[static_cast<std::size_t>(y - decided_.y0) * decided_.width() +
+                       (x - decided_.x0)] != 0;
+    }
+    /// Pixels of `decided` that took all their samples.
+    [[nodiscard]] std::size_t refined_count() const { return refined_pixels_.size(); }
+    /// Bytes held by the buffers.
+    [[nodiscard]] std::uint64_t bytes() const;
+
+    /// The colours of the pixels of `rect` (within `decided`) as bytes into `out`, whose pixel
+    /// (0, 0) is (out_x0, out_y0): a refined pixel's mean over its sub x sub samples, summed row
+    /// by row as full supersampling sums them; an unrefined one's first sample.
+    void resolve_colours(const PixelRect& rect, ImageRgb8& out, int out_x0, int out_y0) const;
+
+    /// The fine grid of `decided` (decided.width() * sub by decided.height() * sub samples)
+    /// for the robust lines: real samples where a pixel was refined; elsewhere the first
+    /// sample's colour, ids and normal, with the view depth of the first sample's plane along
+    /// each sample's ray, which keeps the depth tests' planes planar.
+    void fill_fine(ImageF& view_depth, Image<Vec3f>& normal, Image<Vec3f>& colour,
+                   Image<std::uint32_t>& material, Image<std::uint32_t>& object) const;
+
+private:
+    void trace_first(const SamplerFrame& frame);
+    void decide(const SamplerFrame& frame);
+    void trace_refined(const SamplerFrame& frame);
+    void mark_differences(const RefineRule& rule);
+    [[nodiscard]] bool depth_step(const SamplerFrame& frame, int x, int y) const;
+
+    const SamplerFrame* frame_ = nullptr;
+    PixelRect traced_, decided_;
+    int sub_ = 1;
+    SurfaceSamples first_;             ///< per pixel of traced_
+    /// Per pixel of traced_: the first sample's colour as bytes (low 24 bits), and a 1 above
+    /// them where it misses: equal keys are the same colour, seen or not.
+    std::vector<std::uint32_t> key_;
+    std::vector<std::uint8_t> key_bytes_;  ///< scratch: a row's colour bytes
+    std::vector<std::uint8_t> refine_;  ///< per pixel of decided_
+    /// Per pixel of traced_: whether it differs from the pixel to its right, and below.
+    std::vector<std::uint8_t> differs_right_, differs_below_;
+    /// Refined pixels (indices into decided_) and their other sub * sub - 1 samples, pixel by
+    /// pixel, each pixel's in row order without the first.
+    std::vector<std::uint32_t> refined_pixels_;
+    std::vector<std::uint32_t> refined_slot_;  ///< per pixel of decided_: its first sample in rest_
+    SurfaceSamples rest_;
+    std::vector<Vec3f> dirs_, rest_dirs_;  ///< scratch: directions
+    std::vector<Hit> hits_;
+    std::unique_ptr<bool[]> hit_found_;  ///< scratch: whether each traced ray hit
+    std::size_t hit_found_size_ = 0;
+    std::vector<int> columns_, rows_;
+};
+
+}  // namespace toonray
