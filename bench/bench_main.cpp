@@ -7,7 +7,8 @@
 //
 // Usage: toonray_bench [--quick] [--repeats N] [--size WxH] [--cli PATH|none]
 //                      [--work-dir DIR] [--markdown FILE] [scene.obj ...]
-//        toonray_bench --generate DIR      (writes DIR/scene35k.obj and .mtl)
+//        toonray_bench --generate DIR      (writes DIR/scene35k.obj and .mtl, and DIR/scan70k.obj;
+//                                           prints their paths, one a line)
 // With no scenes: tests/data/teapot.obj and the generated 35k-triangle scene. Images and the
 // generated scene go to --work-dir (default: $TMPDIR/toonray-bench).
 
@@ -737,8 +738,9 @@ int main_impl(int argc, char** argv) {
         } else if (a == "--markdown") {
             opt.markdown = value();
         } else if (a == "--generate") {
-            std::printf("%s\n",
-                        write_bench_scene(value(), TOONRAY_BENCH_DATA_DIR).string().c_str());
+            const fs::path dir = value();
+            std::printf("%s\n", write_bench_scene(dir, TOONRAY_BENCH_DATA_DIR).string().c_str());
+            std::printf("%s\n", write_scan_scene(dir, TOONRAY_BENCH_DATA_DIR).string().c_str());
             return 0;
         } else if (a == "-h" || a == "--help") {
             return usage("per-stage frame benchmark");
