@@ -551,7 +551,7 @@ SceneResult bench_scene(const fs::path& path, const Options& opt) {
     rows.push_back({"OBJ parse, ours (file to Scene)", parse_ours, std::nullopt,
                     fmt::format("{:.0f} MB/s", file_size / (parse_ours.median * 1e3))});
     rows.push_back({"OBJ parse, tinyobjloader rc10", parse_tiny, std::nullopt,
-                    fmt::format("ours {:.1f}x faster (issue: >= 3x; later: >= 5x)", parse_ratio)});
+                    fmt::format("ours {:.1f}x faster (target: >= 5x)", parse_ratio)});
 
     // The build takes no thread count; a one-thread TBB arena confines whatever it runs in
     // parallel, so the same row works for a serial and a parallel builder.
@@ -695,9 +695,12 @@ SceneResult bench_scene(const fs::path& path, const Options& opt) {
         "(1 thread and all threads; ours and the reference) alternate run by run.\n\n",
         R);
     rep += table(rows, hw);
+    // One line in a fixed form: bench/summary.py reads it for run.sh's targets table.
     rep += fmt::format(
-        "\nParse requirement (ours >= 3x tinyobjloader): {} ({:.1f}x; the later 5x target is {})\n",
-        parse_ratio >= 3 ? "met" : "NOT MET", parse_ratio, parse_ratio >= 5 ? "met" : "not met");
+        "\nParse target (ours >= 5x tinyobjloader): {} ({:.2f}x: {:.3f} ms against {:.3f} ms; the "
+        "earlier >= 3x is {})\n",
+        parse_ratio >= 5 ? "met" : "NOT MET", parse_ratio, parse_ours.median, parse_tiny.median,
+        parse_ratio >= 3 ? "met" : "not met");
     return result;
 }
 
