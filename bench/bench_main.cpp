@@ -7,7 +7,8 @@
 //
 // Usage: toonray_bench [--quick] [--repeats N] [--size WxH] [--cli PATH|none]
 //                      [--work-dir DIR] [--markdown FILE] [scene.obj ...]
-//        toonray_bench --generate DIR      (writes DIR/scene35k.obj and .mtl)
+//        toonray_bench --generate DIR      (writes DIR/scene35k.obj and .mtl, and DIR/scan70k.obj;
+//                                           prints their paths, one a line)
 // With no scenes: tests/data/teapot.obj and the generated 35k-triangle scene. Images and the
 // generated scene go to --work-dir (default: $TMPDIR/toonray-bench).
 
@@ -550,7 +551,7 @@ SceneResult bench_scene(const fs::path& path, const Options& opt) {
     rows.push_back({"OBJ parse, ours (file to Scene)", parse_ours, std::nullopt,
                     fmt::format("{:.0f} MB/s", file_size / (parse_ours.median * 1e3))});
     rows.push_back({"OBJ parse, tinyobjloader rc10", parse_tiny, std::nullopt,
-                    fmt::format("ours {:.1f}x faster (issue: >= 3x; later: >= 5x)", parse_ratio)});
+                    fmt::format("ours {:.1f}x faster (target: >= 5x)", parse_ratio)});
 
     // The build takes no thread count; a one-thread TBB arena confines whatever it runs in
     // parallel, so the same row works for a serial and a parallel builder.
@@ -694,9 +695,12 @@ SceneResult bench_scene(const fs::path& path, const Options& opt) {
         "(1 thread and all threads; ours and the reference) alternate run by run.\n\n",
         R);
     rep += table(rows, hw);
+    // One line in a fixed form: bench/summary.py reads it for run.sh's targets table.
     rep += fmt::format(
-        "\nParse requirement (ours >= 3x tinyobjloader): {} ({:.1f}x; the later 5x target is {})\n",
-        parse_ratio >= 3 ? "met" : "NOT MET", parse_ratio, parse_ratio >= 5 ? "met" : "not met");
+        "\nParse target (ours >= 5x tinyobjloader): {} ({:.2f}x: {:.3f} ms against {:.3f} ms; the "
+        "earlier >= 3x is {})\n",
+        parse_ratio >= 5 ? "met" : "NOT MET", parse_ratio, parse_ours.median, parse_tiny.median,
+        parse_ratio >= 3 ? "met" : "not met");
     return result;
 }
 
@@ -737,8 +741,9 @@ int main_impl(int argc, char** argv) {
         } else if (a == "--markdown") {
             opt.markdown = value();
         } else if (a == "--generate") {
-            std::printf("%s\n",
-                        write_bench_scene(value(), TOONRAY_BENCH_DATA_DIR).string().c_str());
+            const fs::path dir = value();
+            std::printf("%s\n", write_bench_scene(dir, TOONRAY_BENCH_DATA_DIR).string().c_str());
+            std::printf("%s\n", write_scan_scene(dir, TOONRAY_BENCH_DATA_DIR).string().c_str());
             return 0;
         } else if (a == "-h" || a == "--help") {
             return usage("per-stage frame benchmark");

@@ -20,4 +20,14 @@ namespace toonray::bench {
 std::filesystem::path write_bench_scene(const std::filesystem::path& dir,
                                         const std::filesystem::path& data_dir);
 
+/// Writes `<dir>/scan70k.obj` and returns its path: tests/data/spot.obj (in `data_dir`) with
+/// each triangle cut into 4 at its edge midpoints (one vertex per edge, shared by the triangles
+/// on both sides), then each of those into 3 at its centroid: 70,272 triangles over 35,138
+/// vertices, `f v` only (no normals, no texture coordinates, one object, no materials), like a
+/// scan, with a camera block framing the cow in a 16:9 frame. The same IEEE-only arithmetic
+/// and printing as write_bench_scene, so the file is the same bytes everywhere; rewritten only
+/// when its content would change.
+std::filesystem::path write_scan_scene(const std::filesystem::path& dir,
+                                       const std::filesystem::path& data_dir);
+
 }  // namespace toonray::bench
