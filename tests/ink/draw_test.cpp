@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <random>
 
 namespace toonray {
@@ -55,6 +57,71 @@ TEST(DrawStrokes, SameForAnyStrokeOrderAndThreadCount) {
     std::reverse(strokes.begin(), strokes.end());
     ink::draw_strokes(strokes, 2.5f, b, 4);
     for (std::size_t i = 0; i < a.size(); ++i) ASSERT_EQ(a.data()[i], b.data()[i]);
+}
+
+// The rasteriser visits, row by row, only the pixels of a segment's capsule (not its whole
+// box): every pixel must still get exactly the coverage of the per-pixel rule, whatever the
+// segment's slope, length and thickness.
+TEST(DrawStrokes, EveryPixelGetsTheRuleOfItsNearestSegmentAtAnySlope) {
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<float> coordinate(-5.0f, 69.0f), width(0.5f, 9.0f);
+    for (int trial = 0; trial < 60; ++trial) {
+        const float thickness = width(rng);
+        std::vector<Stroke> strokes;
+        for (int i = 0; i < 3; ++i) {
+            Point2 a{coordinate(rng), coordinate(rng)}, b{coordinate(rng), coordinate(rng)};
+            if (i == 1) b.y = a.y;  // horizontal
+            if (i == 2 && trial % 2) b = a;  // a dot
+            strokes.push_back(stroke({a, b}));
+        }
+        ImageF got(64, 64, 0.0f);
+        ink::draw_strokes(strokes, thickness, got, 1);
+        const float reach = thickness * 0.5f + 0.5f;
+        for (int y = 0; y < 64; ++y)
+            for (int x = 0; x < 64; ++x) {
+                float want = 0.0f;
+                for (const Stroke& s : strokes) {
+                    const Point2 a = s.points[0], b = s.points[1];
+                    const float dx = b.x - a.x, dy = b.y - a.y, len2 = dx * dx + dy * dy;
+                    const float inv_len2 = len2 > 0.0f ? 1.0f / len2 : 0.0f;
+                    const float px = static_cast<float>(x) + 0.5f - a.x;
+                    const float py = static_cast<float>(y) + 0.5f - a.y;
+                    const float t = std::clamp((px * dx + py * dy) * inv_len2, 0.0f, 1.0f);
+                    const float ex = px - dx * t, ey = py - dy * t;
+                    want = std::max(want, std::min(1.0f, reach - std::sqrt(ex * ex + ey * ey)));
+                }
+                ASSERT_EQ(got(x, y), want) << "trial " << trial << " pixel " << x << "," << y;
+            }
+    }
+}
+
+TEST(OpaqueLines, MarkExactlyWhereThePictureCannotShow) {
+    const std::vector<Stroke> strokes{stroke({{4.0f, 20.0f}, {60.0f, 27.0f}})};
+    std::vector<ink::StrokePen> pens(2);
+    pens[0].thickness = 4.0f;
+    pens[1].thickness = 4.0f;
+    pens[1].opacity = 0.5f;  // a second, see-through pen for the same line
+    for (std::uint16_t style : {0, 1}) {
+        std::vector<Stroke> styled = strokes;
+        styled[0].style = style;
+        ImageF coverage;
+        Image<std::uint16_t> styles;
+        ink::draw_styled_strokes(styled, pens, 64, 48, coverage, styles, 1);
+        Image<std::uint8_t> opaque;
+        ink::opaque_lines(coverage, styles, pens, opaque);
+        ImageRgb8 white(64, 48, Rgb8{255, 255, 255}), red(64, 48, Rgb8{200, 10, 10});
+        ink::composite_styled_lines(coverage, styles, pens, white);
+        ink::composite_styled_lines(coverage, styles, pens, red);
+        int marked = 0;
+        for (int y = 0; y < 48; ++y)
+            for (int x = 0; x < 64; ++x) {
+                // Opaque pixels come out the same over any picture; the others do not.
+                EXPECT_EQ(opaque(x, y) != 0, white(x, y) == red(x, y)) << x << "," << y;
+                marked += opaque(x, y);
+            }
+        if (style == 0) EXPECT_GT(marked, 100);
+        else EXPECT_EQ(marked, 0);
+    }
 }
 
 TEST(DrawStrokes, ThicknessScalesWithImageHeight) {

@@ -90,8 +90,8 @@ TEST(BucketSampler, RefinedPixelsAreFullSupersamplingAndTheRestTheirFirstSample)
     const int sub = 2;
     const ShadingContext ctx{s.scene, s.accel, s.settings.shading, s.lights, nullptr};
     for (bool adaptive : {true, false}) {
-        const SamplerFrame frame{s.accel, ctx,      s.view, s.settings.background, 160, 90, sub,
-                                 adaptive, RefineRule{}};
+        const SamplerFrame frame{s.accel, ctx, s.view,   s.settings.background, 160,
+                                 90,      sub, adaptive, RefineRule{}};
         BucketSampler sampler;
         const PixelRect decided{40, 20, 104, 70};
         sampler.sample(frame, decided.grown(1, 160, 90), decided);
@@ -174,9 +174,8 @@ TEST(AdaptiveSampling, StaysWithinFullSupersampling) {
             const double differing = share_differing(a, b, 2);
             const double refined =
                 static_cast<double>(adaptive.refined_pixels()) / static_cast<double>(a.size());
-            std::printf("%s %s: %.3f%% of pixels differ by more than 2/255; %.1f%% refined\n",
-                        name, mode == EdgeMode::Ink ? "ink" : "robust", 100 * differing,
-                        100 * refined);
+            std::printf("%s %s: %.3f%% of pixels differ by more than 2/255; %.1f%% refined\n", name,
+                        mode == EdgeMode::Ink ? "ink" : "robust", 100 * differing, 100 * refined);
             EXPECT_LE(differing, 0.005) << name;
             EXPECT_EQ(full.refined_pixels(), a.size());
             EXPECT_LT(refined, 0.25) << name;

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <utility>
 
 #include "toonray/core/parallel.h"
 
@@ -15,6 +17,7 @@ struct Segment2 {
     Point2 a, b;
     int x0, x1, y0, y1;  // pixels whose centres may be covered, inclusive, clamped to the image
     float reach;         // half the thickness + 0.5: coverage is reach - distance
+    float max_reach;     // the largest reach anywhere on the segment (width by depth)
     std::uint16_t style;
     float arc0 = 0;                  // arc length of the stroke at a (dashes, taper)
     const StrokePen* pen = nullptr;  // set for dashed, tapered or depth-scaled strokes only
@@ -57,6 +60,7 @@ void add_stroke_segments(const Stroke& s, float thickness, std::uint16_t style,
                      std::max(0, static_cast<int>(std::ceil(ly - 0.5f))),
                      std::min(h - 1, static_cast<int>(std::floor(hy - 0.5f))),
                      reach,
+                     box_reach,
                      style,
                      arc0,
                      by_depth || (pen && (!pen->dash.empty() || pen->taper > 0.0f)) ? pen : nullptr,
@@ -77,6 +81,52 @@ bool in_dash(const std::vector<float>& dash, float s) {
         phase -= dash[i];
     }
     return false;
+}
+
+// The pixels of row y (centre y + 0.5) that a segment's capsule (points within max_reach of it)
+// can cover, within the segment's box: the capsule is convex, so its section is one interval,
+// the hull of the sections of the end discs and of the band along the segment. Widened by a
+// pixel on each side, so that rounding never leaves out a pixel the exact test would cover
+// (outside the capsule coverage is 0 and nothing is written).
+std::pair<int, int> capsule_columns(const Segment2& s, int y) {
+    const float r = s.max_reach;
+    const float dx = s.b.x - s.a.x, dy = s.b.y - s.a.y;
+    const float py = static_cast<float>(y) + 0.5f - s.a.y;
+    float lo = std::numeric_limits<float>::infinity(), hi = -lo;
+    auto add = [&](float a, float b) {
+        lo = std::min(lo, std::min(a, b));
+        hi = std::max(hi, std::max(a, b));
+    };
+    // The end discs.
+    for (const auto& [cx, cy] : {std::pair{0.0f, 0.0f}, std::pair{dx, dy}}) {
+        const float q = r * r - (py - cy) * (py - cy);
+        if (q >= 0.0f) add(cx - std::sqrt(q), cx + std::sqrt(q));
+    }
+    // The band: perpendicular distance within r and the projection within the segment.
+    const float len = std::sqrt(dx * dx + dy * dy);
+    if (len > 0.0f) {
+        // |px dy - py dx| <= r len and 0 <= px dx + py dy <= len^2, as intervals of px.
+        float b_lo = -std::numeric_limits<float>::infinity(), b_hi = -b_lo;
+        auto clip = [&](float coefficient, float low, float high) {  // low <= c px <= high
+            if (coefficient == 0.0f) {
+                if (low > 0.0f || high < 0.0f) b_hi = -b_lo;  // empty
+                return;
+            }
+            float a = low / coefficient, b = high / coefficient;
+            if (a > b) std::swap(a, b);
+            b_lo = std::max(b_lo, a);
+            b_hi = std::min(b_hi, b);
+        };
+        clip(dy, py * dx - r * len, py * dx + r * len);
+        clip(dx, -py * dy, len * len - py * dy);
+        if (b_lo <= b_hi) add(b_lo, b_hi);
+    }
+    if (!(lo <= hi)) return {1, 0};  // the row misses the capsule (or a NaN)
+    const float first = std::floor(s.a.x + lo - 0.5f) - 1.0f;
+    const float last = std::ceil(s.a.x + hi - 0.5f) + 1.0f;
+    const int x0 = first > static_cast<float>(s.x0) ? static_cast<int>(first) : s.x0;
+    const int x1 = last < static_cast<float>(s.x1) ? static_cast<int>(last) : s.x1;
+    return {x0, x1};
 }
 
 // Rasterises the segments in bands of rows; `style` (optional) gets the style of the largest
@@ -102,7 +152,8 @@ void rasterise(const std::vector<Segment2>& segments, ImageF& coverage, Image<st
                     float* row = coverage.row(y);
                     std::uint16_t* style_row = style ? style->row(y) : nullptr;
                     const float py = static_cast<float>(y) + 0.5f - s.a.y;
-                    for (int x = s.x0; x <= s.x1; ++x) {
+                    const auto [x0, x1] = capsule_columns(s, y);
+                    for (int x = x0; x <= x1; ++x) {
                         const float px = static_cast<float>(x) + 0.5f - s.a.x;
                         // Distance to the segment: to its nearest point, ends included (round caps).
                         const float t = std::clamp((px * dx + py * dy) * inv_len2, 0.0f, 1.0f);
@@ -185,6 +236,20 @@ void composite_styled_lines(const ImageF& coverage, const Image<std::uint16_t>& 
                 px[x][c] = to_byte(static_cast<float>(px[x][c]) * (1.0f / 255.0f) * (1.0f - a) +
                                    pen.colour[c] * a);
         }
+    }
+}
+
+void opaque_lines(const ImageF& coverage, const Image<std::uint16_t>& styles,
+                  std::span<const StrokePen> pens, Image<std::uint8_t>& opaque) {
+    opaque.reshape(coverage.width(), coverage.height());
+    for (int y = 0; y < coverage.height(); ++y) {
+        const float* cov = coverage.row(y);
+        const std::uint16_t* style = styles.row(y);
+        std::uint8_t* out = opaque.row(y);
+        for (int x = 0; x < coverage.width(); ++x)
+            // composite_styled_lines's a: with a = 1 the picture's value is multiplied by 0.
+            out[x] =
+                cov[x] > 0.0f && style[x] < pens.size() && cov[x] * pens[style[x]].opacity == 1.0f;
     }
 }
 

@@ -59,6 +59,11 @@ void draw_styled_strokes(std::span<const Stroke> strokes, std::span<const Stroke
 void composite_styled_lines(const ImageF& coverage, const Image<std::uint16_t>& style,
                             std::span<const StrokePen> pens, ImageRgb8& image);
 
+/// 1 where composite_styled_lines covers a pixel completely (coverage times the pen's opacity
+/// is exactly 1), so that nothing of the picture under it shows; else 0. Sized like coverage.
+void opaque_lines(const ImageF& coverage, const Image<std::uint16_t>& style,
+                  std::span<const StrokePen> pens, Image<std::uint8_t>& opaque);
+
 /// image = image * (1 - coverage) + colour * coverage, per channel, in [0, 1] and rounded to
 /// bytes as the renderer does (value * 255 + 0.5, truncated).
 void composite_lines(const ImageF& coverage, const Vec3f& colour, ImageRgb8& image);

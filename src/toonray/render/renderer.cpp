@@ -1,6 +1,8 @@
 #include "toonray/render/renderer.h"
 
 #include <atomic>
+#include <cstdio>
+#include <cstdlib>
 #include <cmath>
 #include <limits>
 
@@ -12,6 +14,7 @@
 #include "toonray/core/portable_math.h"
 #include "toonray/render/classic.h"
 #include "toonray/render/sampler.h"
+#include "toonray/render/shade_samples.h"
 #include "toonray/render/trace.h"
 
 namespace toonray {
@@ -199,7 +202,8 @@ std::uint64_t frame_buffer_bytes(const RenderSettings& settings) {
         // is drawn into. The edges, pieces and strokes grow with the scene, not the image: they
         // are not counted here.
         const std::uint64_t line_layer = sizeof(float) + sizeof(std::uint16_t);
-        per_pixel += line_layer + (settings.feature_images ? line_layer : 0);
+        // Without feature images also the mask of pixels the lines hide.
+        per_pixel += line_layer + (settings.feature_images ? line_layer : 1);
     }
     return add_saturated(mul_saturated(pixels, per_pixel), buckets);
 }
@@ -222,51 +226,25 @@ void prepare_gbuffer(GBuffer& g, int width, int height, int sub, EdgeMode mode) 
 
 namespace {
 
-// shade_tile for one line mode: the mode decides which depth and normal are stored, so it is a
-// template parameter rather than a test per sample.
-template <bool kClassic>
+// shade_tile for one line mode: the mode decides which depth and normal are stored.
 void shade_tile_rows(const ShadingContext& ctx, const ViewPlane& view, const Vec3f& background,
-                     const SampleTile& t, GBuffer& g) {
-    const Scene& scene = ctx.scene;
-    const float inf = std::numeric_limits<float>::infinity();
+                     const SampleTile& t, GBuffer& g, bool classic) {
     const int tw = t.width();
-    const Light* plain = plain_point_light(ctx);  // the common case, shaded inline below
     for (int y = t.y0; y < t.y1; ++y) {
         const int first = (y - t.y0) * tw;  // the row's first sample in the tile's arrays
-        const Vec3f* dirs = t.dirs + first;
-        const Hit* hits = t.hits + first;
-        const bool* found = t.found + first;
-        float* depth = kClassic ? g.distance.row(y) + t.x0 : g.view_depth.row(y) + t.x0;
-        Vec3f* normal = kClassic ? g.normal.row(y) + t.x0 : g.geometric_normal.row(y) + t.x0;
-        Vec3f* colour = g.colour.row(y) + t.x0;
-        std::uint32_t* material = g.material.row(y) + t.x0;
-        std::uint32_t* object = g.object.row(y) + t.x0;
-        for (int i = 0; i < tw; ++i) {
-            if (!found[i]) {
-                depth[i] = inf;
-                normal[i] = Vec3f(0.0f);
-                colour[i] = background;
-                material[i] = kNoIndex;
-                object[i] = kNoIndex;
-                continue;
-            }
-            const Hit& hit = hits[i];
-            const Vec3f& dir = dirs[i];
-            const Vec3f n = shading_normal(scene, hit, dir);
-            if constexpr (kClassic) {
-                depth[i] = hit.t;
-                normal[i] = n;
-            } else {
-                depth[i] = hit.t * dot(dir, view.forward);
-                normal[i] = geometric_normal(scene, hit, dir);
-            }
-            const std::uint32_t m = scene.tri_material[hit.prim];
-            colour[i] = plain && !material_texture(ctx, m)
-                            ? shade_plain(ctx, *plain, hit, view.eye, dir, n)
-                            : shade_hit(ctx, hit, view.eye, dir, n);
-            material[i] = m;
-            object[i] = scene.tri_object[hit.prim];
+        ShadedSamples out;
+        out.colour = g.colour.row(y) + t.x0;
+        out.material = g.material.row(y) + t.x0;
+        out.object = g.object.row(y) + t.x0;
+        if (classic) {
+            out.distance = g.distance.row(y) + t.x0;
+            out.shading_normal = g.normal.row(y) + t.x0;
+        } else {
+            out.view_depth = g.view_depth.row(y) + t.x0;
+            out.geometric_normal = g.geometric_normal.row(y) + t.x0;
         }
+        shade_samples(ctx, view, background, tw, t.dirs + first, t.hits + first, t.found + first,
+                      out);
     }
 }
 
@@ -274,9 +252,7 @@ void shade_tile_rows(const ShadingContext& ctx, const ViewPlane& view, const Vec
 
 void shade_tile(const ShadingContext& ctx, const ViewPlane& view, const RenderSettings& settings,
                 const SampleTile& tile, GBuffer& g) {
-    if (settings.edges == EdgeMode::Classic)
-        shade_tile_rows<true>(ctx, view, settings.background, tile, g);
-    else shade_tile_rows<false>(ctx, view, settings.background, tile, g);
+    shade_tile_rows(ctx, view, settings.background, tile, g, settings.edges == EdgeMode::Classic);
 }
 
 struct Renderer::Bucket {
@@ -342,8 +318,18 @@ const ImageRgb8& Renderer::render(const Scene& scene, const TriangleAccel& accel
     }
     // The other modes keep no frame-sized G-buffer: they render bucket by bucket.
     prepare_gbuffer(gbuffer_, 0, 0, 1, settings.edges);
-    render_buckets(scene, accel, view, settings, textures);
-    if (settings.edges == EdgeMode::Ink) render_ink(scene, accel, camera, settings);
+    if (settings.edges != EdgeMode::Ink) {
+        render_buckets(scene, accel, view, settings, textures, nullptr);
+        return final_;
+    }
+    // Ink lines first: where they cover a pixel completely its colour cannot show, so it needs
+    // no more than one sample (unless the feature images show the colours without lines).
+    ink::draw_ink_lines(scene, accel, camera, settings.width, settings.height,
+                        ink_settings(settings), settings.threads, ink_);
+    if (!settings.feature_images) ink::opaque_lines(ink_.coverage, ink_.style, ink_.pens, hidden_);
+    render_buckets(scene, accel, view, settings, textures,
+                   settings.feature_images ? nullptr : hidden_.data());
+    render_ink(settings);
     return final_;
 }
 
@@ -359,7 +345,8 @@ void Renderer::render_classic(const RenderSettings& settings) {
 }
 
 void Renderer::render_buckets(const Scene& scene, const TriangleAccel& accel, const ViewPlane& view,
-                              const RenderSettings& settings, const TextureSet* textures) {
+                              const RenderSettings& settings, const TextureSet* textures,
+                              const std::uint8_t* hidden) {
     const int w = settings.width, h = settings.height;
     const int sub = samples_per_side(settings.samples);
     const bool robust = settings.edges == EdgeMode::Robust;
@@ -376,9 +363,9 @@ void Renderer::render_buckets(const Scene& scene, const TriangleAccel& accel, co
         rule.cos_normal = portable::cos(settings.lines.crease_angle * 0.25f * 3.14159265f / 180.0f);
         rule.depth_step = settings.lines.depth_threshold * 0.5f;
     }
-    const SamplerFrame frame{accel, shading, view,    settings.background,
-                             w,     h,       sub,     settings.adaptive,
-                             rule,  robust,  features};
+    const SamplerFrame frame{accel, shading, view,     settings.background,
+                             w,     h,       sub,      settings.adaptive,
+                             rule,  robust,  features, hidden};
     const float thickness = robust ? line_thickness(settings.lines.width, h, sub) : 0.0f;
     const int halo = robust ? robust_halo(thickness, sub) : 0;
 
@@ -419,6 +406,8 @@ void Renderer::render_buckets(const Scene& scene, const TriangleAccel& accel, co
         }
     });
     refined_pixels_ = refined;
+    if (std::getenv("TOONRAY_DEBUG_REFINED"))
+        std::fprintf(stderr, "refined %llu of %d\n", (unsigned long long)refined_pixels_, w * h);
     if (features) depth_feature_image(first_depth_, aovs_.depth);
 }
 
@@ -471,13 +460,10 @@ void Renderer::first_sample_features(const Bucket& bucket, const BucketBuffers& 
         }
 }
 
-void Renderer::render_ink(const Scene& scene, const TriangleAccel& accel, const CameraSpec& camera,
-                          const RenderSettings& settings) {
+void Renderer::render_ink(const RenderSettings& settings) {
     const int threads = settings.threads;
     const bool features = settings.feature_images;
     if (features) aovs_.cel = final_;
-    ink::draw_ink_lines(scene, accel, camera, settings.width, settings.height,
-                        ink_settings(settings), threads, ink_);
     ink::composite_styled_lines(ink_.coverage, ink_.style, ink_.pens, final_);
     if (features) {
         ink::coverage_to_gray(ink_.coverage, aovs_.edges);

@@ -184,20 +184,21 @@ private:
                const RenderSettings& settings, const TextureSet* textures);
     void render_classic(const RenderSettings& settings);
     void render_buckets(const Scene& scene, const TriangleAccel& accel, const ViewPlane& view,
-                        const RenderSettings& settings, const TextureSet* textures);
+                        const RenderSettings& settings, const TextureSet* textures,
+                        const std::uint8_t* hidden);
     void resolve_robust_bucket(const Bucket& bucket, BucketBuffers& b,
                                const RenderSettings& settings);
     void resolve_ink_bucket(const Bucket& bucket, const BucketBuffers& b);
     void first_sample_features(const Bucket& bucket, const BucketBuffers& b);
-    void render_ink(const Scene& scene, const TriangleAccel& accel, const CameraSpec& camera,
-                    const RenderSettings& settings);
+    void render_ink(const RenderSettings& settings);
     void ink_type_feature_images(const RenderSettings& settings, int threads);
 
     GBuffer gbuffer_;
     Aovs aovs_;  ///< classic mode draws its lines from depth, normal and edges* here
     bool feature_images_ = false;
     ImageRgb8 final_;
-    ImageF first_depth_;  ///< feature images: each pixel's first sample's view depth
+    ImageF first_depth_;          ///< feature images: each pixel's first sample's view depth
+    Image<std::uint8_t> hidden_;  ///< ink: where the lines hide the picture (ink::opaque_lines)
     std::unique_ptr<PerThread<BucketBuffers>> buckets_;
     std::uint64_t refined_pixels_ = 0;
     ink::InkLines ink_;

@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "toonray/render/classic.h"
+#include "toonray/render/shade_samples.h"
 #include "toonray/render/trace.h"
 
 namespace toonray {
@@ -15,43 +16,23 @@ constexpr int kTile = TriangleAccel::kTileSize;
 // Refined samples are traced as a grid this many rays wide, so that each 4 x 2 packet of
 // intersect_tile holds 8 consecutive samples of the list (neighbouring pixels' samples).
 constexpr int kListWidth = 4;
+// Refined pixels are listed in blocks of this many pixels a side.
+constexpr int kBlock = 16;
 
 // Shades n traced samples into out[offset, offset + n): the colour always, and the view depth,
-// geometric normal and ids when `surface`. The per-sample work of the renderer's G-buffer
-// (shade_tile in renderer.cpp does the same for whole tiles).
-void shade_samples(const SamplerFrame& f, int n, const Vec3f* dirs, const Hit* hits,
-                   const bool* found, SurfaceSamples& out, std::size_t offset, bool surface) {
-    const ShadingContext& ctx = f.shading;
-    const Scene& scene = ctx.scene;
-    const Light* plain = plain_point_light(ctx);  // the common case, shaded inline below
-    Vec3f* colour = out.colour.data() + offset;
-    std::uint8_t* hit_found = out.found.data() + offset;
-    for (int i = 0; i < n; ++i) {
-        hit_found[i] = found[i] ? 1 : 0;
-        if (!found[i]) {
-            colour[i] = f.background;
-            if (surface) {
-                out.view_depth[offset + i] = kInf;
-                out.normal[offset + i] = Vec3f(0.0f);
-                out.material[offset + i] = kNoIndex;
-                out.object[offset + i] = kNoIndex;
-            }
-            continue;
-        }
-        const Hit& hit = hits[i];
-        const Vec3f& dir = dirs[i];
-        const Vec3f normal = shading_normal(scene, hit, dir);
-        const std::uint32_t m = scene.tri_material[hit.prim];
-        colour[i] = plain && !material_texture(ctx, m)
-                        ? shade_plain(ctx, *plain, hit, f.view.eye, dir, normal)
-                        : shade_hit(ctx, hit, f.view.eye, dir, normal);
-        if (surface) {
-            out.view_depth[offset + i] = hit.t * dot(dir, f.view.forward);
-            out.normal[offset + i] = geometric_normal(scene, hit, dir);
-            out.material[offset + i] = m;
-            out.object[offset + i] = scene.tri_object[hit.prim];
-        }
+// geometric normal and ids when `surface`.
+void shade_into(const SamplerFrame& f, int n, const Vec3f* dirs, const Hit* hits, const bool* found,
+                SurfaceSamples& out, std::size_t offset, bool surface) {
+    ShadedSamples to;
+    to.colour = out.colour.data() + offset;
+    to.found = out.found.data() + offset;
+    if (surface) {
+        to.view_depth = out.view_depth.data() + offset;
+        to.geometric_normal = out.normal.data() + offset;
+        to.material = out.material.data() + offset;
+        to.object = out.object.data() + offset;
     }
+    shade_samples(f.shading, f.view, f.background, n, dirs, hits, found, to);
 }
 
 }  // namespace
@@ -140,13 +121,13 @@ void BucketSampler::trace_first(const SamplerFrame& frame) {
             for (int j = 0; j < rows; ++j) {
                 const std::size_t at = static_cast<std::size_t>(j) * cols;
                 const std::size_t to = first_index(tx, ty + j);
-                shade_samples(frame, cols, dirs_.data() + at, hits_.data() + at,
-                              hit_found_.get() + at, first_, to, surface);
+                shade_into(frame, cols, dirs_.data() + at, hits_.data() + at, hit_found_.get() + at,
+                           first_, to, surface);
                 to_bytes(&first_.colour[to].x, 3 * cols, key_bytes_.data());
                 for (int i = 0; i < cols; ++i) {
                     const std::uint8_t* b = key_bytes_.data() + 3 * i;
-                    key_[to + i] = b[0] | (b[1] << 8) | (b[2] << 16) |
-                                   (first_.found[to + i] ? 0u : 1u << 24);
+                    key_[to + i] =
+                        b[0] | (b[1] << 8) | (b[2] << 16) | (first_.found[to + i] ? 0u : 1u << 24);
                 }
             }
         }
@@ -198,8 +179,10 @@ void BucketSampler::mark_differences(const RefineRule& rule) {
         std::uint8_t* below = differs_below_.data() + row;
         for (int x = 0; x < tw; ++x) below[x] = key[row + x] != key[row + x + tw];
         if (!rule.surface) continue;
-        for (int x = 0; x + 1 < tw; ++x) right[x] |= surfaces_differ(first_, row + x, row + x + 1, rule);
-        for (int x = 0; x < tw; ++x) below[x] |= surfaces_differ(first_, row + x, row + x + tw, rule);
+        for (int x = 0; x + 1 < tw; ++x)
+            right[x] |= surfaces_differ(first_, row + x, row + x + 1, rule);
+        for (int x = 0; x < tw; ++x)
+            below[x] |= surfaces_differ(first_, row + x, row + x + tw, rule);
     }
 }
 
@@ -219,6 +202,8 @@ void BucketSampler::decide(const SamplerFrame& frame) {
             if (x > traced_.x0) refine |= differs_right_[i - 1] != 0;
             if (y > traced_.y0) refine |= differs_below_[i - tw] != 0;
             if (!refine && frame.rule.surface) refine = depth_step(frame, x, y);
+            if (frame.hidden && frame.hidden[static_cast<std::size_t>(y) * frame.width + x])
+                refine = false;
             refine_[static_cast<std::size_t>(y - decided_.y0) * dw + (x - decided_.x0)] = refine;
         }
 }
@@ -227,14 +212,22 @@ void BucketSampler::trace_refined(const SamplerFrame& frame) {
     const int dw = decided_.width();
     const int per_pixel = sub_ * sub_ - 1;
     // Sized before filling (not grown), so that the buffers hold no more than they need.
-    resize_exact(refined_pixels_, static_cast<std::size_t>(std::count(refine_.begin(), refine_.end(), 1)));
+    resize_exact(refined_pixels_,
+                 static_cast<std::size_t>(std::count(refine_.begin(), refine_.end(), 1)));
     refined_slot_.assign(refine_.size(), kNoIndex);
+    // Listed block by block of kBlock x kBlock pixels, so that rays next to each other in the
+    // list (one packet of intersect_tile) are near each other in the image.
+    const int dh = decided_.height();
     std::size_t count = 0;
-    for (std::size_t p = 0; p < refine_.size(); ++p)
-        if (refine_[p]) {
-            refined_slot_[p] = static_cast<std::uint32_t>(count * per_pixel);
-            refined_pixels_[count++] = static_cast<std::uint32_t>(p);
-        }
+    for (int by = 0; by < dh; by += kBlock)
+        for (int bx = 0; bx < dw; bx += kBlock)
+            for (int y = by; y < std::min(by + kBlock, dh); ++y)
+                for (int x = bx; x < std::min(bx + kBlock, dw); ++x) {
+                    const std::size_t p = static_cast<std::size_t>(y) * dw + x;
+                    if (!refine_[p]) continue;
+                    refined_slot_[p] = static_cast<std::uint32_t>(count * per_pixel);
+                    refined_pixels_[count++] = static_cast<std::uint32_t>(p);
+                }
     const std::size_t n = refined_pixels_.size() * per_pixel;
     rest_.resize(n);
     if (n == 0) return;
@@ -242,13 +235,16 @@ void BucketSampler::trace_refined(const SamplerFrame& frame) {
     resize_exact(rest_dirs_, padded);
     std::size_t k = 0;
     for (std::uint32_t p : refined_pixels_) {
-        const int x = decided_.x0 + static_cast<int>(p % dw), y = decided_.y0 + static_cast<int>(p / dw);
+        const int x = decided_.x0 + static_cast<int>(p % dw),
+                  y = decided_.y0 + static_cast<int>(p / dw);
         for (int j = 0; j < sub_; ++j)
             for (int i = 0; i < sub_; ++i)
                 if (i != 0 || j != 0)
-                    rest_dirs_[k++] = sample_direction(frame.view, x * sub_ + i, y * sub_ + j, sub_);
+                    rest_dirs_[k++] =
+                        sample_direction(frame.view, x * sub_ + i, y * sub_ + j, sub_);
     }
-    std::fill(rest_dirs_.begin() + static_cast<std::ptrdiff_t>(n), rest_dirs_.end(), rest_dirs_[n - 1]);
+    std::fill(rest_dirs_.begin() + static_cast<std::ptrdiff_t>(n), rest_dirs_.end(),
+              rest_dirs_[n - 1]);
     resize_exact(hits_, padded);
     if (hit_found_size_ < padded) {
         hit_found_size_ = padded;
@@ -257,8 +253,8 @@ void BucketSampler::trace_refined(const SamplerFrame& frame) {
     frame.accel.intersect_tile(frame.view.eye, rest_dirs_.data(), kListWidth,
                                static_cast<int>(padded / kListWidth), hits_.data(),
                                hit_found_.get());
-    shade_samples(frame, static_cast<int>(n), rest_dirs_.data(), hits_.data(), hit_found_.get(),
-                  rest_, 0, frame.rule.surface || frame.surface_of_all);
+    shade_into(frame, static_cast<int>(n), rest_dirs_.data(), hits_.data(), hit_found_.get(), rest_,
+               0, frame.rule.surface || frame.surface_of_all);
 }
 
 void BucketSampler::resolve_colours(const PixelRect& rect, ImageRgb8& out, int out_x0,
@@ -290,8 +286,7 @@ void BucketSampler::resolve_colours(const PixelRect& rect, ImageRgb8& out, int o
 }
 
 void BucketSampler::fill_fine(ImageF& view_depth, Image<Vec3f>& normal, Image<Vec3f>& colour,
-                              Image<std::uint32_t>& material,
-                              Image<std::uint32_t>& object) const {
+                              Image<std::uint32_t>& material, Image<std::uint32_t>& object) const {
     const SamplerFrame& f = *frame_;
     const int dw = decided_.width(), dh = decided_.height(), sub = sub_;
     view_depth.reshape(dw * sub, dh * sub);
@@ -303,7 +298,8 @@ void BucketSampler::fill_fine(ImageF& view_depth, Image<Vec3f>& normal, Image<Ve
     for (int y = decided_.y0; y < decided_.y1; ++y)
         for (int x = decided_.x0; x < decided_.x1; ++x) {
             const std::size_t a = first_index(x, y);
-            const std::size_t p = static_cast<std::size_t>(y - decided_.y0) * dw + (x - decided_.x0);
+            const std::size_t p =
+                static_cast<std::size_t>(y - decided_.y0) * dw + (x - decided_.x0);
             const int fx0 = (x - decided_.x0) * sub, fy0 = (y - decided_.y0) * sub;
             if (refine_[p]) {
                 std::size_t r = refined_slot_[p];
@@ -336,10 +332,10 @@ void BucketSampler::fill_fine(ImageF& view_depth, Image<Vec3f>& normal, Image<Ve
                 for (int i = 0; i < sub; ++i) {
                     float z = z0;
                     if (first_.found[a] && (i != 0 || j != 0)) {
-                        const Vec3f d = f.view.pixel_point(
-                                            (static_cast<float>(x * sub + i) + 0.5f) / sub,
-                                            (static_cast<float>(y * sub + j) + 0.5f) / sub) -
-                                        f.view.eye;
+                        const Vec3f d =
+                            f.view.pixel_point((static_cast<float>(x * sub + i) + 0.5f) / sub,
+                                               (static_cast<float>(y * sub + j) + 0.5f) / sub) -
+                            f.view.eye;
                         const float along = plane * (dot(forward, d) / dot(n, d));
                         if (std::isfinite(along) && along > 0.0f) z = along;
                     }

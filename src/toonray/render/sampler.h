@@ -45,11 +45,11 @@ struct BucketGrid {
 
 /// Per sample, what the renderer keeps of a surface seen there, in separate arrays.
 struct SurfaceSamples {
-    std::vector<Vec3f> colour;          ///< toon colour; the background where the ray misses
-    std::vector<float> view_depth;      ///< along the view direction; +inf where it misses
-    std::vector<Vec3f> normal;          ///< geometric, unit, facing the viewer; 0 on a miss
+    std::vector<Vec3f> colour;      ///< toon colour; the background where the ray misses
+    std::vector<float> view_depth;  ///< along the view direction; +inf where it misses
+    std::vector<Vec3f> normal;      ///< geometric, unit, facing the viewer; 0 on a miss
     std::vector<std::uint32_t> material, object;  ///< kNoIndex where the ray misses
-    std::vector<std::uint8_t> found;    ///< 1 where the ray hits
+    std::vector<std::uint8_t> found;              ///< 1 where the ray hits
 
     void resize(std::size_t n);
     [[nodiscard]] std::uint64_t bytes() const;
@@ -81,6 +81,9 @@ struct SamplerFrame {
     bool surface_of_all = false;
     /// Keep view depth, normal and ids of first samples (feature images).
     bool surface_of_first = false;
+    /// Per pixel of the image (row by row), or null: 1 where lines drawn over the frame hide
+    /// the picture completely. Such pixels never take more than their first sample.
+    const std::uint8_t* hidden = nullptr;
 };
 
 /// Samples buckets one after another, keeping its buffers. One per thread.
@@ -128,12 +131,12 @@ private:
     const SamplerFrame* frame_ = nullptr;
     PixelRect traced_, decided_;
     int sub_ = 1;
-    SurfaceSamples first_;             ///< per pixel of traced_
+    SurfaceSamples first_;  ///< per pixel of traced_
     /// Per pixel of traced_: the first sample's colour as bytes (low 24 bits), and a 1 above
     /// them where it misses: equal keys are the same colour, seen or not.
     std::vector<std::uint32_t> key_;
     std::vector<std::uint8_t> key_bytes_;  ///< scratch: a row's colour bytes
-    std::vector<std::uint8_t> refine_;  ///< per pixel of decided_
+    std::vector<std::uint8_t> refine_;     ///< per pixel of decided_
     /// Per pixel of traced_: whether it differs from the pixel to its right, and below.
     std::vector<std::uint8_t> differs_right_, differs_below_;
     /// Refined pixels (indices into decided_) and their other sub * sub - 1 samples, pixel by
