@@ -70,7 +70,7 @@ TEST(DrawStrokes, EveryPixelGetsTheRuleOfItsNearestSegmentAtAnySlope) {
         std::vector<Stroke> strokes;
         for (int i = 0; i < 3; ++i) {
             Point2 a{coordinate(rng), coordinate(rng)}, b{coordinate(rng), coordinate(rng)};
-            if (i == 1) b.y = a.y;  // horizontal
+            if (i == 1) b.y = a.y;           // horizontal
             if (i == 2 && trial % 2) b = a;  // a dot
             strokes.push_back(stroke({a, b}));
         }

@@ -155,10 +155,12 @@ std::uint64_t bucket_buffer_bytes(const RenderSettings& settings) {
     const std::uint64_t ray = sizeof(Vec3f) + sizeof(Hit) + 1;
     // The rays of one traced tile and their sample columns and rows.
     const std::uint64_t tile_rays = TriangleAccel::kTileSize * TriangleAccel::kTileSize;
-    std::uint64_t bytes =
-        tile_rays * ray + 2 * TriangleAccel::kTileSize * sizeof(int) + 3 * TriangleAccel::kTileSize;
-    // The first samples, with their colour keys and the differences to their neighbours.
-    bytes = add_saturated(bytes, mul_saturated(traced, surface + sizeof(std::uint32_t) + 2));
+    std::uint64_t bytes = tile_rays * ray + 2 * TriangleAccel::kTileSize * sizeof(int);
+    // The first samples, with their colours as bytes and keys, the differences to their
+    // neighbours, and a row of no differences.
+    bytes = add_saturated(
+        bytes, mul_saturated(traced, surface + sizeof(Rgb8) + sizeof(std::uint32_t) + 2));
+    bytes = add_saturated(bytes, side(w, halo + 1));
     // Every other sample of every decided pixel, with its slot and flag.
     bytes = add_saturated(
         bytes, mul_saturated(decided, add_saturated(mul_saturated(samples - 1, surface + ray),

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 
 #include "toonray/render/classic.h"
@@ -76,7 +77,9 @@ std::uint64_t SurfaceSamples::bytes() const {
 }
 
 std::uint64_t BucketSampler::bytes() const {
-    return first_.bytes() + rest_.bytes() + refine_.capacity() +
+    return first_.bytes() + rest_.bytes() + refine_.capacity() + first_bytes_.capacity() +
+           key_.capacity() * sizeof(std::uint32_t) + differs_right_.capacity() +
+           differs_below_.capacity() + no_differences_.capacity() +
            (refined_pixels_.capacity() + refined_slot_.capacity()) * sizeof(std::uint32_t) +
            (dirs_.capacity() + rest_dirs_.capacity()) * sizeof(Vec3f) +
            hits_.capacity() * sizeof(Hit) + hit_found_size_ +
@@ -98,7 +101,7 @@ void BucketSampler::trace_first(const SamplerFrame& frame) {
     const int tw = traced_.width(), th = traced_.height();
     first_.resize(static_cast<std::size_t>(tw) * th);
     resize_exact(key_, static_cast<std::size_t>(tw) * th);
-    resize_exact(key_bytes_, 3 * kTile);
+    resize_exact(first_bytes_, 3 * static_cast<std::size_t>(tw) * th);
     resize_exact(dirs_, kTile * kTile);
     resize_exact(hits_, std::max<std::size_t>(hits_.size(), kTile * kTile));
     if (hit_found_size_ < static_cast<std::size_t>(kTile * kTile)) {
@@ -123,9 +126,10 @@ void BucketSampler::trace_first(const SamplerFrame& frame) {
                 const std::size_t to = first_index(tx, ty + j);
                 shade_into(frame, cols, dirs_.data() + at, hits_.data() + at, hit_found_.get() + at,
                            first_, to, surface);
-                to_bytes(&first_.colour[to].x, 3 * cols, key_bytes_.data());
+                std::uint8_t* bytes = first_bytes_.data() + 3 * to;
+                to_bytes(&first_.colour[to].x, 3 * cols, bytes);
                 for (int i = 0; i < cols; ++i) {
-                    const std::uint8_t* b = key_bytes_.data() + 3 * i;
+                    const std::uint8_t* b = bytes + 3 * i;
                     key_[to + i] =
                         b[0] | (b[1] << 8) | (b[2] << 16) | (first_.found[to + i] ? 0u : 1u << 24);
                 }
@@ -163,6 +167,25 @@ bool BucketSampler::depth_step(const SamplerFrame& frame, int x, int y) const {
     return step(1, 0) || step(0, 1);
 }
 
+namespace {
+
+// out[x] = whether pixel x of a row differs from a 4-neighbour: right[x] (with the pixel to
+// its right), right[x - 1] (to its left; left_of_first for x = 0), below[x] and above[x] (the
+// row above's flag with this row). Plain arrays so that the loop vectorises.
+void neighbours_differ(const std::uint8_t* __restrict right, std::uint8_t left_of_first,
+                       const std::uint8_t* __restrict below, const std::uint8_t* __restrict above,
+                       int n, std::uint8_t* __restrict out) {
+    out[0] = right[0] | left_of_first | below[0] | above[0];
+    for (int x = 1; x < n; ++x) out[x] = right[x] | right[x - 1] | below[x] | above[x];
+}
+
+// Pixels the lines hide take no more samples.
+void keep_visible(const std::uint8_t* __restrict hidden, int n, std::uint8_t* __restrict refine) {
+    for (int x = 0; x < n; ++x) refine[x] = refine[x] & (hidden[x] ^ 1);
+}
+
+}  // namespace
+
 void BucketSampler::mark_differences(const RefineRule& rule) {
     // Each pair of 4-neighbours of the traced pixels once: with the pixel to the right, and
     // with the one below. Pixels at the traced rectangle's edge have no pair beyond it.
@@ -193,19 +216,26 @@ void BucketSampler::decide(const SamplerFrame& frame) {
     if (all || sub_ == 1) return;
     mark_differences(frame.rule);
     // A pixel takes all its samples when it differs from a neighbour (which the precondition
-    // on `decided` puts inside `traced` whenever it is inside the image).
+    // on `decided` puts inside `traced` whenever it is inside the image), row by row.
     const int tw = traced_.width();
-    for (int y = decided_.y0; y < decided_.y1; ++y)
-        for (int x = decided_.x0; x < decided_.x1; ++x) {
-            const std::size_t i = first_index(x, y);
-            bool refine = differs_right_[i] | differs_below_[i];
-            if (x > traced_.x0) refine |= differs_right_[i - 1] != 0;
-            if (y > traced_.y0) refine |= differs_below_[i - tw] != 0;
-            if (!refine && frame.rule.surface) refine = depth_step(frame, x, y);
-            if (frame.hidden && frame.hidden[static_cast<std::size_t>(y) * frame.width + x])
-                refine = false;
-            refine_[static_cast<std::size_t>(y - decided_.y0) * dw + (x - decided_.x0)] = refine;
-        }
+    resize_exact(no_differences_, static_cast<std::size_t>(tw));
+    std::fill(no_differences_.begin(), no_differences_.end(), 0);
+    for (int y = decided_.y0; y < decided_.y1; ++y) {
+        const std::size_t i = first_index(decided_.x0, y);
+        const std::uint8_t* right = differs_right_.data() + i;
+        // The pixel left of the row's first: its flag, or none at the image's edge.
+        const std::uint8_t left_of_first = decided_.x0 > traced_.x0 ? right[-1] : 0;
+        const std::uint8_t* above =
+            y > traced_.y0 ? differs_below_.data() + (i - tw) : no_differences_.data();
+        std::uint8_t* row = refine_.data() + static_cast<std::size_t>(y - decided_.y0) * dw;
+        neighbours_differ(right, left_of_first, differs_below_.data() + i, above, dw, row);
+        if (frame.rule.surface)
+            for (int x = 0; x < dw; ++x)
+                if (!row[x]) row[x] = depth_step(frame, decided_.x0 + x, y);
+        if (frame.hidden)
+            keep_visible(frame.hidden + static_cast<std::size_t>(y) * frame.width + decided_.x0, dw,
+                         row);
+    }
 }
 
 void BucketSampler::trace_refined(const SamplerFrame& frame) {
@@ -265,23 +295,18 @@ void BucketSampler::resolve_colours(const PixelRect& rect, ImageRgb8& out, int o
     for (int y = rect.y0; y < rect.y1; ++y) {
         Rgb8* row = out.row(y - out_y0) + (rect.x0 - out_x0);
         const std::size_t first_row = first_index(rect.x0, y);
-        const std::size_t decided_row =
-            static_cast<std::size_t>(y - decided_.y0) * dw + (rect.x0 - decided_.x0);
-        for (int i = 0; i < rect.width(); ++i) {
-            const std::uint32_t key = key_[first_row + i];
-            row[i] = {static_cast<std::uint8_t>(key), static_cast<std::uint8_t>(key >> 8),
-                      static_cast<std::uint8_t>(key >> 16)};
-        }
-        for (int i = 0; i < rect.width(); ++i) {
-            const std::size_t p = decided_row + i;
-            if (!refine_[p]) continue;
-            // Summed in the order full supersampling sums a pixel's samples (row by row).
-            Vec3f sum = first_.colour[first_row + i];
-            const Vec3f* rest = rest_.colour.data() + refined_slot_[p];
-            for (int k = 0; k + 1 < n; ++k) sum += rest[k];
-            sum = sum * inv_n;
-            row[i] = {to_byte(sum.x), to_byte(sum.y), to_byte(sum.z)};
-        }
+        std::memcpy(row, first_bytes_.data() + 3 * first_row, 3 * rect.width());
+    }
+    for (std::uint32_t p : refined_pixels_) {
+        const int x = decided_.x0 + static_cast<int>(p % dw),
+                  y = decided_.y0 + static_cast<int>(p / dw);
+        if (!rect.contains(x, y)) continue;
+        // Summed in the order full supersampling sums a pixel's samples (row by row).
+        Vec3f sum = first_.colour[first_index(x, y)];
+        const Vec3f* rest = rest_.colour.data() + refined_slot_[p];
+        for (int k = 0; k + 1 < n; ++k) sum += rest[k];
+        sum = sum * inv_n;
+        out(x - out_x0, y - out_y0) = {to_byte(sum.x), to_byte(sum.y), to_byte(sum.z)};
     }
 }
 

@@ -135,10 +135,11 @@ private:
     /// Per pixel of traced_: the first sample's colour as bytes (low 24 bits), and a 1 above
     /// them where it misses: equal keys are the same colour, seen or not.
     std::vector<std::uint32_t> key_;
-    std::vector<std::uint8_t> key_bytes_;  ///< scratch: a row's colour bytes
-    std::vector<std::uint8_t> refine_;     ///< per pixel of decided_
+    std::vector<std::uint8_t> first_bytes_;  ///< per pixel of traced_: the colour as bytes
+    std::vector<std::uint8_t> refine_;       ///< per pixel of decided_
     /// Per pixel of traced_: whether it differs from the pixel to its right, and below.
     std::vector<std::uint8_t> differs_right_, differs_below_;
+    std::vector<std::uint8_t> no_differences_;  ///< zeros: the row above the image
     /// Refined pixels (indices into decided_) and their other sub * sub - 1 samples, pixel by
     /// pixel, each pixel's in row order without the first.
     std::vector<std::uint32_t> refined_pixels_;

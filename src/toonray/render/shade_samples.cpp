@@ -34,8 +34,7 @@ inline V3 negate(const V3& a) {
 }
 // dot(): (x * x' + y * y') + z * z'.
 inline __m128 dot4(const V3& a, const V3& b) {
-    return _mm_add_ps(_mm_add_ps(_mm_mul_ps(a.x, b.x), _mm_mul_ps(a.y, b.y)),
-                      _mm_mul_ps(a.z, b.z));
+    return _mm_add_ps(_mm_add_ps(_mm_mul_ps(a.x, b.x), _mm_mul_ps(a.y, b.y)), _mm_mul_ps(a.z, b.z));
 }
 // cross() component by component.
 inline V3 cross4(const V3& a, const V3& b) {
@@ -129,8 +128,8 @@ void shade_four_plain(const ShadingContext& ctx, const ViewPlane& view, const Li
     alignas(16) std::uint32_t with_normals[4];
     for (int l = 0; l < 4; ++l) {
         tn[l] = &scene.tri_normals[hits[l].prim];
-        const bool with = (*tn[l])[0] != kNoIndex && (*tn[l])[1] != kNoIndex &&
-                          (*tn[l])[2] != kNoIndex;
+        const bool with =
+            (*tn[l])[0] != kNoIndex && (*tn[l])[1] != kNoIndex && (*tn[l])[2] != kNoIndex;
         with_normals[l] = with ? ~0u : 0u;
         all_with_normals &= with;
     }
@@ -146,9 +145,8 @@ void shade_four_plain(const ShadingContext& ctx, const ViewPlane& view, const Li
     __m128 face_ok = zero;
     if (need_face) {
         auto corner = [&](int c) {
-            return gather([&](int l) {
-                return scene.positions[scene.tri_positions[hits[l].prim][c]];
-            });
+            return gather(
+                [&](int l) { return scene.positions[scene.tri_positions[hits[l].prim][c]]; });
         };
         const V3 a = corner(0);
         const V3 face = cross4(sub(corner(1), a), sub(corner(2), a));
@@ -161,9 +159,8 @@ void shade_four_plain(const ShadingContext& ctx, const ViewPlane& view, const Li
     // where all three corners have one and the result has a finite, non-zero length; else the
     // face's normal, or -normalize(dir) for a degenerate face.
     auto vertex_normal = [&](int c) {
-        return gather([&](int l) {
-            return with_normals[l] ? scene.normals[(*tn[l])[c]] : Vec3f(0.0f);
-        });
+        return gather(
+            [&](int l) { return with_normals[l] ? scene.normals[(*tn[l])[c]] : Vec3f(0.0f); });
     };
     const __m128 w0 = _mm_sub_ps(_mm_sub_ps(one, uv), vv);
     const V3 m0 = scale(vertex_normal(0), w0), m1 = scale(vertex_normal(1), uv),
@@ -193,8 +190,8 @@ void shade_four_plain(const ShadingContext& ctx, const ViewPlane& view, const Li
     const __m128 l_dot_n = _mm_blendv_ps(one, _mm_div_ps(dot4(to_light, normal), distance),
                                          _mm_cmpgt_ps(distance, zero));
     // std::max(0, l.n) is maxps(l.n, 0) and std::min(d, 1) is minps(1, d), NaNs included.
-    const __m128 diffuse = _mm_min_ps(
-        one, _mm_mul_ps(_mm_set1_ps(light.intensity), _mm_max_ps(l_dot_n, zero)));
+    const __m128 diffuse =
+        _mm_min_ps(one, _mm_mul_ps(_mm_set1_ps(light.intensity), _mm_max_ps(l_dot_n, zero)));
     // ToonRamp::level: the first threshold the diffuse term is below.
     const ToonRamp& ramp = ctx.settings.ramp;
     __m128i band = _mm_setzero_si128();
@@ -228,12 +225,12 @@ void shade_four_plain(const ShadingContext& ctx, const ViewPlane& view, const Li
 
 }  // namespace
 
-void shade_samples(const ShadingContext& ctx, const ViewPlane& view, const Vec3f& background,
-                   int n, const Vec3f* dirs, const Hit* hits, const bool* found,
+void shade_samples(const ShadingContext& ctx, const ViewPlane& view, const Vec3f& background, int n,
+                   const Vec3f* dirs, const Hit* hits, const bool* found,
                    const ShadedSamples& out) {
     const Light* plain = plain_point_light(ctx);
-    const Outputs kind = out.distance ? Outputs::Classic
-                                      : (out.view_depth ? Outputs::Surface : Outputs::Colour);
+    const Outputs kind =
+        out.distance ? Outputs::Classic : (out.view_depth ? Outputs::Surface : Outputs::Colour);
     auto run = [&](int begin, int end) {
         switch (kind) {
             case Outputs::Colour:
@@ -259,8 +256,7 @@ void shade_samples(const ShadingContext& ctx, const ViewPlane& view, const Vec3f
                 shade_four_plain<Outputs::Colour>(ctx, view, *plain, dirs + i, hits + i, out, i);
             else if (kind == Outputs::Surface)
                 shade_four_plain<Outputs::Surface>(ctx, view, *plain, dirs + i, hits + i, out, i);
-            else
-                shade_four_plain<Outputs::Classic>(ctx, view, *plain, dirs + i, hits + i, out, i);
+            else shade_four_plain<Outputs::Classic>(ctx, view, *plain, dirs + i, hits + i, out, i);
         }
     }
     run(i, n);

@@ -27,8 +27,7 @@ struct ShadedSamples {
 /// materials are shaded together in SIMD, with the operations of shading_normal,
 /// geometric_normal and shade_plain in their order, so every value has the same bits as the
 /// scalar functions give.
-void shade_samples(const ShadingContext& ctx, const ViewPlane& view, const Vec3f& background,
-                   int n, const Vec3f* dirs, const Hit* hits, const bool* found,
-                   const ShadedSamples& out);
+void shade_samples(const ShadingContext& ctx, const ViewPlane& view, const Vec3f& background, int n,
+                   const Vec3f* dirs, const Hit* hits, const bool* found, const ShadedSamples& out);
 
 }  // namespace toonray
