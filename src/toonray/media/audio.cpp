@@ -1,6 +1,5 @@
 #include "toonray/media/audio.h"
 
-#include <fluidsynth.h>
 
 #include <algorithm>
 #include <array>
@@ -14,6 +13,8 @@
 #include <mutex>
 #include <numbers>
 #include <vector>
+
+#include "toonray/media/fluidsynth_library.h"
 
 namespace toonray {
 
@@ -37,7 +38,7 @@ void install_fluid_logging() {
     static std::once_flag once;
     std::call_once(once, [] {
         for (int level = FLUID_PANIC; level < LAST_LOG_LEVEL; ++level)
-            fluid_set_log_function(level, fluid_log_to_collector, nullptr);
+            fluidsynth().fluid_set_log_function(level, fluid_log_to_collector, nullptr);
     });
 }
 
@@ -56,10 +57,10 @@ private:
 };
 
 struct SettingsDeleter {
-    void operator()(fluid_settings_t* s) const { delete_fluid_settings(s); }
+    void operator()(fluid_settings_t* s) const { fluidsynth().delete_fluid_settings(s); }
 };
 struct SynthDeleter {
-    void operator()(fluid_synth_t* s) const { delete_fluid_synth(s); }
+    void operator()(fluid_synth_t* s) const { fluidsynth().delete_fluid_synth(s); }
 };
 
 std::string joined(const std::vector<std::string>& messages) {
@@ -170,22 +171,23 @@ void validate(const Score& score, const AudioOptions& o) {
 /// warning) so a single-instrument piano SoundFont works without knowing its preset number.
 std::string select_preset(fluid_synth_t* synth, int sfont_id, const AudioOptions& o,
                           const std::filesystem::path& path, Warnings& warnings) {
-    fluid_sfont_t* sfont = fluid_synth_get_sfont_by_id(synth, sfont_id);
+    const FluidSynthLibrary& fs = fluidsynth();
+    fluid_sfont_t* sfont = fs.fluid_synth_get_sfont_by_id(synth, sfont_id);
     if (!sfont) throw Error(fmt::format("{}: SoundFont vanished after loading", path.string()));
-    if (fluid_preset_t* p = fluid_sfont_get_preset(sfont, o.bank, o.program)) {
-        fluid_synth_program_select(synth, 0, sfont_id, o.bank, o.program);
-        return fluid_preset_get_name(p);
+    if (fluid_preset_t* p = fs.fluid_sfont_get_preset(sfont, o.bank, o.program)) {
+        fs.fluid_synth_program_select(synth, 0, sfont_id, o.bank, o.program);
+        return fs.fluid_preset_get_name(p);
     }
-    fluid_sfont_iteration_start(sfont);
-    fluid_preset_t* first = fluid_sfont_iteration_next(sfont);
+    fs.fluid_sfont_iteration_start(sfont);
+    fluid_preset_t* first = fs.fluid_sfont_iteration_next(sfont);
     if (!first) throw Error(fmt::format("{}: SoundFont has no presets", path.string()));
-    const int bank = fluid_preset_get_banknum(first), program = fluid_preset_get_num(first);
-    std::string name = fluid_preset_get_name(first);
+    const int bank = fs.fluid_preset_get_banknum(first), program = fs.fluid_preset_get_num(first);
+    std::string name = fs.fluid_preset_get_name(first);
     warnings.push_back(
         fmt::format("{}: no preset at bank {} program {}; using '{}' (bank {} "
                     "program {})",
                     path.string(), o.bank, o.program, name, bank, program));
-    fluid_synth_program_select(synth, 0, sfont_id, bank, program);
+    fs.fluid_synth_program_select(synth, 0, sfont_id, bank, program);
     return name;
 }
 
@@ -247,27 +249,28 @@ AudioResult synthesize_score(const Score& score, const AudioOptions& options) {
 
     // --- The synthesiser. ---
     install_fluid_logging();
+    const FluidSynthLibrary& fs = fluidsynth();
     std::vector<std::string> messages;
     FluidMessageScope scope(&messages);
     check_soundfont_file(sf_path);
 
-    std::unique_ptr<fluid_settings_t, SettingsDeleter> settings(new_fluid_settings());
+    std::unique_ptr<fluid_settings_t, SettingsDeleter> settings(fs.new_fluid_settings());
     if (!settings) throw Error("audio: FluidSynth could not create its settings");
-    fluid_settings_setnum(settings.get(), "synth.sample-rate", rate);
-    fluid_settings_setnum(settings.get(), "synth.gain", options.gain);
-    fluid_settings_setint(settings.get(), "synth.reverb.active", options.reverb ? 1 : 0);
-    fluid_settings_setint(settings.get(), "synth.chorus.active", 0);
+    fs.fluid_settings_setnum(settings.get(), "synth.sample-rate", rate);
+    fs.fluid_settings_setnum(settings.get(), "synth.gain", options.gain);
+    fs.fluid_settings_setint(settings.get(), "synth.reverb.active", options.reverb ? 1 : 0);
+    fs.fluid_settings_setint(settings.get(), "synth.chorus.active", 0);
     // One rendering thread: FluidSynth's parallel voice mixing is not needed offline, and a
     // single thread keeps the output independent of scheduling.
-    fluid_settings_setint(settings.get(), "synth.cpu-cores", 1);
+    fs.fluid_settings_setint(settings.get(), "synth.cpu-cores", 1);
     // Load only the samples the selected preset uses (a few MB of FluidR3's 148 MB).
-    fluid_settings_setint(settings.get(), "synth.dynamic-sample-loading", 1);
-    fluid_settings_setint(settings.get(), "synth.polyphony", 256);
+    fs.fluid_settings_setint(settings.get(), "synth.dynamic-sample-loading", 1);
+    fs.fluid_settings_setint(settings.get(), "synth.polyphony", 256);
 
-    std::unique_ptr<fluid_synth_t, SynthDeleter> synth(new_fluid_synth(settings.get()));
+    std::unique_ptr<fluid_synth_t, SynthDeleter> synth(fs.new_fluid_synth(settings.get()));
     if (!synth) throw Error(fmt::format("audio: FluidSynth could not start: {}", joined(messages)));
     messages.clear();
-    const int sfont_id = fluid_synth_sfload(synth.get(), sf_path.c_str(), 1);
+    const int sfont_id = fs.fluid_synth_sfload(synth.get(), sf_path.c_str(), 1);
     if (sfont_id == FLUID_FAILED)
         throw Error(fmt::format("{}: FluidSynth could not load the SoundFont{}{}", sf_path.string(),
                                 messages.empty() ? "" : ": ", joined(messages)));
@@ -289,7 +292,7 @@ AudioResult synthesize_score(const Score& score, const AudioOptions& options) {
         until = std::min(until, total);
         while (pos < until) {
             const int n = static_cast<int>(std::min<std::int64_t>(kMaxBlock, until - pos));
-            fluid_synth_write_float(synth.get(), n, left.data(), 0, 1, right.data(), 0, 1);
+            fs.fluid_synth_write_float(synth.get(), n, left.data(), 0, 1, right.data(), 0, 1);
             for (int i = 0; i < n; ++i) {
                 const std::int64_t s = pos + i;
                 float g = 1.0f;
@@ -322,14 +325,14 @@ AudioResult synthesize_score(const Score& score, const AudioOptions& options) {
                 // A second strike of a key already sounding restarts it, as on a real piano;
                 // FluidSynth releases the old voice.
                 ++held[e.key];
-                fluid_synth_noteon(synth.get(), 0, e.key, e.value);
+                fs.fluid_synth_noteon(synth.get(), 0, e.key, e.value);
                 break;
             case SynthEvent::NoteOff:
                 // Only the last of overlapping same-key notes releases the key.
                 if (held[e.key] > 0 && --held[e.key] == 0)
-                    fluid_synth_noteoff(synth.get(), 0, e.key);
+                    fs.fluid_synth_noteoff(synth.get(), 0, e.key);
                 break;
-            case SynthEvent::Pedal: fluid_synth_cc(synth.get(), 0, 64, e.key); break;
+            case SynthEvent::Pedal: fs.fluid_synth_cc(synth.get(), 0, 64, e.key); break;
         }
     }
     render_until(total);
