@@ -101,9 +101,9 @@ void RenderArgs::add_to(CLI::App& app) {
         "Also write feature images to this directory, named after the output: "
         "NAME_depth, _normal, _edges, _cel .png, and per mode: classic _edges_depth, "
         "_edges_normal; robust _lines_silhouette, _lines_crease, _lines_depth, _lines_object, "
-        "_lines_material, _object_id, _material_id; ink _lines_silhouette, _lines_crease, "
-        "_lines_material, _lines_border, _lines_intersection, _lines_polyline, _object_id, "
-        "_material_id");
+        "_lines_material, _object_id, _material_id, _samples; ink _lines_silhouette, "
+        "_lines_crease, _lines_material, _lines_border, _lines_intersection, _lines_polyline, "
+        "_object_id, _material_id, _samples");
     app.add_option("--aov-exr", aov_exr,
                    "Also write the feature images as one multi-layer OpenEXR (docs/exr.md): "
                    "render: this .exr file; batch, piano, demo: a directory, one NAME.exr a frame");

@@ -66,7 +66,7 @@ TEST(FrameRenderer, WritesTheImageAndAllFeatureImagesNamedAfterTheOutput) {
             EXPECT_EQ(read_png(p).width, 64);
             EXPECT_EQ(p, aov_path(dir.path / "aov", dir.path / "frame.png", f.name));
         }
-        EXPECT_EQ(written, mode == EdgeMode::Robust ? 11u : (mode == EdgeMode::Ink ? 12u : 6u));
+        EXPECT_EQ(written, mode == EdgeMode::Robust ? 12u : (mode == EdgeMode::Ink ? 13u : 6u));
         fs::remove_all(dir.path / "aov");
     }
 }

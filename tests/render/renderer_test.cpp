@@ -304,13 +304,13 @@ TEST(Renderer, FeatureImageTableListsEachModesImages) {
     EXPECT_EQ(ink, (std::vector<std::string_view>{
                        "depth", "normal", "edges", "cel", "lines_silhouette", "lines_crease",
                        "lines_material", "lines_border", "lines_intersection", "lines_polyline",
-                       "object_id", "material_id"}));
+                       "object_id", "material_id", "samples"}));
     EXPECT_EQ(classic, (std::vector<std::string_view>{"depth", "normal", "edges_depth",
                                                       "edges_normal", "edges", "cel"}));
-    EXPECT_EQ(robust,
-              (std::vector<std::string_view>{"depth", "normal", "edges", "cel", "lines_silhouette",
-                                             "lines_crease", "lines_depth", "lines_object",
-                                             "lines_material", "object_id", "material_id"}));
+    EXPECT_EQ(robust, (std::vector<std::string_view>{
+                          "depth", "normal", "edges", "cel", "lines_silhouette", "lines_crease",
+                          "lines_depth", "lines_object", "lines_material", "object_id",
+                          "material_id", "samples"}));
 }
 
 // frame_buffer_bytes counts the buffers a renderer holds after a frame: exactly the frame-sized

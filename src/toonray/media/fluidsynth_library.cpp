@@ -23,10 +23,10 @@ const FluidSynthLibrary& fluidsynth() {
                                   TOONRAY_FLUIDSYNTH_SONAME, ::dlerror());
             return;
         }
-#define TOONRAY_FLUIDSYNTH_LOAD(name)                                                          \
-    library.name = reinterpret_cast<decltype(&::name)>(::dlsym(handle, #name));                \
-    if (!library.name && failure.empty())                                                      \
-        failure = fmt::format("sound needs FluidSynth ({}), which has no function {}",          \
+#define TOONRAY_FLUIDSYNTH_LOAD(name)                                                  \
+    library.name = reinterpret_cast<decltype(&::name)>(::dlsym(handle, #name));        \
+    if (!library.name && failure.empty())                                              \
+        failure = fmt::format("sound needs FluidSynth ({}), which has no function {}", \
                               TOONRAY_FLUIDSYNTH_SONAME, #name);
         TOONRAY_FLUIDSYNTH_FUNCTIONS(TOONRAY_FLUIDSYNTH_LOAD)
 #undef TOONRAY_FLUIDSYNTH_LOAD

@@ -11,26 +11,26 @@ namespace toonray {
 
 /// The FluidSynth functions toonray calls, with their own names and types.
 struct FluidSynthLibrary {
-#define TOONRAY_FLUIDSYNTH_FUNCTIONS(X)                                                           \
-    X(new_fluid_settings)                                                                          \
-    X(delete_fluid_settings)                                                                       \
-    X(fluid_settings_setnum)                                                                       \
-    X(fluid_settings_setint)                                                                       \
-    X(new_fluid_synth)                                                                             \
-    X(delete_fluid_synth)                                                                          \
-    X(fluid_synth_sfload)                                                                          \
-    X(fluid_synth_get_sfont_by_id)                                                                 \
-    X(fluid_synth_program_select)                                                                  \
-    X(fluid_synth_noteon)                                                                          \
-    X(fluid_synth_noteoff)                                                                         \
-    X(fluid_synth_cc)                                                                              \
-    X(fluid_synth_write_float)                                                                     \
-    X(fluid_sfont_get_preset)                                                                      \
-    X(fluid_sfont_iteration_start)                                                                 \
-    X(fluid_sfont_iteration_next)                                                                  \
-    X(fluid_preset_get_name)                                                                       \
-    X(fluid_preset_get_banknum)                                                                    \
-    X(fluid_preset_get_num)                                                                        \
+#define TOONRAY_FLUIDSYNTH_FUNCTIONS(X) \
+    X(new_fluid_settings)               \
+    X(delete_fluid_settings)            \
+    X(fluid_settings_setnum)            \
+    X(fluid_settings_setint)            \
+    X(new_fluid_synth)                  \
+    X(delete_fluid_synth)               \
+    X(fluid_synth_sfload)               \
+    X(fluid_synth_get_sfont_by_id)      \
+    X(fluid_synth_program_select)       \
+    X(fluid_synth_noteon)               \
+    X(fluid_synth_noteoff)              \
+    X(fluid_synth_cc)                   \
+    X(fluid_synth_write_float)          \
+    X(fluid_sfont_get_preset)           \
+    X(fluid_sfont_iteration_start)      \
+    X(fluid_sfont_iteration_next)       \
+    X(fluid_preset_get_name)            \
+    X(fluid_preset_get_banknum)         \
+    X(fluid_preset_get_num)             \
     X(fluid_set_log_function)
 #define TOONRAY_FLUIDSYNTH_MEMBER(name) decltype(&::name) name = nullptr;
     TOONRAY_FLUIDSYNTH_FUNCTIONS(TOONRAY_FLUIDSYNTH_MEMBER)

@@ -109,6 +109,7 @@ std::span<const FeatureImage> feature_images() {
         {"lines_polyline", false, false, true, &Aovs::lines_polyline},
         {"object_id", false, true, true, &Aovs::object_id},
         {"material_id", false, true, true, &Aovs::material_id},
+        {"samples", false, true, true, &Aovs::samples},
     };
     return kImages;
 }
@@ -377,6 +378,7 @@ void Renderer::render_buckets(const Scene& scene, const TriangleAccel& accel, co
         aovs_.normal.reshape(w, h);
         aovs_.object_id.reshape(w, h);
         aovs_.material_id.reshape(w, h);
+        aovs_.samples.reshape(w, h);
         if (robust) {
             aovs_.cel.reshape(w, h);
             aovs_.edges.reshape(w, h);
@@ -459,6 +461,7 @@ void Renderer::first_sample_features(const Bucket& bucket, const BucketBuffers& 
             aovs_.normal(x, y) = found ? normal_colour(first.normal[i]) : Rgb8{0, 0, 0};
             aovs_.object_id(x, y) = id_colour(found ? first.object[i] : kNoIndex);
             aovs_.material_id(x, y) = id_colour(found ? first.material[i] : kNoIndex);
+            aovs_.samples(x, y) = b.sampler.refined(x, y) ? 0 : 255;
         }
 }
 

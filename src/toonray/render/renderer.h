@@ -90,6 +90,9 @@ struct Aovs {
         lines_material;  ///< robust; ink: silhouette, crease and material
     ImageGray8 lines_border, lines_intersection, lines_polyline;  ///< ink
     ImageRgb8 object_id, material_id;  ///< robust and ink: ids in false colour
+    /// Robust and ink: 0 where a pixel took every sample of its grid (adaptive sampling), 255
+    /// where it took one.
+    ImageGray8 samples;
 };
 
 /// One feature image of Aovs: its name, the line modes that fill it, and which member it is.
@@ -110,7 +113,8 @@ struct FeatureImage {
 /// (line coverage), cel, lines_silhouette, lines_crease, lines_depth, lines_object,
 /// lines_material, object_id, material_id. Ink: depth, normal, edges (line coverage), cel,
 /// one coverage image per line type (lines_silhouette, lines_crease, lines_material,
-/// lines_border, lines_intersection, lines_polyline), object_id, material_id.
+/// lines_border, lines_intersection, lines_polyline), object_id, material_id. Robust and ink
+/// also: samples.
 std::span<const FeatureImage> feature_images();
 
 /// Bytes of the buffers Renderer keeps for a frame with `settings`: classic mode's G-buffer and
