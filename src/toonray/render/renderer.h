@@ -45,8 +45,10 @@ struct RenderSettings {
     /// supersampling, the reference the adaptive frames are measured against).
     bool adaptive = true;
     /// Robust and ink: pixels per side of the buckets the frame is rendered in. Memory follows
-    /// the bucket, not the image; the frame is the same for any size.
-    int tile_size = 64;
+    /// the bucket, not the image; the frame is the same for any size. 126: with the one pixel
+    /// of halo each side that an ink bucket traces, 128 = 8 of the accelerator's 16-ray tiles
+    /// (piano frame: 3% fewer instructions in the bucket pass than 64).
+    int tile_size = 126;
     int threads = 0;  ///< 0 = all hardware threads
     /// Also compute the feature images (Renderer::aovs). The final image is the same either way.
     bool feature_images = false;
