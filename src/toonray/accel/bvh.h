@@ -43,8 +43,16 @@ struct Bvh {
     /// built as parallel tasks. Deterministic: the same input gives the same tree for any thread
     /// count (work is cut at fixed sizes, merges are exact min/max and sums, and nodes are
     /// numbered in a final depth-first pass).
-    [[nodiscard]] static Bvh build(std::span<const BBox> boxes, const Config& config);
+    [[nodiscard]] static Bvh build(std::span<const BBox> boxes, const Config& config) {
+        return build(boxes, config, nullptr);
+    }
     [[nodiscard]] static Bvh build(std::span<const BBox> boxes) { return build(boxes, Config{}); }
+    /// The same, and when `leaf_areas` is not null, fills it with the half area of each
+    /// primitive's box in leaf order (leaf_areas[i] = boxes[prim_indices[i]].half_area(), bit
+    /// for bit), which the leaves write as they are made: a wide collapse reads it in order
+    /// instead of gathering boxes.
+    [[nodiscard]] static Bvh build(std::span<const BBox> boxes, const Config& config,
+                                   std::vector<float>* leaf_areas);
 
     /// Recomputes node bounds for moved primitives, keeping the topology (for animation where
     /// only poses change).

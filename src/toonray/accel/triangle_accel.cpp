@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <memory>
 
+#include "toonray/accel/huge_pages.h"
 #include "toonray/accel/kernels.h"
 #include "toonray/accel/watertight.h"
 
@@ -56,6 +57,7 @@ const accel::KernelTable& kernels() { return *kernels_slot().load(std::memory_or
 
 void boxes_of(std::span<const Vec3f> positions, std::span<const std::array<std::uint32_t, 3>> tris,
               std::vector<BBox>& boxes) {
+    accel::reserve_huge(boxes, tris.size());
     boxes.resize(tris.size());
     for (std::size_t i = 0; i < tris.size(); ++i) {
         BBox b;
@@ -88,10 +90,11 @@ void TriangleAccel::build(std::span<const Vec3f> positions,
                           const Bvh::Config& config) {
     std::vector<BBox> boxes;
     boxes_of(positions, tris, boxes);
-    bvh_ = Bvh::build(boxes, config);
+    std::vector<float> leaf_areas;
+    bvh_ = Bvh::build(boxes, config, &leaf_areas);
     triangle_count_ = tris.size();
     collapse_ = {config.traversal_cost, config.intersection_cost};
-    wide_.build(bvh_, boxes, positions, tris, collapse_);
+    wide_.build(bvh_, leaf_areas, positions, tris, collapse_);
 }
 
 void TriangleAccel::refit(std::span<const Vec3f> positions,
@@ -99,7 +102,10 @@ void TriangleAccel::refit(std::span<const Vec3f> positions,
     std::vector<BBox> boxes;
     boxes_of(positions, tris, boxes);
     bvh_.refit(boxes);
-    wide_.build(bvh_, boxes, positions, tris, collapse_);
+    std::vector<float> leaf_areas(bvh_.prim_indices.size());
+    for (std::size_t i = 0; i < leaf_areas.size(); ++i)
+        leaf_areas[i] = boxes[bvh_.prim_indices[i]].half_area();
+    wide_.build(bvh_, leaf_areas, positions, tris, collapse_);
 }
 
 std::size_t TriangleAccel::memory_bytes() const {
