@@ -2,6 +2,9 @@
 // no fused multiply-adds (the project compiles with -ffp-contract=off).
 #include "toonray/accel/triangle_accel.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <atomic>
 #include <cstdlib>
 #include <memory>
@@ -59,11 +62,14 @@ void boxes_of(std::span<const Vec3f> positions, std::span<const std::array<std::
               std::vector<BBox>& boxes) {
     accel::reserve_huge(boxes, tris.size());
     boxes.resize(tris.size());
-    for (std::size_t i = 0; i < tris.size(); ++i) {
-        BBox b;
-        for (std::uint32_t v : tris[i]) b.extend(positions[v]);
-        boxes[i] = b;
-    }
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, tris.size(), 1u << 14),
+                      [&](const auto& r) {
+                          for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                              BBox b;
+                              for (std::uint32_t v : tris[i]) b.extend(positions[v]);
+                              boxes[i] = b;
+                          }
+                      });
 }
 
 constexpr std::size_t kFixedStack = 256;

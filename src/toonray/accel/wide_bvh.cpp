@@ -1,5 +1,8 @@
 #include "toonray/accel/wide_bvh.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <limits>
 #include <memory>
@@ -57,30 +60,48 @@ void WideBvh::build(const Bvh& bvh, std::span<const float> leaf_areas,
             for (auto& axis : corner) std::fill(std::begin(axis), std::end(axis), nan);
         std::fill(std::begin(empty.prim), std::end(empty.prim), kNoIndex);
     }
+    // Leaves take their slots in the order they are made (depth-first through the wide tree);
+    // the triangles are copied into the blocks afterwards, block by block in parallel: reading
+    // their corners is the slow part (gathers through the index buffer).
+    auto slot_prim = make_huge_array<std::uint32_t>(tri_count);
     std::uint32_t next_slot = 0;
-    // Leaves are packed in the order they are made (depth-first through the wide tree).
     auto make_leaf = [&](const BvhNode& leaf) {
         const std::uint32_t first = next_slot;
-        for (std::uint32_t i = 0; i < leaf.count; ++i, ++next_slot) {
-            const std::uint32_t l = next_slot % 4;
-            if (l == 0) blocks.push_back(empty);
-            TriBlock& b = blocks.back();
-            const std::uint32_t p = bvh.prim_indices[leaf.first + i];
-            for (int c = 0; c < 3; ++c) {
-                const Vec3f& v = positions[tris[p][c]];
-                b.v[c][0][l] = v.x;
-                b.v[c][1][l] = v.y;
-                b.v[c][2][l] = v.z;
-            }
-            b.prim[l] = p | (i + 1 == leaf.count ? kLeafEnd : 0u);
-        }
+        for (std::uint32_t i = 0; i < leaf.count; ++i)
+            slot_prim[next_slot++] =
+                bvh.prim_indices[leaf.first + i] | (i + 1 == leaf.count ? kLeafEnd : 0u);
         return kLeafBit | ((leaf.count <= 15 ? leaf.count : 0u) << kLeafCountShift) | first;
+    };
+    // Fills the blocks, plus two empty ones after the last (8-wide loads may read up to two
+    // blocks past a leaf).
+    auto pack = [&] {
+        const std::size_t used = (next_slot + 3) / 4;
+        blocks.resize(used + 2);
+        blocks[used] = empty;
+        blocks[used + 1] = empty;
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, used, 2048), [&](const auto& r) {
+            for (std::size_t b = r.begin(); b != r.end(); ++b) {
+                TriBlock block = empty;
+                const std::size_t lanes = std::min<std::size_t>(4, next_slot - 4 * b);
+                for (std::size_t l = 0; l < lanes; ++l) {
+                    const std::uint32_t slot = slot_prim[4 * b + l];
+                    const std::uint32_t p = slot & ~kLeafEnd;
+                    for (int c = 0; c < 3; ++c) {
+                        const Vec3f& v = positions[tris[p][c]];
+                        block.v[c][0][l] = v.x;
+                        block.v[c][1][l] = v.y;
+                        block.v[c][2][l] = v.z;
+                    }
+                    block.prim[l] = slot;
+                }
+                blocks[b] = block;
+            }
+        });
     };
 
     if (bvh.nodes[0].is_leaf()) {
         root = make_leaf(bvh.nodes[0]);
-        blocks.push_back(empty);
-        blocks.push_back(empty);
+        pack();
         return;
     }
 
@@ -192,8 +213,7 @@ void WideBvh::build(const Bvh& bvh, std::span<const float> leaf_areas,
 
     if (flags[0] & kAsLeaf) {
         root = make_leaf(range(0));
-        blocks.push_back(empty);
-        blocks.push_back(empty);
+        pack();
         return;
     }
     struct Item {
@@ -239,9 +259,8 @@ void WideBvh::build(const Bvh& bvh, std::span<const float> leaf_areas,
         }
         nodes[item.wide] = w;
     }
+    pack();
     // Traversal pushes at most 7 entries per level.
-    blocks.push_back(empty);  // 8-wide loads may read up to two blocks past a leaf
-    blocks.push_back(empty);
     max_stack = 8 * static_cast<std::size_t>(depth) + 8;
 }
 
