@@ -526,11 +526,11 @@ struct Builder {
     }
 };
 
-}  // namespace
-
-Bvh Bvh::build(std::span<const BBox> boxes, const Config& config, std::vector<float>* leaf_areas) {
+// Builds over n primitives whose boxes box_of(i, lo, hi) gives (w lanes 0).
+template <class BoxOf>
+Bvh build_over(std::size_t n, BoxOf box_of, const Bvh::Config& config,
+               std::vector<float>* leaf_areas) {
     Bvh bvh;
-    const std::size_t n = boxes.size();
     if (n == 0) return bvh;  // no nodes at all: a zero-count node would read as an inner node
 
     // Not value-initialised: every element is written before it is read (pages are touched
@@ -544,9 +544,8 @@ Bvh Bvh::build(std::span<const BBox> boxes, const Config& config, std::vector<fl
             Box4 bb, cc;
             std::size_t e = std::min(n, (chunk + 1) * kChunk);
             for (std::size_t i = chunk * kChunk; i < e; ++i) {
-                const BBox& box = boxes[i];
-                __m128 lo = _mm_setr_ps(box.lo.x, box.lo.y, box.lo.z, 0.0f);
-                __m128 hi = _mm_setr_ps(box.hi.x, box.hi.y, box.hi.z, 0.0f);
+                __m128 lo, hi;
+                box_of(i, lo, hi);
                 bb.extend(lo, hi);
                 cc.extend_point(_mm_add_ps(lo, hi));
                 refs[i].lo = _mm_castsi128_ps(
@@ -614,6 +613,38 @@ Bvh Bvh::build(std::span<const BBox> boxes, const Config& config, std::vector<fl
         }
     }
     return bvh;
+}
+
+}  // namespace
+
+Bvh Bvh::build(std::span<const BBox> boxes, const Config& config, std::vector<float>* leaf_areas) {
+    return build_over(
+        boxes.size(),
+        [&](std::size_t i, __m128& lo, __m128& hi) {
+            const BBox& box = boxes[i];
+            lo = _mm_setr_ps(box.lo.x, box.lo.y, box.lo.z, 0.0f);
+            hi = _mm_setr_ps(box.hi.x, box.hi.y, box.hi.z, 0.0f);
+        },
+        config, leaf_areas);
+}
+
+Bvh Bvh::build(std::span<const Vec3f> positions, std::span<const std::array<std::uint32_t, 3>> tris,
+               const Config& config, std::vector<float>* leaf_areas) {
+    return build_over(
+        tris.size(),
+        [&](std::size_t i, __m128& lo, __m128& hi) {
+            // BBox::extend from an empty box, corner by corner: std::min(a, b) is
+            // _mm_min_ps(b, a) (and max likewise), also for signed zeros and NaN.
+            lo = kPosInf;
+            hi = kNegInf;
+            for (std::uint32_t v : tris[i]) {
+                const Vec3f& p = positions[v];
+                const __m128 c = _mm_setr_ps(p.x, p.y, p.z, 0.0f);
+                lo = _mm_min_ps(c, lo);
+                hi = _mm_max_ps(c, hi);
+            }
+        },
+        config, leaf_areas);
 }
 
 void Bvh::refit(std::span<const BBox> boxes) {

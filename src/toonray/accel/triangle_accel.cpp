@@ -94,10 +94,8 @@ bool intersect_triangle(const Ray& ray, const Vec3f& v0, const Vec3f& v1, const 
 void TriangleAccel::build(std::span<const Vec3f> positions,
                           std::span<const std::array<std::uint32_t, 3>> tris,
                           const Bvh::Config& config) {
-    std::vector<BBox> boxes;
-    boxes_of(positions, tris, boxes);
     std::vector<float> leaf_areas;
-    bvh_ = Bvh::build(boxes, config, &leaf_areas);
+    bvh_ = Bvh::build(positions, tris, config, &leaf_areas);
     triangle_count_ = tris.size();
     collapse_ = {config.traversal_cost, config.intersection_cost};
     wide_.build(bvh_, leaf_areas, positions, tris, collapse_);
