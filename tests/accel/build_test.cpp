@@ -59,6 +59,13 @@ void expect_one_tree(const Bvh& bvh, std::size_t prims) {
     for (std::size_t p = 0; p < prims; ++p) ASSERT_EQ(seen[p], 1) << "primitive " << p;
 }
 
+// The same nodes (bounds bit for bit) and primitive order.
+void expect_same_tree(const Bvh& a, const Bvh& b) {
+    ASSERT_EQ(a.prim_indices, b.prim_indices);
+    ASSERT_EQ(a.nodes.size(), b.nodes.size());
+    EXPECT_EQ(std::memcmp(a.nodes.data(), b.nodes.data(), a.nodes.size() * sizeof(BvhNode)), 0);
+}
+
 }  // namespace
 
 TEST(Build, SubtreesBuiltApartJoinIntoOneTree) {
@@ -76,11 +83,7 @@ TEST(Build, LeafAreasAreTheBoxesInLeafOrder) {
         std::vector<float> areas;
         const Bvh with = Bvh::build(boxes, Bvh::Config{}, &areas);
         const Bvh without = Bvh::build(boxes);
-        ASSERT_EQ(with.prim_indices, without.prim_indices);
-        ASSERT_EQ(with.nodes.size(), without.nodes.size());
-        ASSERT_EQ(std::memcmp(with.nodes.data(), without.nodes.data(),
-                              with.nodes.size() * sizeof(BvhNode)),
-                  0);
+        expect_same_tree(with, without);
         ASSERT_EQ(areas.size(), boxes.size());
         for (std::size_t i = 0; i < areas.size(); ++i) {
             const float expected = boxes[with.prim_indices[i]].half_area();
@@ -102,11 +105,7 @@ TEST(Build, FromTrianglesIsFromTheirBoxes) {
     std::vector<float> from_boxes_areas, from_tris_areas;
     const Bvh from_boxes = Bvh::build(boxes_of(s), Bvh::Config{}, &from_boxes_areas);
     const Bvh from_tris = Bvh::build(s.positions, s.tris, Bvh::Config{}, &from_tris_areas);
-    ASSERT_EQ(from_tris.prim_indices, from_boxes.prim_indices);
-    ASSERT_EQ(from_tris.nodes.size(), from_boxes.nodes.size());
-    EXPECT_EQ(std::memcmp(from_tris.nodes.data(), from_boxes.nodes.data(),
-                          from_tris.nodes.size() * sizeof(BvhNode)),
-              0);
+    expect_same_tree(from_tris, from_boxes);
     ASSERT_EQ(from_tris_areas.size(), from_boxes_areas.size());
     EXPECT_EQ(std::memcmp(from_tris_areas.data(), from_boxes_areas.data(),
                           from_tris_areas.size() * sizeof(float)),
