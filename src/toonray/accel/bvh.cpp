@@ -9,6 +9,7 @@
 #include <limits>
 #include <memory>
 #include <mutex>
+#include <type_traits>
 
 #include "toonray/accel/huge_pages.h"
 #include "toonray/core/simd_sse.h"
@@ -65,17 +66,22 @@ struct Box4 {
 // in the w lane of `hi` (an integer). One store fewer per update than a count array: the binning
 // loop is bound by its stores.
 struct Bins {
-    Box4 box[3][kMaxBins];  // [axis][bin]
+    // Plain data: a Box4 member would initialise all 3 x 64 bins on every construction, and
+    // clear() sets only the bins a node uses.
+    struct Bin {
+        __m128 lo, hi;
+    };
+    Bin box[3][kMaxBins];  // [axis][bin]
     void clear(int n) {
-        const Box4 empty{kPosInf, _mm_blend_ps(kNegInf, _mm_setzero_ps(), 8)};
+        const Bin empty{kPosInf, _mm_blend_ps(kNegInf, _mm_setzero_ps(), 8)};
         for (int a = 0; a < 3; ++a)
             for (int b = 0; b < n; ++b) box[a][b] = empty;
     }
     void merge(const Bins& o, int n) {
         for (int a = 0; a < 3; ++a)
             for (int b = 0; b < n; ++b) {
-                Box4& x = box[a][b];
-                const Box4& y = o.box[a][b];
+                Bin& x = box[a][b];
+                const Bin& y = o.box[a][b];
                 x.lo = _mm_min_ps(x.lo, y.lo);
                 x.hi = _mm_blend_ps(
                     _mm_max_ps(x.hi, y.hi),
@@ -91,7 +97,7 @@ struct Bins {
                               static_cast<int>(count(2, b)), 0);
     }
 };
-static_assert(sizeof(Box4) == 32);
+static_assert(sizeof(Bins::Bin) == 32 && std::is_trivially_default_constructible_v<Bins>);
 
 // Half areas of three boxes at once (lanes 0-2).
 inline __m128 half_areas(const Box4& a, const Box4& b, const Box4& c) {
@@ -137,7 +143,7 @@ inline void bin_add(Bins& bins, const PrimRef& r, __m128i off) {
                               static_cast<std::uint32_t>(_mm_extract_epi32(off, 1)),
                               static_cast<std::uint32_t>(_mm_extract_epi32(off, 2))};
     for (int a = 0; a < 3; ++a) {
-        Box4& b = *reinterpret_cast<Box4*>(boxes + o[a]);
+        Bins::Bin& b = *reinterpret_cast<Bins::Bin*>(boxes + o[a]);
         b.lo = _mm_min_ps(b.lo, r.lo);
         b.hi = _mm_blend_ps(_mm_max_ps(b.hi, r.hi),
                             _mm_castsi128_ps(_mm_add_epi32(_mm_castps_si128(b.hi), one)), 8);
@@ -327,7 +333,7 @@ struct Builder {
         Box4 acc[3];
         __m128i cnt = _mm_setzero_si128();
         for (int i = bins - 1; i > 0; --i) {
-            for (int a = 0; a < 3; ++a) acc[a].extend(b.box[a][i]);
+            for (int a = 0; a < 3; ++a) acc[a].extend(b.box[a][i].lo, b.box[a][i].hi);
             cnt = _mm_add_epi32(cnt, b.counts(i));
             right_area[i] = half_areas(acc[0], acc[1], acc[2]);
             right_count[i] = cnt;
@@ -339,7 +345,7 @@ struct Builder {
         __m128i best_bin = _mm_setzero_si128();
         __m128i best_count = _mm_setzero_si128();
         for (int i = 0; i < bins - 1; ++i) {
-            for (int a = 0; a < 3; ++a) acc[a].extend(b.box[a][i]);
+            for (int a = 0; a < 3; ++a) acc[a].extend(b.box[a][i].lo, b.box[a][i].hi);
             cnt = _mm_add_epi32(cnt, b.counts(i));
             __m128 cost = _mm_add_ps(_mm_mul_ps(half_areas(acc[0], acc[1], acc[2]), blocks4(cnt)),
                                      _mm_mul_ps(right_area[i + 1], blocks4(right_count[i + 1])));
@@ -371,7 +377,8 @@ struct Builder {
             }
         if (best.axis >= 0)
             for (int i = 0; i < bins; ++i)
-                (i < best.bin ? best.left : best.right).extend(b.box[best.axis][i]);
+                (i < best.bin ? best.left : best.right)
+                    .extend(b.box[best.axis][i].lo, b.box[best.axis][i].hi);
         return best;
     }
 
