@@ -285,7 +285,10 @@ struct Builder {
     NewChunk new_chunk(std::size_t first_prim, std::size_t prims) {
         auto chunk = std::make_unique<NodeChunk>();
         chunk->first_prim = first_prim;
-        accel::reserve_huge(chunk->nodes, prims);  // a subtree has about 0.6 nodes a primitive
+        // A subtree has about 0.6 nodes a primitive, but a task's chunk holds only the nodes not
+        // in its own subtasks' chunks: the top levels of a large subtree, or a whole small one.
+        // Not advised for huge pages, which would zero 2 MiB for the few nodes of a large one.
+        chunk->nodes.reserve(std::min<std::size_t>(prims, kTaskSize * 2));
         std::lock_guard lock(chunks_mutex);
         chunk->id = static_cast<std::uint32_t>(chunks.size());
         chunks.push_back(std::move(chunk));
