@@ -6,10 +6,12 @@
 
 #include <algorithm>
 #include <cstddef>
-#include <atomic>
 #include <limits>
 #include <memory>
+#include <mutex>
+#include <type_traits>
 
+#include "toonray/accel/huge_pages.h"
 #include "toonray/core/simd_sse.h"
 
 namespace toonray {
@@ -60,29 +62,42 @@ struct Box4 {
     }
 };
 
+// Per axis and bin: the bounds of the primitives whose centres fall in the bin, and their count
+// in the w lane of `hi` (an integer). One store fewer per update than a count array: the binning
+// loop is bound by its stores.
 struct Bins {
-    Box4 box[3][kMaxBins];             // [axis][bin]: 32 bytes each
-    std::uint32_t count[3][kMaxBins];  // at a byte offset 1/8 of its box's
+    // Plain data: a Box4 member would initialise all 3 x 64 bins on every construction, and
+    // clear() sets only the bins a node uses.
+    struct Bin {
+        __m128 lo, hi;
+    };
+    Bin box[3][kMaxBins];  // [axis][bin]
     void clear(int n) {
+        const Bin empty{kPosInf, _mm_blend_ps(kNegInf, _mm_setzero_ps(), 8)};
         for (int a = 0; a < 3; ++a)
-            for (int b = 0; b < n; ++b) {
-                box[a][b] = Box4{};
-                count[a][b] = 0;
-            }
+            for (int b = 0; b < n; ++b) box[a][b] = empty;
     }
     void merge(const Bins& o, int n) {
         for (int a = 0; a < 3; ++a)
             for (int b = 0; b < n; ++b) {
-                box[a][b].extend(o.box[a][b]);
-                count[a][b] += o.count[a][b];
+                Bin& x = box[a][b];
+                const Bin& y = o.box[a][b];
+                x.lo = _mm_min_ps(x.lo, y.lo);
+                x.hi = _mm_blend_ps(
+                    _mm_max_ps(x.hi, y.hi),
+                    _mm_castsi128_ps(_mm_add_epi32(_mm_castps_si128(x.hi), _mm_castps_si128(y.hi))),
+                    8);
             }
     }
+    [[nodiscard]] std::uint32_t count(int a, int b) const {
+        return static_cast<std::uint32_t>(_mm_extract_epi32(_mm_castps_si128(box[a][b].hi), 3));
+    }
     [[nodiscard]] __m128i counts(int b) const {
-        return _mm_setr_epi32(static_cast<int>(count[0][b]), static_cast<int>(count[1][b]),
-                              static_cast<int>(count[2][b]), 0);
+        return _mm_setr_epi32(static_cast<int>(count(0, b)), static_cast<int>(count(1, b)),
+                              static_cast<int>(count(2, b)), 0);
     }
 };
-static_assert(sizeof(Box4) == 32 && offsetof(Bins, count) == 3 * kMaxBins * 32);
+static_assert(sizeof(Bins::Bin) == 32 && std::is_trivially_default_constructible_v<Bins>);
 
 // Half areas of three boxes at once (lanes 0-2).
 inline __m128 half_areas(const Box4& a, const Box4& b, const Box4& c) {
@@ -119,19 +134,19 @@ struct Binner {
 
 
 // Adds one primitive to the bin of its centre on each axis; `off` holds the byte offsets of
-// those bins' boxes (the counts are at 1/8 of them).
+// those bins. The primitive's hi.w is 0, which the max leaves as it is; the count is added.
 inline void bin_add(Bins& bins, const PrimRef& r, __m128i off) {
     char* boxes = reinterpret_cast<char*>(&bins.box[0][0]);
-    char* counts = reinterpret_cast<char*>(&bins.count[0][0]);
+    const __m128i one = _mm_setr_epi32(0, 0, 0, 1);
     // Unsigned, so that the offsets need no sign extension.
     const std::size_t o[3] = {static_cast<std::uint32_t>(_mm_cvtsi128_si32(off)),
                               static_cast<std::uint32_t>(_mm_extract_epi32(off, 1)),
                               static_cast<std::uint32_t>(_mm_extract_epi32(off, 2))};
     for (int a = 0; a < 3; ++a) {
-        Box4& b = *reinterpret_cast<Box4*>(boxes + o[a]);
+        Bins::Bin& b = *reinterpret_cast<Bins::Bin*>(boxes + o[a]);
         b.lo = _mm_min_ps(b.lo, r.lo);
-        b.hi = _mm_max_ps(b.hi, r.hi);
-        ++*reinterpret_cast<std::uint32_t*>(counts + (o[a] >> 3));
+        b.hi = _mm_blend_ps(_mm_max_ps(b.hi, r.hi),
+                            _mm_castsi128_ps(_mm_add_epi32(_mm_castps_si128(b.hi), one)), 8);
     }
 }
 
@@ -143,27 +158,42 @@ void bin_range(const PrimRef* refs, std::size_t begin, std::size_t end, const Bi
         bin_add(bins, refs[i], _mm_add_epi32(_mm_slli_epi32(binner.bin(refs[i]), 5), axis_off));
 }
 
-// The same into two bin sets, even and odd primitives apart: neighbours in memory are
-// neighbours in space and usually share bins, and one set would chain every update on the
-// previous one through memory.
-void bin_range2(const PrimRef* refs, std::size_t begin, std::size_t end, const Binner& binner,
-                Bins& a, Bins& b) {
+// The same into four bin sets, primitive i into set i % 4, merged into `out` after: neighbours
+// in memory are neighbours in space and usually share bins, and one set would chain every
+// update on the previous one's through memory (four sets measured faster than one or two).
+void bin_range4(const PrimRef* refs, std::size_t begin, std::size_t end, const Binner& binner,
+                int bins, Bins& out) {
+    Bins more[3];
+    for (Bins& m : more) m.clear(bins);
+    Bins* sets[4] = {&out, &more[0], &more[1], &more[2]};
     const __m128i axis_off = _mm_setr_epi32(0, kMaxBins * 32, 2 * kMaxBins * 32, 0);
     std::size_t i = begin;
-    for (; i + 1 < end; i += 2) {
-        const PrimRef& r0 = refs[i];
-        const PrimRef& r1 = refs[i + 1];
-        const __m128i o0 = _mm_add_epi32(_mm_slli_epi32(binner.bin(r0), 5), axis_off);
-        const __m128i o1 = _mm_add_epi32(_mm_slli_epi32(binner.bin(r1), 5), axis_off);
-        bin_add(a, r0, o0);
-        bin_add(b, r1, o1);
-    }
-    if (i < end)
-        bin_add(a, refs[i], _mm_add_epi32(_mm_slli_epi32(binner.bin(refs[i]), 5), axis_off));
+    for (; i + 3 < end; i += 4)
+        for (int k = 0; k < 4; ++k)
+            bin_add(*sets[k], refs[i + k],
+                    _mm_add_epi32(_mm_slli_epi32(binner.bin(refs[i + k]), 5), axis_off));
+    for (; i < end; ++i)
+        bin_add(out, refs[i], _mm_add_epi32(_mm_slli_epi32(binner.bin(refs[i]), 5), axis_off));
+    for (const Bins& m : more) out.merge(m, bins);
 }
 
+// Nodes as one task makes them, in the order it makes them (depth first, children pairs after
+// their parent). A task that builds a subtree of its own gets a chunk of its own, whose node 0
+// is that subtree's root; in its parent's chunk the root's slot holds a reference to it
+// (kSubtree) until the chunks are joined, ordered by the subtree's first primitive: an order that
+// does not depend on scheduling, so neither does the tree's layout.
+constexpr std::uint32_t kSubtree = 0xffffffffu;  // BvhNode::count of a slot whose node is elsewhere
+
+struct NodeChunk {
+    std::vector<BvhNode> nodes;
+    std::uint32_t id = 0;  // index in Builder::chunks
+    std::size_t first_prim = 0;
+    std::uint32_t offset = 0;  // where its node 1 goes in the joined array
+};
+
 struct Task {
-    std::uint32_t node;    // index in the temporary node array
+    NodeChunk* chunk;
+    std::uint32_t node;    // index in chunk->nodes
     std::uint32_t buffer;  // which of the two PrimRef arrays holds the range
     std::size_t begin, end;
     Box4 bounds, centres;
@@ -172,51 +202,97 @@ struct Task {
 struct Split {
     int axis = -1;
     int bin = 0;  // primitives in bins [0, bin) go left
+    std::uint32_t left_count = 0;
     float cost = std::numeric_limits<float>::infinity();
     Box4 left, right;
 };
 
 // Whether a primitive goes left: its bin on axis A is below the split. The same float
-// operations as Binner::bin (the clamp does not change the comparison, as 1 <= split < bins).
+// operations as Binner::bin (the clamp does not change the comparison, as 1 <= split < bins),
+// so exactly Split::left_count primitives go left.
 template <int A>
 struct GoesLeft {
     __m128 base, scale;
-    int split;
+    __m128i split;  // the split bin in every lane
+    // All ones when the centre goes left.
+    [[nodiscard]] __m128i mask(__m128 centre) const {
+        return _mm_cmplt_epi32(_mm_shuffle_epi32(bin(centre), A * 0x55), split);
+    }
     [[nodiscard]] bool operator()(__m128 centre) const {
-        __m128i i = _mm_cvttps_epi32(_mm_mul_ps(_mm_sub_ps(centre, base), scale));
-        return _mm_extract_epi32(i, A) < split;
+        return _mm_extract_epi32(bin(centre), A) < _mm_cvtsi128_si32(split);
+    }
+    [[nodiscard]] __m128i bin(__m128 centre) const {
+        return _mm_cvttps_epi32(_mm_mul_ps(_mm_sub_ps(centre, base), scale));
     }
 };
+
+// Moves src[begin, end) into dst, those going left from `left_at` on and the others from
+// `right_at` on, in their order, and bounds the centres of both sides. No branch depends on the
+// side: it would be mispredicted about as often as not (the bounds by blends; a second pass
+// over each side for them, without blends, measured more instructions and more mispredicted
+// loop exits).
+template <int A>
+void partition_range(const PrimRef* src, PrimRef* dst, std::size_t begin, std::size_t end,
+                     std::size_t left_at, std::size_t right_at, GoesLeft<A> left, Box4& lc,
+                     Box4& rc) {
+    __m128 llo = lc.lo, lhi = lc.hi, rlo = rc.lo, rhi = rc.hi;
+    for (std::size_t i = begin; i < end; ++i) {
+        const __m128 lo = src[i].lo, hi = src[i].hi;
+        const __m128 c = _mm_add_ps(lo, hi);
+        const __m128 m = _mm_castsi128_ps(left.mask(c));
+        const std::size_t goes_left = static_cast<std::size_t>(_mm_movemask_ps(m) & 1);
+        const std::size_t at = goes_left ? left_at : right_at;
+        dst[at].lo = lo;
+        dst[at].hi = hi;
+        left_at += goes_left;
+        right_at += goes_left ^ 1;
+        llo = _mm_min_ps(llo, _mm_blendv_ps(kPosInf, c, m));
+        lhi = _mm_max_ps(lhi, _mm_blendv_ps(kNegInf, c, m));
+        rlo = _mm_min_ps(rlo, _mm_blendv_ps(c, kPosInf, m));
+        rhi = _mm_max_ps(rhi, _mm_blendv_ps(c, kNegInf, m));
+    }
+    lc = Box4{llo, lhi};
+    rc = Box4{rlo, rhi};
+}
 
 struct Builder {
     const Bvh::Config& config;
     int bins;
     int max_leaf;
-    int block_shift;      // log2 of the block size
-    PrimRef* buffers[2];  // the primitives, and scratch space for parallel partitions (ping-pong)
-    // Nodes in allocation order (which depends on scheduling). Plain data, left uninitialised:
-    // room for 2n - 1 nodes is reserved but far fewer are used, and untouched pages cost nothing.
-    struct TmpNode {
-        float lo[3], hi[3];
-        std::uint32_t first, count;
-    };
-    std::unique_ptr<TmpNode[]> tmp;
-    void set_node(std::uint32_t i, const Box4& box, std::uint32_t first, std::uint32_t count) {
-        alignas(16) float l[4], h[4];
-        _mm_store_ps(l, box.lo);
-        _mm_store_ps(h, box.hi);
-        tmp[i] = TmpNode{{l[0], l[1], l[2]}, {h[0], h[1], h[2]}, first, count};
-    }
-    std::atomic<std::uint32_t> next_node{1};
+    int block_shift;              // log2 of the block size
+    PrimRef* buffers[2];          // the primitives, and where partitions move them (ping-pong)
+    std::uint32_t* prim_indices;  // leaves write their primitives' ids here
+    float* leaf_areas;            // and, when not null, their boxes' half areas
     tbb::task_group tasks;
+    std::mutex chunks_mutex;
+    std::vector<std::unique_ptr<NodeChunk>> chunks;
 
-    Builder(const Bvh::Config& c, PrimRef* refs, PrimRef* scratch)
+    Builder(const Bvh::Config& c, PrimRef* refs, PrimRef* scratch, std::uint32_t* ids, float* areas)
         : config(c),
           bins(std::clamp(c.bin_count, 2, kMaxBins)),
           max_leaf(std::clamp(c.max_leaf_size, 1, kMaxLeaf)),
           block_shift(0),
-          buffers{refs, scratch} {
+          buffers{refs, scratch},
+          prim_indices(ids),
+          leaf_areas(areas) {
         while ((1 << block_shift) < std::clamp(c.block_size, 1, 64)) ++block_shift;
+    }
+
+    struct NewChunk {
+        NodeChunk* chunk;
+        std::uint32_t id;
+    };
+    NewChunk new_chunk(std::size_t first_prim, std::size_t prims) {
+        auto chunk = std::make_unique<NodeChunk>();
+        chunk->first_prim = first_prim;
+        // A subtree has about 0.6 nodes a primitive, but a task's chunk holds only the nodes not
+        // in its own subtasks' chunks: the top levels of a large subtree, or a whole small one.
+        // Not advised for huge pages, which would zero 2 MiB for the few nodes of a large one.
+        chunk->nodes.reserve(std::min<std::size_t>(prims, kTaskSize * 2));
+        std::lock_guard lock(chunks_mutex);
+        chunk->id = static_cast<std::uint32_t>(chunks.size());
+        chunks.push_back(std::move(chunk));
+        return {chunks.back().get(), chunks.back()->id};
     }
 
     [[nodiscard]] float blocks(std::uint32_t n) const {
@@ -228,13 +304,10 @@ struct Builder {
         const PrimRef* refs = buffers[t.buffer];
         out.clear(bins);
         if (n < kParallelSplit) {
-            if (n < 128) {
+            if (n < 1024) {
                 bin_range(refs, t.begin, t.end, binner, out);
             } else {
-                Bins other;
-                other.clear(bins);
-                bin_range2(refs, t.begin, t.end, binner, out, other);
-                out.merge(other, bins);
+                bin_range4(refs, t.begin, t.end, binner, bins, out);
             }
             return;
         }
@@ -243,11 +316,8 @@ struct Builder {
         tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks, 1), [&](const auto& r) {
             for (std::size_t c = r.begin(); c != r.end(); ++c) {
                 partial[c].clear(bins);
-                Bins other;
-                other.clear(bins);
-                std::size_t b = t.begin + c * kChunk;
-                bin_range2(refs, b, std::min(b + kChunk, t.end), binner, partial[c], other);
-                partial[c].merge(other, bins);
+                const std::size_t b = t.begin + c * kChunk;
+                bin_range4(refs, b, std::min(b + kChunk, t.end), binner, bins, partial[c]);
             }
         });
         // min/max and integer sums are exact: the merge order cannot change the result.
@@ -266,7 +336,7 @@ struct Builder {
         Box4 acc[3];
         __m128i cnt = _mm_setzero_si128();
         for (int i = bins - 1; i > 0; --i) {
-            for (int a = 0; a < 3; ++a) acc[a].extend(b.box[a][i]);
+            for (int a = 0; a < 3; ++a) acc[a].extend(b.box[a][i].lo, b.box[a][i].hi);
             cnt = _mm_add_epi32(cnt, b.counts(i));
             right_area[i] = half_areas(acc[0], acc[1], acc[2]);
             right_count[i] = cnt;
@@ -276,8 +346,9 @@ struct Builder {
         const __m128i total = _mm_set1_epi32(static_cast<int>(n));
         __m128 best_cost = _mm_set1_ps(std::numeric_limits<float>::infinity());
         __m128i best_bin = _mm_setzero_si128();
+        __m128i best_count = _mm_setzero_si128();
         for (int i = 0; i < bins - 1; ++i) {
-            for (int a = 0; a < 3; ++a) acc[a].extend(b.box[a][i]);
+            for (int a = 0; a < 3; ++a) acc[a].extend(b.box[a][i].lo, b.box[a][i].hi);
             cnt = _mm_add_epi32(cnt, b.counts(i));
             __m128 cost = _mm_add_ps(_mm_mul_ps(half_areas(acc[0], acc[1], acc[2]), blocks4(cnt)),
                                      _mm_mul_ps(right_area[i + 1], blocks4(right_count[i + 1])));
@@ -290,119 +361,81 @@ struct Builder {
             best_cost = _mm_blendv_ps(best_cost, cost, better);
             best_bin = _mm_castps_si128(_mm_blendv_ps(
                 _mm_castsi128_ps(best_bin), _mm_castsi128_ps(_mm_set1_epi32(i + 1)), better));
+            best_count = _mm_castps_si128(
+                _mm_blendv_ps(_mm_castsi128_ps(best_count), _mm_castsi128_ps(cnt), better));
         }
         alignas(16) float costs[4];
         alignas(16) int bin_of[4];
+        alignas(16) std::uint32_t count_of[4];
         _mm_store_ps(costs, best_cost);
         _mm_store_si128(reinterpret_cast<__m128i*>(bin_of), best_bin);
+        _mm_store_si128(reinterpret_cast<__m128i*>(count_of), best_count);
         Split best;
         for (int axis = 0; axis < 3; ++axis)
             if (costs[axis] < best.cost) {
                 best.cost = costs[axis];
                 best.axis = axis;
                 best.bin = bin_of[axis];
+                best.left_count = count_of[axis];
             }
         if (best.axis >= 0)
             for (int i = 0; i < bins; ++i)
-                (i < best.bin ? best.left : best.right).extend(b.box[best.axis][i]);
+                (i < best.bin ? best.left : best.right)
+                    .extend(b.box[best.axis][i].lo, b.box[best.axis][i].hi);
         return best;
     }
 
-    // In place: [begin, mid) go left. Returns mid.
+    // Moves t's range into the other buffer, the left side first (stable), several tasks when
+    // it is large; sets the children's buffer and centre bounds.
     template <int A>
-    static std::size_t partition_serial(PrimRef* refs, std::size_t begin, std::size_t end,
-                                        GoesLeft<A> left, Box4& lc, Box4& rc) {
-        std::size_t i = begin, j = end;
-        while (true) {
-            while (i < j) {
-                __m128 c = _mm_add_ps(refs[i].lo, refs[i].hi);
-                if (!left(c)) break;
-                lc.extend_point(c);
-                ++i;
-            }
-            while (i < j) {
-                __m128 c = _mm_add_ps(refs[j - 1].lo, refs[j - 1].hi);
-                if (left(c)) break;
-                rc.extend_point(c);
-                --j;
-            }
-            if (i >= j) break;
-            std::swap(refs[i], refs[j - 1]);  // both are now on their side: the loops take them
+    void partition_axis(const Task& t, const Binner& binner, const Split& s, Task& l, Task& r) {
+        const GoesLeft<A> left{binner.base, binner.scale, _mm_set1_epi32(s.bin)};
+        const PrimRef* src = buffers[t.buffer];
+        PrimRef* dst = buffers[1 - t.buffer];
+        l.buffer = r.buffer = 1 - t.buffer;
+        const std::size_t n = t.end - t.begin;
+        if (n < kParallelSplit) {
+            partition_range(src, dst, t.begin, t.end, t.begin, t.begin + s.left_count, left,
+                            l.centres, r.centres);
+            return;
         }
-        return i;
-    }
-
-    // Stable, several tasks: from `src` into `dst`, left side first. Returns mid.
-    template <int A>
-    static std::size_t partition_parallel(const PrimRef* src, PrimRef* dst, std::size_t begin,
-                                          std::size_t end, GoesLeft<A> left, Box4& lc, Box4& rc) {
-        const std::size_t n = end - begin;
+        // In chunks: count each chunk's left side, then each chunk knows where its primitives go.
         const std::size_t chunks = (n + kChunk - 1) / kChunk;
         std::vector<std::size_t> left_count(chunks);
-        std::vector<Box4> lcs(chunks), rcs(chunks);
-        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks, 1), [&](const auto& r) {
-            for (std::size_t c = r.begin(); c != r.end(); ++c) {
-                std::size_t b = begin + c * kChunk, e = std::min(b + kChunk, end), k = 0;
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks, 1), [&](const auto& range) {
+            for (std::size_t c = range.begin(); c != range.end(); ++c) {
+                const std::size_t b = t.begin + c * kChunk, e = std::min(b + kChunk, t.end);
+                std::size_t k = 0;
                 for (std::size_t i = b; i < e; ++i) k += left(_mm_add_ps(src[i].lo, src[i].hi));
                 left_count[c] = k;
             }
         });
         std::vector<std::size_t> left_at(chunks), right_at(chunks);
-        std::size_t nl = 0;
+        std::size_t nl = 0, nr = 0;
         for (std::size_t c = 0; c < chunks; ++c) {
-            left_at[c] = nl;
+            left_at[c] = t.begin + nl;
+            right_at[c] = t.begin + s.left_count + nr;
             nl += left_count[c];
-        }
-        std::size_t nr = 0;
-        for (std::size_t c = 0; c < chunks; ++c) {
-            right_at[c] = nl + nr;
             nr += std::min(kChunk, n - c * kChunk) - left_count[c];
         }
-        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks, 1), [&](const auto& r) {
-            for (std::size_t c = r.begin(); c != r.end(); ++c) {
-                std::size_t b = begin + c * kChunk, e = std::min(b + kChunk, end);
-                std::size_t li = begin + left_at[c], ri = begin + right_at[c];
-                Box4 l, rr;
-                for (std::size_t i = b; i < e; ++i) {
-                    const PrimRef& p = src[i];
-                    __m128 cen = _mm_add_ps(p.lo, p.hi);
-                    if (left(cen)) {
-                        dst[li++] = p;
-                        l.extend_point(cen);
-                    } else {
-                        dst[ri++] = p;
-                        rr.extend_point(cen);
-                    }
-                }
-                lcs[c] = l;
-                rcs[c] = rr;
+        std::vector<Box4> lcs(chunks), rcs(chunks);
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks, 1), [&](const auto& range) {
+            for (std::size_t c = range.begin(); c != range.end(); ++c) {
+                const std::size_t b = t.begin + c * kChunk, e = std::min(b + kChunk, t.end);
+                partition_range(src, dst, b, e, left_at[c], right_at[c], left, lcs[c], rcs[c]);
             }
         });
         for (std::size_t c = 0; c < chunks; ++c) {
-            lc.extend(lcs[c]);
-            rc.extend(rcs[c]);
+            l.centres.extend(lcs[c]);
+            r.centres.extend(rcs[c]);
         }
-        return begin + nl;
     }
 
-    // Splits t's range; sets the children's buffer, returns the middle.
-    template <int A>
-    std::size_t partition_axis(const Task& t, const Binner& binner, int split, Task& l, Task& r) {
-        GoesLeft<A> left{binner.base, binner.scale, split};
-        if (t.end - t.begin < kParallelSplit) {
-            l.buffer = r.buffer = t.buffer;
-            return partition_serial(buffers[t.buffer], t.begin, t.end, left, l.centres, r.centres);
-        }
-        l.buffer = r.buffer = 1 - t.buffer;
-        return partition_parallel(buffers[t.buffer], buffers[1 - t.buffer], t.begin, t.end, left,
-                                  l.centres, r.centres);
-    }
-
-    std::size_t partition(const Task& t, const Binner& binner, const Split& s, Task& l, Task& r) {
+    void partition(const Task& t, const Binner& binner, const Split& s, Task& l, Task& r) {
         switch (s.axis) {
-            case 0: return partition_axis<0>(t, binner, s.bin, l, r);
-            case 1: return partition_axis<1>(t, binner, s.bin, l, r);
-            default: return partition_axis<2>(t, binner, s.bin, l, r);
+            case 0: partition_axis<0>(t, binner, s, l, r); break;
+            case 1: partition_axis<1>(t, binner, s, l, r); break;
+            default: partition_axis<2>(t, binner, s, l, r); break;
         }
     }
 
@@ -414,10 +447,19 @@ struct Builder {
         }
     }
 
+    static void set_node(const Task& t, const Box4& box, std::uint32_t first, std::uint32_t count) {
+        t.chunk->nodes[t.node] = BvhNode{box.bbox(), first, count};
+    }
+
     void make_leaf(const Task& t) {
-        if (t.buffer != 0)
-            std::copy(buffers[1] + t.begin, buffers[1] + t.end, buffers[0] + t.begin);
-        set_node(t.node, t.bounds, static_cast<std::uint32_t>(t.begin),
+        const PrimRef* refs = buffers[t.buffer];
+        for (std::size_t i = t.begin; i < t.end; ++i)
+            prim_indices[i] =
+                static_cast<std::uint32_t>(_mm_extract_epi32(_mm_castps_si128(refs[i].lo), 3));
+        if (leaf_areas)
+            for (std::size_t i = t.begin; i < t.end; ++i)
+                leaf_areas[i] = Box4{refs[i].lo, refs[i].hi}.half_area();
+        set_node(t, t.bounds, static_cast<std::uint32_t>(t.begin),
                  static_cast<std::uint32_t>(t.end - t.begin));
     }
 
@@ -446,7 +488,8 @@ struct Builder {
             Split s = find_split(bins_storage, node_bins, n);
             const float leaf_cost = config.intersection_cost * blocks(n);
             std::size_t mid;
-            Task left{0, t.buffer, t.begin, 0, {}, {}}, right{0, t.buffer, 0, t.end, {}, {}};
+            Task left{t.chunk, 0, t.buffer, t.begin, 0, {}, {}};
+            Task right{t.chunk, 0, t.buffer, 0, t.end, {}, {}};
             if (s.axis >= 0) {
                 float split_cost = config.traversal_cost +
                                    config.intersection_cost * s.cost / t.bounds.half_area();
@@ -454,7 +497,8 @@ struct Builder {
                     make_leaf(t);
                     continue;
                 }
-                mid = partition(t, binner, s, left, right);
+                partition(t, binner, s, left, right);
+                mid = t.begin + s.left_count;
                 left.bounds = s.left;
                 right.bounds = s.right;
             } else {
@@ -468,11 +512,19 @@ struct Builder {
             }
             left.end = mid;
             right.begin = mid;
-            std::uint32_t pair = next_node.fetch_add(2, std::memory_order_relaxed);
-            set_node(t.node, t.bounds, pair, 0);
+            auto& nodes = t.chunk->nodes;
+            const auto pair = static_cast<std::uint32_t>(nodes.size());
+            nodes.resize(nodes.size() + 2);
+            set_node(t, t.bounds, pair, 0);
             left.node = pair;
             right.node = pair + 1;
             if (right.end - right.begin >= kTaskSize && left.end - left.begin >= kTaskSize) {
+                // The right child's subtree goes into a chunk of its own, its root first.
+                const NewChunk chunk = new_chunk(right.begin, right.end - right.begin);
+                nodes[pair + 1] = BvhNode{{}, chunk.id, kSubtree};
+                chunk.chunk->nodes.emplace_back();
+                right.chunk = chunk.chunk;
+                right.node = 0;
                 tasks.run([this, right] { build(right); });
             } else {
                 todo.push_back(right);
@@ -482,16 +534,16 @@ struct Builder {
     }
 };
 
-}  // namespace
-
-Bvh Bvh::build(std::span<const BBox> boxes, const Config& config) {
+// Builds over n primitives whose boxes box_of(i, lo, hi) gives (w lanes 0).
+template <class BoxOf>
+Bvh build_over(std::size_t n, BoxOf box_of, const Bvh::Config& config,
+               std::vector<float>* leaf_areas) {
     Bvh bvh;
-    const std::size_t n = boxes.size();
     if (n == 0) return bvh;  // no nodes at all: a zero-count node would read as an inner node
 
     // Not value-initialised: every element is written before it is read (pages are touched
     // only when used).
-    auto refs = std::make_unique_for_overwrite<PrimRef[]>(n);
+    auto refs = accel::make_huge_array<PrimRef>(n);
     Box4 bounds, centres;
     {
         const std::size_t chunks = (n + kChunk - 1) / kChunk;
@@ -500,9 +552,8 @@ Bvh Bvh::build(std::span<const BBox> boxes, const Config& config) {
             Box4 bb, cc;
             std::size_t e = std::min(n, (chunk + 1) * kChunk);
             for (std::size_t i = chunk * kChunk; i < e; ++i) {
-                const BBox& box = boxes[i];
-                __m128 lo = _mm_setr_ps(box.lo.x, box.lo.y, box.lo.z, 0.0f);
-                __m128 hi = _mm_setr_ps(box.hi.x, box.hi.y, box.hi.z, 0.0f);
+                __m128 lo, hi;
+                box_of(i, lo, hi);
                 bb.extend(lo, hi);
                 cc.extend_point(_mm_add_ps(lo, hi));
                 refs[i].lo = _mm_castsi128_ps(
@@ -525,38 +576,83 @@ Bvh Bvh::build(std::span<const BBox> boxes, const Config& config) {
         }
     }
 
-    auto scratch = std::make_unique_for_overwrite<PrimRef[]>(n >= kParallelSplit ? n : 0);
-    Builder builder(config, refs.get(), scratch.get());
-    builder.tmp = std::make_unique_for_overwrite<Builder::TmpNode[]>(2 * n - 1);
-    builder.build(Task{0, 0, 0, n, bounds, centres});
+    auto scratch = accel::make_huge_array<PrimRef>(n);
+    accel::reserve_huge(bvh.prim_indices, n);
+    bvh.prim_indices.resize(n);
+    if (leaf_areas) {
+        accel::reserve_huge(*leaf_areas, n);
+        leaf_areas->resize(n);
+    }
+    Builder builder(config, refs.get(), scratch.get(), bvh.prim_indices.data(),
+                    leaf_areas ? leaf_areas->data() : nullptr);
+    NodeChunk* root = builder.new_chunk(0, n).chunk;
+    root->nodes.emplace_back();
+    builder.build(Task{root, 0, 0, 0, n, bounds, centres});
     builder.tasks.wait();
 
-    // Number the nodes depth-first (children pairs after their parent), independently of the
-    // order tasks allocated them in.
-    const Builder::TmpNode* tmp = builder.tmp.get();
-    bvh.nodes.resize(builder.next_node.load());
-    std::vector<std::pair<std::uint32_t, std::uint32_t>> stack{{0u, 0u}};
-    std::uint32_t next = 1;
-    while (!stack.empty()) {
-        auto [from, to] = stack.back();
-        stack.pop_back();
-        const Builder::TmpNode& t = tmp[from];
-        BvhNode node{BBox{Vec3f(t.lo[0], t.lo[1], t.lo[2]), Vec3f(t.hi[0], t.hi[1], t.hi[2])},
-                     t.first, t.count};
-        if (!node.is_leaf()) {
-            std::uint32_t pair = next;
-            next += 2;
-            stack.push_back({node.first + 1, pair + 1});
-            stack.push_back({node.first, pair});
-            node.first = pair;
-        }
-        bvh.nodes[to] = node;
+    // Join the chunks: the root's first, then the others by their first primitive (a parent's
+    // chunk comes before its children's, so children stay after their parents).
+    std::vector<NodeChunk*> order;
+    for (const auto& c : builder.chunks) order.push_back(c.get());
+    std::sort(order.begin(), order.end(),
+              [](const NodeChunk* a, const NodeChunk* b) { return a->first_prim < b->first_prim; });
+    std::size_t total = order[0]->nodes.size();
+    for (std::size_t c = 1; c < order.size(); ++c) {
+        order[c]->offset = static_cast<std::uint32_t>(total);
+        total += order[c]->nodes.size() - 1;  // its root goes into its parent's slot
     }
-    bvh.prim_indices.resize(n);
-    for (std::size_t i = 0; i < n; ++i)
-        bvh.prim_indices[i] =
-            static_cast<std::uint32_t>(_mm_extract_epi32(_mm_castps_si128(refs[i].lo), 3));
+    accel::reserve_huge(bvh.nodes, total);
+    bvh.nodes.resize(total);
+    std::vector<std::uint32_t> root_at(builder.chunks.size(), 0);
+    for (std::size_t c = 0; c < order.size(); ++c) {
+        const NodeChunk& chunk = *order[c];
+        // Local node k >= 1 goes to offset + k - 1 (the root chunk: to k).
+        const std::uint32_t shift = c == 0 ? 0u : chunk.offset - 1;
+        for (std::size_t k = 0; k < chunk.nodes.size(); ++k) {
+            BvhNode node = chunk.nodes[k];
+            const std::uint32_t at =
+                k == 0 && c != 0 ? root_at[chunk.id] : static_cast<std::uint32_t>(k) + shift;
+            if (node.count == kSubtree) {
+                root_at[node.first] = at;  // filled from that chunk
+                continue;
+            }
+            if (!node.is_leaf()) node.first += shift;
+            bvh.nodes[at] = node;
+        }
+    }
     return bvh;
+}
+
+}  // namespace
+
+Bvh Bvh::build(std::span<const BBox> boxes, const Config& config, std::vector<float>* leaf_areas) {
+    return build_over(
+        boxes.size(),
+        [&](std::size_t i, __m128& lo, __m128& hi) {
+            const BBox& box = boxes[i];
+            lo = _mm_setr_ps(box.lo.x, box.lo.y, box.lo.z, 0.0f);
+            hi = _mm_setr_ps(box.hi.x, box.hi.y, box.hi.z, 0.0f);
+        },
+        config, leaf_areas);
+}
+
+Bvh Bvh::build(std::span<const Vec3f> positions, std::span<const std::array<std::uint32_t, 3>> tris,
+               const Config& config, std::vector<float>* leaf_areas) {
+    return build_over(
+        tris.size(),
+        [&](std::size_t i, __m128& lo, __m128& hi) {
+            // BBox::extend from an empty box, corner by corner: std::min(a, b) is
+            // _mm_min_ps(b, a) (and max likewise), also for signed zeros and NaN.
+            lo = kPosInf;
+            hi = kNegInf;
+            for (std::uint32_t v : tris[i]) {
+                const Vec3f& p = positions[v];
+                const __m128 c = _mm_setr_ps(p.x, p.y, p.z, 0.0f);
+                lo = _mm_min_ps(c, lo);
+                hi = _mm_max_ps(c, hi);
+            }
+        },
+        config, leaf_areas);
 }
 
 void Bvh::refit(std::span<const BBox> boxes) {

@@ -3,11 +3,13 @@
 /// boxes, and traversal is left to the caller (see triangle_accel.h, which collapses it into an
 /// 8-wide tree for SIMD traversal).
 
+#include <array>
 #include <cstdint>
 #include <span>
 #include <vector>
 
 #include "toonray/core/bbox.h"
+#include "toonray/core/math.h"
 
 namespace toonray {
 
@@ -43,8 +45,21 @@ struct Bvh {
     /// built as parallel tasks. Deterministic: the same input gives the same tree for any thread
     /// count (work is cut at fixed sizes, merges are exact min/max and sums, and nodes are
     /// numbered in a final depth-first pass).
-    [[nodiscard]] static Bvh build(std::span<const BBox> boxes, const Config& config);
+    [[nodiscard]] static Bvh build(std::span<const BBox> boxes, const Config& config) {
+        return build(boxes, config, nullptr);
+    }
     [[nodiscard]] static Bvh build(std::span<const BBox> boxes) { return build(boxes, Config{}); }
+    /// The same, and when `leaf_areas` is not null, fills it with the half area of each
+    /// primitive's box in leaf order (leaf_areas[i] = boxes[prim_indices[i]].half_area(), bit
+    /// for bit), which the leaves write as they are made: a wide collapse reads it in order
+    /// instead of gathering boxes.
+    [[nodiscard]] static Bvh build(std::span<const BBox> boxes, const Config& config,
+                                   std::vector<float>* leaf_areas);
+    /// The same over triangles, their boxes computed as it goes (the same boxes, bit for bit,
+    /// as BBox::extend over the corners gives): one pass over the triangles fewer.
+    [[nodiscard]] static Bvh build(std::span<const Vec3f> positions,
+                                   std::span<const std::array<std::uint32_t, 3>> tris,
+                                   const Config& config, std::vector<float>* leaf_areas);
 
     /// Recomputes node bounds for moved primitives, keeping the topology (for animation where
     /// only poses change).

@@ -2,10 +2,14 @@
 // no fused multiply-adds (the project compiles with -ffp-contract=off).
 #include "toonray/accel/triangle_accel.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <atomic>
 #include <cstdlib>
 #include <memory>
 
+#include "toonray/accel/huge_pages.h"
 #include "toonray/accel/kernels.h"
 #include "toonray/accel/watertight.h"
 
@@ -56,12 +60,16 @@ const accel::KernelTable& kernels() { return *kernels_slot().load(std::memory_or
 
 void boxes_of(std::span<const Vec3f> positions, std::span<const std::array<std::uint32_t, 3>> tris,
               std::vector<BBox>& boxes) {
+    accel::reserve_huge(boxes, tris.size());
     boxes.resize(tris.size());
-    for (std::size_t i = 0; i < tris.size(); ++i) {
-        BBox b;
-        for (std::uint32_t v : tris[i]) b.extend(positions[v]);
-        boxes[i] = b;
-    }
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, tris.size(), 1u << 14),
+                      [&](const auto& r) {
+                          for (std::size_t i = r.begin(); i != r.end(); ++i) {
+                              BBox b;
+                              for (std::uint32_t v : tris[i]) b.extend(positions[v]);
+                              boxes[i] = b;
+                          }
+                      });
 }
 
 constexpr std::size_t kFixedStack = 256;
@@ -86,12 +94,11 @@ bool intersect_triangle(const Ray& ray, const Vec3f& v0, const Vec3f& v1, const 
 void TriangleAccel::build(std::span<const Vec3f> positions,
                           std::span<const std::array<std::uint32_t, 3>> tris,
                           const Bvh::Config& config) {
-    std::vector<BBox> boxes;
-    boxes_of(positions, tris, boxes);
-    bvh_ = Bvh::build(boxes, config);
+    std::vector<float> leaf_areas;
+    bvh_ = Bvh::build(positions, tris, config, &leaf_areas);
     triangle_count_ = tris.size();
     collapse_ = {config.traversal_cost, config.intersection_cost};
-    wide_.build(bvh_, boxes, positions, tris, collapse_);
+    wide_.build(bvh_, leaf_areas, positions, tris, collapse_);
 }
 
 void TriangleAccel::refit(std::span<const Vec3f> positions,
@@ -99,7 +106,10 @@ void TriangleAccel::refit(std::span<const Vec3f> positions,
     std::vector<BBox> boxes;
     boxes_of(positions, tris, boxes);
     bvh_.refit(boxes);
-    wide_.build(bvh_, boxes, positions, tris, collapse_);
+    std::vector<float> leaf_areas(bvh_.prim_indices.size());
+    for (std::size_t i = 0; i < leaf_areas.size(); ++i)
+        leaf_areas[i] = boxes[bvh_.prim_indices[i]].half_area();
+    wide_.build(bvh_, leaf_areas, positions, tris, collapse_);
 }
 
 std::size_t TriangleAccel::memory_bytes() const {

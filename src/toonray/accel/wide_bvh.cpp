@@ -1,14 +1,42 @@
 #include "toonray/accel/wide_bvh.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <limits>
 #include <memory>
+#include <utility>
 
+#include "toonray/accel/huge_pages.h"
 #include "toonray/core/error.h"
 
 namespace toonray::accel {
+namespace {
 
-void WideBvh::build(const Bvh& bvh, std::span<const BBox> boxes, std::span<const Vec3f> positions,
+// The collapse's step for I slots (2..8): the cheapest of I - 1 slots, or of k slots for the
+// left child's subtree and I - k for the right's. I is a constant so that the loop unrolls: its
+// varying trip count was a mispredicted branch per node and slot count.
+template <int I>
+void best_in_slots(const std::array<float, 8>& cl, const std::array<float, 8>& cr,
+                   std::array<float, 8>& cost, std::array<std::int8_t, 8>& split) {
+    float c = cost[I - 2];
+    int s = 0;
+    for (int k = 1; k < I; ++k) {
+        // Selects, not branches: which side wins is data.
+        const float v = cl[k - 1] + cr[I - k - 1];
+        const bool better = v < c;
+        c = better ? v : c;
+        s = better ? k : s;
+    }
+    cost[I - 1] = c;
+    split[I - 1] = static_cast<std::int8_t>(s);
+}
+
+}  // namespace
+
+void WideBvh::build(const Bvh& bvh, std::span<const float> leaf_areas,
+                    std::span<const Vec3f> positions,
                     std::span<const std::array<std::uint32_t, 3>> tris,
                     const CollapseCosts& costs) {
     nodes.clear();
@@ -23,8 +51,8 @@ void WideBvh::build(const Bvh& bvh, std::span<const BBox> boxes, std::span<const
     const std::size_t tri_count = bvh.prim_indices.size();
     if (tri_count >= kMaxSlots) throw Error("too many triangles for the BVH (at most 134,217,727)");
     blocks.clear();
-    blocks.reserve((tri_count + 3) / 4 + 2);
-    nodes.reserve(leaves / 4 + 1);
+    reserve_huge(blocks, (tri_count + 3) / 4 + 2);
+    reserve_huge(nodes, leaves / 4 + 1);
     TriBlock empty;
     {
         const float nan = std::numeric_limits<float>::quiet_NaN();
@@ -32,30 +60,48 @@ void WideBvh::build(const Bvh& bvh, std::span<const BBox> boxes, std::span<const
             for (auto& axis : corner) std::fill(std::begin(axis), std::end(axis), nan);
         std::fill(std::begin(empty.prim), std::end(empty.prim), kNoIndex);
     }
+    // Leaves take their slots in the order they are made (depth-first through the wide tree);
+    // the triangles are copied into the blocks afterwards, block by block in parallel: reading
+    // their corners is the slow part (gathers through the index buffer).
+    auto slot_prim = make_huge_array<std::uint32_t>(tri_count);
     std::uint32_t next_slot = 0;
-    // Leaves are packed in the order they are made (depth-first through the wide tree).
     auto make_leaf = [&](const BvhNode& leaf) {
         const std::uint32_t first = next_slot;
-        for (std::uint32_t i = 0; i < leaf.count; ++i, ++next_slot) {
-            const std::uint32_t l = next_slot % 4;
-            if (l == 0) blocks.push_back(empty);
-            TriBlock& b = blocks.back();
-            const std::uint32_t p = bvh.prim_indices[leaf.first + i];
-            for (int c = 0; c < 3; ++c) {
-                const Vec3f& v = positions[tris[p][c]];
-                b.v[c][0][l] = v.x;
-                b.v[c][1][l] = v.y;
-                b.v[c][2][l] = v.z;
-            }
-            b.prim[l] = p | (i + 1 == leaf.count ? kLeafEnd : 0u);
-        }
+        for (std::uint32_t i = 0; i < leaf.count; ++i)
+            slot_prim[next_slot++] =
+                bvh.prim_indices[leaf.first + i] | (i + 1 == leaf.count ? kLeafEnd : 0u);
         return kLeafBit | ((leaf.count <= 15 ? leaf.count : 0u) << kLeafCountShift) | first;
+    };
+    // Fills the blocks, plus two empty ones after the last (8-wide loads may read up to two
+    // blocks past a leaf).
+    auto pack = [&] {
+        const std::size_t used = (next_slot + 3) / 4;
+        blocks.resize(used + 2);
+        blocks[used] = empty;
+        blocks[used + 1] = empty;
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, used, 2048), [&](const auto& r) {
+            for (std::size_t b = r.begin(); b != r.end(); ++b) {
+                TriBlock block = empty;
+                const std::size_t lanes = std::min<std::size_t>(4, next_slot - 4 * b);
+                for (std::size_t l = 0; l < lanes; ++l) {
+                    const std::uint32_t slot = slot_prim[4 * b + l];
+                    const std::uint32_t p = slot & ~kLeafEnd;
+                    for (int c = 0; c < 3; ++c) {
+                        const Vec3f& v = positions[tris[p][c]];
+                        block.v[c][0][l] = v.x;
+                        block.v[c][1][l] = v.y;
+                        block.v[c][2][l] = v.z;
+                    }
+                    block.prim[l] = slot;
+                }
+                blocks[b] = block;
+            }
+        });
     };
 
     if (bvh.nodes[0].is_leaf()) {
         root = make_leaf(bvh.nodes[0]);
-        blocks.push_back(empty);
-        blocks.push_back(empty);
+        pack();
         return;
     }
 
@@ -67,17 +113,23 @@ void WideBvh::build(const Bvh& bvh, std::span<const BBox> boxes, std::span<const
     // leaves with only 2 or 3 children.
     const std::size_t count = bvh.nodes.size();
     // Scratch, every entry written before it is read.
-    auto cost = std::make_unique_for_overwrite<std::array<float, 8>[]>(count);
-    auto split = std::make_unique_for_overwrite<std::array<std::int8_t, 8>[]>(count);
+    auto cost = make_huge_array<std::array<float, 8>>(count);
+    auto split = make_huge_array<std::array<std::int8_t, 8>>(count);
     // Subtrees cover contiguous ranges of prim_indices; small ones may become one leaf.
-    auto first_prim = std::make_unique_for_overwrite<std::uint32_t[]>(count);
-    auto prim_count = std::make_unique_for_overwrite<std::uint32_t[]>(count);
-    auto flags = std::make_unique_for_overwrite<std::uint8_t[]>(count);  // kAsLeaf, kSpread
+    auto first_prim = make_huge_array<std::uint32_t>(count);
+    auto prim_count = make_huge_array<std::uint32_t>(count);
+    auto flags = make_huge_array<std::uint8_t>(count);  // kAsLeaf, kSpread
     constexpr std::uint8_t kAsLeaf = 1, kSpread = 2;
     auto range = [&](std::uint32_t n) {
         return BvhNode{bvh.nodes[n].bounds, first_prim[n], prim_count[n]};
     };
-    auto tri_box = [&](std::uint32_t p) { return boxes[p]; };
+    // A triangle's box from its corners: only spread leaves need it, and their corners are read
+    // right after to pack them.
+    auto tri_box = [&](std::uint32_t p) {
+        BBox box;
+        for (std::uint32_t v : tris[p]) box.extend(positions[v]);
+        return box;
+    };
     for (std::size_t n = count; n-- > 0;) {
         const BvhNode& b = bvh.nodes[n];
         const float area = b.bounds.half_area();
@@ -92,7 +144,7 @@ void WideBvh::build(const Bvh& bvh, std::span<const BBox> boxes, std::span<const
             if (b.count >= 2 && b.count <= 8) {
                 float singles = 0.0f;
                 for (std::uint32_t i = 0; i < b.count; ++i)
-                    singles += costs.block * tri_box(bvh.prim_indices[b.first + i]).half_area();
+                    singles += costs.block * leaf_areas[b.first + i];
                 if (singles < cost[n][0]) {
                     flags[n] |= kSpread;
                     for (std::uint32_t i = b.count; i <= 8; ++i) cost[n][i - 1] = singles;
@@ -105,14 +157,15 @@ void WideBvh::build(const Bvh& bvh, std::span<const BBox> boxes, std::span<const
         flags[n] = 0;
         const auto& cl = cost[b.first];
         const auto& cr = cost[b.first + 1];
+        // The minima below are selects, not branches: which side wins is data, and a branch
+        // on it would be mispredicted about as often as not.
         float best = std::numeric_limits<float>::infinity();
         int best_k = 1;
         for (int k = 1; k < 8; ++k) {
-            float c = cl[k - 1] + cr[7 - k];
-            if (c < best) {
-                best = c;
-                best_k = k;
-            }
+            const float c = cl[k - 1] + cr[7 - k];
+            const bool better = c < best;
+            best = better ? c : best;
+            best_k = better ? k : best_k;
         }
         cost[n][0] = costs.node * area + best;
         split[n][0] = static_cast<std::int8_t>(best_k);
@@ -125,19 +178,10 @@ void WideBvh::build(const Bvh& bvh, std::span<const BBox> boxes, std::span<const
                 flags[n] |= kAsLeaf;
             }
         }
-        for (int i = 2; i <= 8; ++i) {
-            float c = cost[n][i - 2];
-            int s = 0;
-            for (int k = 1; k < i; ++k) {
-                float v = cl[k - 1] + cr[i - k - 1];
-                if (v < c) {
-                    c = v;
-                    s = k;
-                }
-            }
-            cost[n][i - 1] = c;
-            split[n][i - 1] = static_cast<std::int8_t>(s);
+        [&]<int... I>(std::integer_sequence<int, I...>) {
+            (best_in_slots<I + 2>(cl, cr, cost[n], split[n]), ...);
         }
+        (std::make_integer_sequence<int, 7>{});
     }
     // The children that binary node n becomes with at most i slots: leaves (triangle ranges)
     // and inner nodes (binary node ids).
@@ -169,8 +213,7 @@ void WideBvh::build(const Bvh& bvh, std::span<const BBox> boxes, std::span<const
 
     if (flags[0] & kAsLeaf) {
         root = make_leaf(range(0));
-        blocks.push_back(empty);
-        blocks.push_back(empty);
+        pack();
         return;
     }
     struct Item {
@@ -216,9 +259,8 @@ void WideBvh::build(const Bvh& bvh, std::span<const BBox> boxes, std::span<const
         }
         nodes[item.wide] = w;
     }
+    pack();
     // Traversal pushes at most 7 entries per level.
-    blocks.push_back(empty);  // 8-wide loads may read up to two blocks past a leaf
-    blocks.push_back(empty);
     max_stack = 8 * static_cast<std::size_t>(depth) + 8;
 }
 

@@ -67,8 +67,9 @@ struct WideBvh {
         std::uint32_t leaf_width = 4;  ///< triangles a leaf test takes at once
     };
 
-    /// Collapses `bvh` (built over `tris`, whose boxes are `boxes`) and packs the triangles.
-    void build(const Bvh& bvh, std::span<const BBox> boxes, std::span<const Vec3f> positions,
+    /// Collapses `bvh` (built over `tris`) and packs the triangles. `leaf_areas[i]` is the half
+    /// area of the box of triangle bvh.prim_indices[i] (read in leaf order, not gathered).
+    void build(const Bvh& bvh, std::span<const float> leaf_areas, std::span<const Vec3f> positions,
                std::span<const std::array<std::uint32_t, 3>> tris, const CollapseCosts& costs);
 };
 
