@@ -6,11 +6,14 @@
 // image, and with --out writes both, the ink lines over the cel colours, and the SVG.
 //
 // Usage: toonray_ink_bench [--repeats N] [--size WxH] [--out DIR] [--quick] [--previous PREV.obj]
-//        scene.obj ...
+//        [--lines-only] scene.obj ...
 // With --previous, each scene is also timed as the next frame of an animation after PREV.obj
 // (ink at 1 sample, the intersection lines of unmoved triangles kept from PREV.obj).
 // With no scenes: tests/data/teapot.obj. --quick runs each stage once and checks that the
-// ink lines do not depend on the thread count (CTest: ink_bench_quick).
+// ink lines do not depend on the thread count (CTest: ink_bench_quick). --lines-only times
+// the ink stages alone (no whole frames), for profiles: under callgrind,
+// --toggle-collect='*fresh_frame_lines*' counts the frames on their own and
+// --toggle-collect='*next_frame_lines*' the frames after PREV.obj.
 
 #include <fmt/format.h>
 
@@ -74,16 +77,102 @@ int count_specks(const ImageGray8& lines) {
     return specks;
 }
 
+// The ink stages of one frame on its own and of one frame after another, in functions of their
+// own so that a profiler can count each case apart.
+[[gnu::noinline]] void fresh_frame_lines(const Scene& scene, const TriangleAccel& accel,
+                                         const CameraSpec& camera, int width, int height,
+                                         ink::InkLines& lines) {
+    lines.intersections = {};  // nothing kept from an earlier frame
+    ink::draw_ink_lines(scene, accel, camera, width, height, {}, 1, lines);
+}
+
+[[gnu::noinline]] void next_frame_lines(const Scene& scene, const TriangleAccel& accel,
+                                        const CameraSpec& camera, int width, int height,
+                                        ink::InkLines& lines) {
+    ink::draw_ink_lines(scene, accel, camera, width, height, {}, 1, lines);
+}
+
+std::string ms(double s) { return fmt::format("{:.1f} ms", s * 1e3); }
+
+// Medians of the stage times of repeated draws.
+struct StageTimes {
+    std::vector<double> edges, visibility, chaining, drawing;
+    void add(const ink::InkTimings& t) {
+        edges.push_back(t.edges);
+        visibility.push_back(t.visibility);
+        chaining.push_back(t.chaining);
+        drawing.push_back(t.drawing);
+    }
+    [[nodiscard]] std::string row() const {
+        return fmt::format("{} | {} | {} | {}", ms(median(edges)), ms(median(visibility)),
+                           ms(median(chaining)), ms(median(drawing)));
+    }
+};
+
 struct Options {
     int repeats = 7;
     int width = 1280, height = 720;
     bool quick = false;
+    bool lines_only = false;  ///< the ink stages only, no whole frames
     std::optional<fs::path> out;
     std::optional<fs::path> previous;  ///< a frame drawn before each scene, as in an animation
     std::vector<fs::path> scenes;
 };
 
+TriangleAccel build_accel(const Scene& scene) {
+    TriangleAccel accel;
+    accel.build(scene.positions, scene.tri_positions);
+    return accel;
+}
+
+// --lines-only: the stages of each scene on its own, and after --previous.
+void run_lines_only(const Options& options) {
+    fmt::print(
+        "| scene | triangles | ink: edges | visibility | chaining | drawing |\n"
+        "|---|---:|---:|---:|---:|---:|\n");
+    FrameOptions file_options;
+    file_options.settings.width = options.width;
+    file_options.settings.height = options.height;
+    Scene before;
+    TriangleAccel before_accel;
+    CameraSpec before_camera;
+    if (options.previous) {
+        Warnings warnings;
+        load_obj(*options.previous, before, warnings);
+        before_accel = build_accel(before);
+        before_camera = choose_camera(before, file_options);
+    }
+    for (const fs::path& path : options.scenes) {
+        Scene scene;
+        Warnings warnings;
+        load_obj(path, scene, warnings);
+        const TriangleAccel accel = build_accel(scene);
+        const CameraSpec camera = choose_camera(scene, file_options);
+        ink::InkLines lines;
+        StageTimes fresh, next;
+        for (int i = 0; i <= options.repeats; ++i) {
+            fresh_frame_lines(scene, accel, camera, options.width, options.height, lines);
+            if (i > 0 || options.repeats == 0) fresh.add(lines.timings);
+        }
+        fmt::print("| {} | {} | {} |\n", path.filename().string(), scene.triangle_count(),
+                   fresh.row());
+        if (!options.previous) continue;
+        for (int i = 0; i <= options.repeats; ++i) {
+            fresh_frame_lines(before, before_accel, before_camera, options.width, options.height,
+                              lines);
+            next_frame_lines(scene, accel, camera, options.width, options.height, lines);
+            if (i > 0 || options.repeats == 0) next.add(lines.timings);
+        }
+        fmt::print("| {} after {} | | {} |\n", path.filename().string(),
+                   options.previous->filename().string(), next.row());
+    }
+}
+
 int run(const Options& options) {
+    if (options.lines_only) {
+        run_lines_only(options);
+        return 0;
+    }
     fmt::print(
         "| scene | triangles | classic frame | robust frame | ink frame | ink frame, 1 sample | "
         "ink 1 sample / classic | ink: edges | visibility | chaining | drawing | specks robust / ink |\n");
@@ -94,8 +183,7 @@ int run(const Options& options) {
         Scene scene;
         Warnings warnings;
         load_obj(path, scene, warnings);
-        TriangleAccel accel;
-        accel.build(scene.positions, scene.tri_positions);
+        const TriangleAccel accel = build_accel(scene);
         FrameOptions file_options;
         file_options.settings.width = options.width;
         file_options.settings.height = options.height;
@@ -143,8 +231,7 @@ int run(const Options& options) {
         ink::InkLines lines;
         std::vector<double> edges, visibility, chaining, drawing, total;
         for (int i = 0; i <= repeats; ++i) {
-            lines.intersections = {};  // one frame on its own
-            ink::draw_ink_lines(scene, accel, camera, options.width, options.height, {}, 1, lines);
+            fresh_frame_lines(scene, accel, camera, options.width, options.height, lines);
             if (i == 0 && repeats > 0) continue;
             edges.push_back(lines.timings.edges);
             visibility.push_back(lines.timings.visibility);
@@ -168,7 +255,6 @@ int run(const Options& options) {
         ink::coverage_to_gray(lines.coverage, ink_gray);
         const int ink_specks = count_specks(ink_gray);
         const int robust_specks = count_specks(robust.aovs().edges);
-        auto ms = [](double s) { return fmt::format("{:.1f} ms", s * 1e3); };
         fmt::print("| {} | {} | {} | {} | {} | {} | {:.2f} | {} | {} | {} | {} | {} / {} |\n",
                    path.filename().string(), scene.triangle_count(), ms(classic_s), ms(robust_s),
                    ms(ink_s), ms(ink1_s), ink1_s / classic_s, ms(median(edges)),
@@ -197,8 +283,7 @@ int run(const Options& options) {
                 const double frame_s = std::chrono::duration<double>(Clock::now() - start).count();
                 ink::draw_ink_lines(before, before_accel, before_camera, options.width,
                                     options.height, {}, 1, animated);
-                ink::draw_ink_lines(scene, accel, camera, options.width, options.height, {}, 1,
-                                    animated);
+                next_frame_lines(scene, accel, camera, options.width, options.height, animated);
                 if (i == 0 && repeats > 0) continue;
                 frame_t.push_back(frame_s);
                 edges_t.push_back(animated.timings.edges);
@@ -262,6 +347,7 @@ int main(int argc, char** argv) {
                 options.height = std::stoi(v.substr(x + 1));
             } else if (arg == "--out") options.out = value();
             else if (arg == "--quick") options.quick = true;
+            else if (arg == "--lines-only") options.lines_only = true;
             else if (arg == "--previous") options.previous = value();
             else if (!arg.empty() && arg[0] == '-') throw toonray::Error("unknown option " + arg);
             else options.scenes.emplace_back(arg);
