@@ -2,12 +2,14 @@
 
 #include <algorithm>
 #include <bit>
+#include <limits>
 #include <map>
 #include <cmath>
 #include <numbers>
 #include <tuple>
 
 #include "toonray/core/portable_math.h"
+#include "toonray/core/simd_sse.h"
 #include "toonray/ink/chunks.h"
 
 namespace toonray::ink {
@@ -35,10 +37,8 @@ bool position_less(const Vec3f& a, const Vec3f& b) {
 }
 
 // Unit geometric normal (p1 - p0) x (p2 - p0), or zero for a degenerate triangle.
-Vec3f face_normal(const Scene& scene, std::size_t t) {
-    const auto& v = scene.tri_positions[t];
-    const Vec3f n = cross(scene.positions[v[1]] - scene.positions[v[0]],
-                          scene.positions[v[2]] - scene.positions[v[0]]);
+Vec3f face_normal(const std::array<Vec3f, 3>& p) {
+    const Vec3f n = cross(p[1] - p[0], p[2] - p[0]);
     const float len = length(n);
     if (!(len > 0.0f) || !std::isfinite(len)) return Vec3f(0.0f);
     return n / len;
@@ -60,19 +60,38 @@ std::array<Vec3f, 3> corners(const Scene& scene, std::size_t t) {
 
 WeldedMesh weld_vertices(const Scene& scene) {
     const std::size_t n = scene.triangle_count();
-    // Positions with the same bits share a canonical index, the lowest among them.
-    std::vector<std::uint32_t> order(scene.positions.size()), canonical(scene.positions.size());
-    for (std::size_t i = 0; i < order.size(); ++i) order[i] = static_cast<std::uint32_t>(i);
+    // Positions with the same bits share a canonical index, the lowest among them: each
+    // position, in index order, looks its bits up in an open-addressing table (linear probing,
+    // at most half full) and takes the index found there, or enters its own.
+    const std::size_t positions = scene.positions.size();
+    std::vector<std::uint32_t> canonical(positions);
+    using Bits = std::array<std::uint32_t, 3>;
     auto bits = [&](std::uint32_t i) {
         const Vec3f& p = scene.positions[i];
-        return std::tuple(float_bits(p.x), float_bits(p.y), float_bits(p.z));
+        return Bits{float_bits(p.x), float_bits(p.y), float_bits(p.z)};
     };
-    std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
-        return std::tuple_cat(bits(a), std::tuple(a)) < std::tuple_cat(bits(b), std::tuple(b));
-    });
-    for (std::size_t i = 0; i < order.size(); ++i)
-        canonical[order[i]] =
-            i > 0 && bits(order[i]) == bits(order[i - 1]) ? canonical[order[i - 1]] : order[i];
+    std::size_t table_size = 16;
+    while (table_size < 2 * positions) table_size *= 2;
+    const std::size_t mask = table_size - 1;
+    std::vector<std::uint32_t> table(table_size, kNoIndex);
+    for (std::uint32_t i = 0; i < positions; ++i) {
+        const Bits b = bits(i);
+        std::uint64_t h = (static_cast<std::uint64_t>(b[0]) * 0x9e3779b97f4a7c15ull) ^
+                          (static_cast<std::uint64_t>(b[1]) * 0xc2b2ae3d27d4eb4full) ^
+                          (static_cast<std::uint64_t>(b[2]) * 0x165667b19e3779f9ull);
+        h ^= h >> 29;
+        for (std::size_t slot = static_cast<std::size_t>(h) & mask;; slot = (slot + 1) & mask) {
+            if (table[slot] == kNoIndex) {
+                table[slot] = i;
+                canonical[i] = i;
+                break;
+            }
+            if (bits(table[slot]) == b) {
+                canonical[i] = table[slot];
+                break;
+            }
+        }
+    }
     // Welded ids in order of first use by the triangles: one per (object, canonical position).
     // Most positions belong to one object; the few shared by several look the rest up.
     WeldedMesh mesh;
@@ -178,84 +197,280 @@ bool intersect_triangles(const std::array<Vec3f, 3>& a, const std::array<Vec3f, 
     return true;
 }
 
+namespace {
+
+// Boxes in the BVH's primitive slots, one array per bound and axis so that the boxes of four
+// neighbouring slots are tested at once. Slots whose triangles take no part hold empty boxes
+// (lo = +inf, hi = -inf), which overlap nothing; kLanes more empty boxes pad the end so that
+// loads of four never read past it.
+constexpr std::uint32_t kLanes = 4;
+struct SlotBoxes {
+    std::vector<float> lo[3], hi[3];
+};
+
+// Bit k is set when the box of slot j + k overlaps the box (lo, hi), each bound broadcast.
+int overlap_mask(const SlotBoxes& boxes, std::uint32_t j, const __m128 (&lo)[3],
+                 const __m128 (&hi)[3]) {
+    __m128 m = _mm_set1_ps(-0.0f);  // all lanes' sign bits set
+    for (int a = 0; a < 3; ++a)
+        m = _mm_and_ps(m, _mm_and_ps(_mm_cmple_ps(lo[a], _mm_loadu_ps(&boxes.hi[a][j])),
+                                     _mm_cmpge_ps(hi[a], _mm_loadu_ps(&boxes.lo[a][j]))));
+    return _mm_movemask_ps(m);
+}
+
+// Every pair of triangles that take part (`live`) and cross, as intersect_triangles finds them,
+// with (when `stale` is given) at least one stale triangle; in no particular order. Candidate
+// pairs are those whose boxes overlap, from a traversal of the BVH against itself: a pair of
+// nodes is opened only when the boxes of their live triangles overlap, and a node is paired with
+// itself once, so each triangle pair is met once, in the leaf pair that holds it. The node pairs
+// are first expanded breadth-first into enough independent tasks for the threads. Triangles
+// that share a corner position (in any object) touch there and are not tested.
+std::vector<PairCrossing> find_crossings(const Bvh& bvh,
+                                         const std::vector<std::array<Vec3f, 3>>& tri_corners,
+                                         const WeldedMesh& mesh,
+                                         const std::vector<std::uint8_t>& live,
+                                         const std::vector<std::uint8_t>* stale, int threads) {
+    const std::uint32_t prims = static_cast<std::uint32_t>(bvh.prim_indices.size());
+    constexpr float inf = std::numeric_limits<float>::infinity();
+    SlotBoxes boxes;
+    for (int a = 0; a < 3; ++a) {
+        boxes.lo[a].assign(prims + kLanes, inf);
+        boxes.hi[a].assign(prims + kLanes, -inf);
+    }
+    // Per slot: corner positions (canonical: equal for equal coordinates, across objects),
+    // whether the triangle takes part and whether it is stale.
+    std::vector<std::array<std::uint32_t, 3>> tri_position(prims);
+    std::vector<std::uint8_t> live_slot(prims), stale_slot(prims);
+    for (std::uint32_t i = 0; i < prims; ++i) {
+        const std::uint32_t t = bvh.prim_indices[i];
+        for (int k = 0; k < 3; ++k)
+            tri_position[i][k] = mesh.vertex_position[mesh.tri_vertices[t][k]];
+        live_slot[i] = live[t];
+        stale_slot[i] = !stale || (*stale)[t];
+        if (!live[t]) continue;
+        BBox box;
+        for (const Vec3f& p : tri_corners[t]) box.extend(p);
+        for (int a = 0; a < 3; ++a) {
+            boxes.lo[a][i] = box.lo[a];
+            boxes.hi[a][i] = box.hi[a];
+        }
+    }
+    // Per node: the box of its live triangles (empty without), and whether one is stale.
+    // Boxes of live triangles only: nodes of faces turned away from the eye shrink or vanish,
+    // and fewer pairs of nodes overlap.
+    std::vector<BBox> live_box(bvh.nodes.size());
+    std::vector<std::uint8_t> node_stale(bvh.nodes.size(), 0);
+    for (std::size_t i = bvh.nodes.size(); i-- > 0;) {  // children come after parents
+        const BvhNode& node = bvh.nodes[i];
+        if (node.is_leaf()) {
+            for (std::uint32_t k = node.first; k < node.first + node.count; ++k) {
+                if (!live_slot[k]) continue;
+                live_box[i].extend(BBox{Vec3f(boxes.lo[0][k], boxes.lo[1][k], boxes.lo[2][k]),
+                                        Vec3f(boxes.hi[0][k], boxes.hi[1][k], boxes.hi[2][k])});
+                node_stale[i] |= stale_slot[k];
+            }
+            continue;
+        }
+        live_box[i] = live_box[node.first];
+        live_box[i].extend(live_box[node.first + 1]);
+        node_stale[i] = node_stale[node.first] | node_stale[node.first + 1];
+    }
+    auto overlap = [](const BBox& a, const BBox& b) {
+        return !(a.lo.x > b.hi.x || a.hi.x < b.lo.x || a.lo.y > b.hi.y || a.hi.y < b.lo.y ||
+                 a.lo.z > b.hi.z || a.hi.z < b.lo.z);
+    };
+    // Tests the triangles in slots i and j, whose boxes overlap.
+    auto test_pair = [&](std::uint32_t i, std::uint32_t j, std::vector<PairCrossing>& out) {
+        if (!stale_slot[i] && !stale_slot[j]) return;  // the cache has it
+        const auto& pa = tri_position[i];
+        const auto& pb = tri_position[j];
+        for (std::uint32_t a_corner : pa)
+            if (a_corner == pb[0] || a_corner == pb[1] || a_corner == pb[2]) return;
+        std::uint32_t t = bvh.prim_indices[i], u = bvh.prim_indices[j];
+        if (u < t) std::swap(t, u);
+        PairCrossing found{t, u, {}};
+        if (intersect_triangles(tri_corners[t], tri_corners[u], found.crossing))
+            out.push_back(found);
+    };
+    // Tests slot i against the slots [j0, j1) whose boxes overlap its own.
+    auto test_slots = [&](std::uint32_t i, std::uint32_t j0, std::uint32_t j1,
+                          std::vector<PairCrossing>& out) {
+        const __m128 lo[3] = {_mm_set1_ps(boxes.lo[0][i]), _mm_set1_ps(boxes.lo[1][i]),
+                              _mm_set1_ps(boxes.lo[2][i])};
+        const __m128 hi[3] = {_mm_set1_ps(boxes.hi[0][i]), _mm_set1_ps(boxes.hi[1][i]),
+                              _mm_set1_ps(boxes.hi[2][i])};
+        for (std::uint32_t j = j0; j < j1; j += kLanes) {
+            int mask = overlap_mask(boxes, j, lo, hi);
+            if (j1 - j < kLanes) mask &= (1 << (j1 - j)) - 1;
+            for (; mask; mask &= mask - 1)
+                test_pair(
+                    i,
+                    j + static_cast<std::uint32_t>(std::countr_zero(static_cast<unsigned>(mask))),
+                    out);
+        }
+    };
+    using NodePair = std::pair<std::uint32_t, std::uint32_t>;
+    // Opens one node pair: tests the triangles of two leaves (or of one leaf with itself), or
+    // pushes the child pairs whose boxes may overlap.
+    auto expand = [&](NodePair pair, std::vector<NodePair>& next, std::vector<PairCrossing>& out) {
+        if (!node_stale[pair.first] && !node_stale[pair.second]) return;
+        const BBox& box_a = live_box[pair.first];
+        const BBox& box_b = live_box[pair.second];
+        if (!overlap(box_a, box_b)) return;  // also when either has no live triangle
+        const BvhNode& a = bvh.nodes[pair.first];
+        const BvhNode& b = bvh.nodes[pair.second];
+        if (pair.first == pair.second) {
+            if (a.is_leaf()) {
+                for (std::uint32_t i = a.first; i + 1 < a.first + a.count; ++i)
+                    if (live_slot[i]) test_slots(i, i + 1, a.first + a.count, out);
+            } else {
+                next.push_back({a.first, a.first});
+                next.push_back({a.first + 1, a.first + 1});
+                next.push_back({a.first, a.first + 1});
+            }
+            return;
+        }
+        if (a.is_leaf() && b.is_leaf()) {
+            for (std::uint32_t i = a.first; i < a.first + a.count; ++i)
+                if (live_slot[i]) test_slots(i, b.first, b.first + b.count, out);
+            return;
+        }
+        // Open the inner node with the larger box (or the only inner one).
+        auto extent = [](const BBox& box) {
+            const Vec3f d = box.hi - box.lo;
+            return d.x + d.y + d.z;
+        };
+        if (b.is_leaf() || (!a.is_leaf() && extent(box_a) >= extent(box_b))) {
+            next.push_back({a.first, pair.second});
+            next.push_back({a.first + 1, pair.second});
+        } else {
+            next.push_back({pair.first, b.first});
+            next.push_back({pair.first, b.first + 1});
+        }
+    };
+    std::vector<PairCrossing> found;
+    std::vector<NodePair> tasks{{0u, 0u}}, next;
+    const std::size_t wanted_tasks = 256;
+    while (!tasks.empty() && tasks.size() < wanted_tasks) {
+        next.clear();
+        for (const NodePair& pair : tasks) expand(pair, next, found);
+        tasks.swap(next);
+    }
+    auto deeper =
+        gather_chunks<PairCrossing>(static_cast<int>(tasks.size()), 4, threads,
+                                    [&](int i0, int i1, std::vector<PairCrossing>& out) {
+                                        std::vector<NodePair> stack;
+                                        for (int i = i0; i < i1; ++i) {
+                                            stack.assign(1, tasks[static_cast<std::size_t>(i)]);
+                                            while (!stack.empty()) {
+                                                const NodePair pair = stack.back();
+                                                stack.pop_back();
+                                                expand(pair, stack, out);
+                                            }
+                                        }
+                                    });
+    found.insert(found.end(), deeper.begin(), deeper.end());
+    return found;
+}
+
+}  // namespace
+
 std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedMesh& mesh,
                                                const Bvh& bvh, const Vec3f& eye,
                                                const FeatureEdgeSettings& settings, int threads,
                                                IntersectionCache* cache) {
     const std::size_t n = scene.triangle_count();
-    std::vector<Vec3f> normal(n);
-    for (std::size_t t = 0; t < n; ++t) normal[t] = face_normal(scene, t);
-    auto usable = [&](std::size_t t) { return normal[t] != Vec3f(0.0f); };
     std::vector<FeatureSegment> segments;
-
-    // Mesh edges: every triangle side as (lower welded id, higher, triangle, forward), sorted so
-    // that the sides of one edge are adjacent.
-    struct Side {
-        std::uint32_t lo, hi, tri;
-        bool forward;  // lo -> hi in the triangle's winding
-        int corner;    // the corner the side starts from in the winding
-    };
-    // The sides are gathered vertex by vertex from the triangles around each welded vertex:
-    // at vertex lo, the sides from lo to a higher id, sorted by (hi, triangle). That is the
-    // order of a sort of all sides by (lo, hi, triangle), without sorting them all.
-    std::vector<Side> sides;
-    sides.reserve(n * 3);
-    for (std::uint32_t lo = 0; lo < mesh.vertex_count(); ++lo) {
-        const std::size_t first = sides.size();
-        for (std::uint32_t r = mesh.ring_offsets[lo]; r < mesh.ring_offsets[lo + 1]; ++r) {
-            const std::uint32_t t = mesh.ring_triangles[r];
-            if (!usable(t)) continue;
-            const auto& w = mesh.tri_vertices[t];
-            for (int k = 0; k < 3; ++k) {
-                const std::uint32_t u = w[k], v = w[(k + 1) % 3];
-                if (u == v || std::min(u, v) != lo) continue;
-                sides.push_back({lo, std::max(u, v), t, u < v, k});
-            }
-        }
-        std::sort(sides.begin() + static_cast<std::ptrdiff_t>(first), sides.end(),
-                  [](const Side& a, const Side& b) {
-                      return std::tie(a.hi, a.tri, a.corner) < std::tie(b.hi, b.tri, b.corner);
-                  });
-    }
-    const float cos_crease =
-        portable::cos(settings.crease_angle * std::numbers::pi_v<float> / 180.0f);
-    // Shading is smooth across a side shared by two triangles when both have a normal at every
-    // corner and the same normals at the side's two ends.
-    auto corner_normal = [&](std::uint32_t t, std::uint32_t welded) {
-        for (int k = 0; k < 3; ++k)
-            if (mesh.tri_vertices[t][k] == welded) return scene.normals[scene.tri_normals[t][k]];
-        return Vec3f(0.0f);
-    };
-    auto smooth_across = [&](const Side& s0, const Side& s1) {
-        if (!has_corner_normals(scene, s0.tri) || !has_corner_normals(scene, s1.tri)) return false;
-        return corner_normal(s0.tri, s0.lo) == corner_normal(s1.tri, s1.lo) &&
-               corner_normal(s0.tri, s0.hi) == corner_normal(s1.tri, s1.hi);
-    };
+    std::size_t objects = scene.objects.size();
+    for (std::size_t t = 0; t < n; ++t)
+        objects = std::max<std::size_t>(objects, scene.tri_object[t] + std::size_t{1});
     // Objects whose lines on faces turned away from the eye are certainly hidden: closed
     // (every edge has two faces, wound in opposite directions along it), with a non-zero
     // volume, and not around the eye. A line of sight from such a line into the eye starts
     // inside the solid, so it must leave it through the surface on the way.
-    std::size_t objects = scene.objects.size();
-    for (std::size_t t = 0; t < n; ++t)
-        objects = std::max<std::size_t>(objects, scene.tri_object[t] + std::size_t{1});
     std::vector<std::uint8_t> closed(objects, 1);
     std::vector<double> volume(objects, 0.0);
     std::vector<BBox> object_box(objects);
+
+    // Per triangle, in one pass: its corners (kept by the cache for the next frame), unit
+    // normal (zero when degenerate: the triangle is not usable), whether it has a normal at
+    // every corner, its object's box and volume, and the count of its sides at each vertex.
+    const std::size_t vertices = mesh.vertex_count();
+    std::vector<std::array<Vec3f, 3>> tri_corners;
+    std::vector<Vec3f> normal;
+    std::vector<std::uint8_t> corner_normals;
+    tri_corners.reserve(n);
+    normal.reserve(n);
+    corner_normals.reserve(n);
+    std::vector<std::uint32_t> side_offsets(vertices + 1, 0);
     for (std::size_t t = 0; t < n; ++t) {
+        const auto& p = tri_corners.emplace_back(corners(scene, t));
+        const Vec3f& nt = normal.emplace_back(face_normal(p));
+        corner_normals.push_back(has_corner_normals(scene, t));
         const std::uint32_t o = scene.tri_object[t];
         const auto& w = mesh.tri_vertices[t];
-        if (!usable(t) || w[0] == w[1] || w[1] == w[2] || w[2] == w[0]) closed[o] = 0;
-        const auto p = corners(scene, t);
+        const bool usable = nt != Vec3f(0.0f);
+        if (!usable || w[0] == w[1] || w[1] == w[2] || w[2] == w[0]) closed[o] = 0;
         for (const Vec3f& q : p) object_box[o].extend(q);
         volume[o] += static_cast<double>(dot(p[0], cross(p[1], p[2])));
+        if (!usable) continue;
+        for (int k = 0; k < 3; ++k)
+            if (w[k] != w[(k + 1) % 3]) ++side_offsets[std::min(w[k], w[(k + 1) % 3]) + 1];
     }
-    for (std::size_t i = 0; i < sides.size();) {
-        std::size_t j = i + 1;
-        while (j < sides.size() && sides[j].lo == sides[i].lo && sides[j].hi == sides[i].hi) ++j;
-        const std::uint32_t o = scene.tri_object[sides[i].tri];
-        if (j - i != 2 || sides[i].forward == sides[i + 1].forward) closed[o] = 0;
-        i = j;
+    auto usable = [&](std::size_t t) { return normal[t] != Vec3f(0.0f); };
+
+    // Mesh edges: every side of a usable triangle as (lower welded id, higher, triangle,
+    // corner), in that order, so that the sides of one edge are adjacent. A counting sort by
+    // lo over the triangles in order puts each vertex's sides in (triangle, corner) order; a
+    // stable sort by hi within each vertex then gives the whole order.
+    struct Side {
+        std::uint32_t lo, hi, tri;
+        bool forward;  // lo -> hi in the triangle's winding
+    };
+    for (std::size_t v = 0; v < vertices; ++v) side_offsets[v + 1] += side_offsets[v];
+    std::vector<Side> sides(side_offsets[vertices]);
+    {
+        std::vector<std::uint32_t> fill(side_offsets.begin(), side_offsets.end() - 1);
+        for (std::size_t t = 0; t < n; ++t) {
+            if (!usable(t)) continue;
+            const auto& w = mesh.tri_vertices[t];
+            for (int k = 0; k < 3; ++k) {
+                const std::uint32_t u = w[k], v = w[(k + 1) % 3];
+                if (u == v) continue;
+                const std::uint32_t lo = std::min(u, v);
+                sides[fill[lo]++] = {lo, std::max(u, v), static_cast<std::uint32_t>(t), u < v};
+            }
+        }
     }
+    // Then the edges, runs of sides with the same ends (edge e is sides [edge_first[e],
+    // edge_first[e + 1])), and whether each object is closed.
+    std::vector<std::uint32_t> edge_first;
+    edge_first.reserve(sides.size() / 2 + 1);
+    for (std::size_t v = 0; v < vertices; ++v) {
+        Side* const first = sides.data() + side_offsets[v];
+        Side* const last = sides.data() + side_offsets[v + 1];
+        // By insertion, as a vertex has few sides (but not at the centre of a large fan).
+        if (last - first > 32) {
+            std::stable_sort(first, last, [](const Side& a, const Side& b) { return a.hi < b.hi; });
+        } else {
+            for (Side* i = first + 1; i < last; ++i) {
+                const Side side = *i;
+                Side* j = i;
+                for (; j > first && (j - 1)->hi > side.hi; --j) *j = *(j - 1);
+                *j = side;
+            }
+        }
+        for (const Side* i = first; i < last;) {
+            const Side* j = i + 1;
+            while (j < last && j->hi == i->hi) ++j;
+            edge_first.push_back(static_cast<std::uint32_t>(i - sides.data()));
+            if (j - i != 2 || i[0].forward == i[1].forward) closed[scene.tri_object[i->tri]] = 0;
+            i = j;
+        }
+    }
+    const std::size_t edge_count = edge_first.size();
+    edge_first.push_back(static_cast<std::uint32_t>(sides.size()));
+
     auto eye_outside = [&](const BBox& b) {
         return eye.x < b.lo.x || eye.y < b.lo.y || eye.z < b.lo.z || eye.x > b.hi.x ||
                eye.y > b.hi.y || eye.z > b.hi.z;
@@ -270,55 +485,67 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
     std::vector<std::uint8_t> turned_away(n, 0);
     for (std::size_t t = 0; t < n; ++t) {
         const int out = outward[scene.tri_object[t]];
-        const float facing = dot(normal[t], eye - scene.positions[scene.tri_positions[t][0]]);
+        const float facing = dot(normal[t], eye - tri_corners[t][0]);
         turned_away[t] = out != 0 && usable(t) && (out > 0 ? facing < 0 : facing > 0);
     }
 
-    for (std::size_t i = 0; i < sides.size();) {
-        std::size_t j = i + 1;
-        while (j < sides.size() && sides[j].lo == sides[i].lo && sides[j].hi == sides[i].hi) ++j;
+    const float cos_crease =
+        portable::cos(settings.crease_angle * std::numbers::pi_v<float> / 180.0f);
+    // Shading is smooth across a side shared by two triangles when both have a normal at every
+    // corner and the same normals at the side's two ends.
+    auto corner_normal = [&](std::uint32_t t, std::uint32_t welded) {
+        for (int k = 0; k < 3; ++k)
+            if (mesh.tri_vertices[t][k] == welded) return scene.normals[scene.tri_normals[t][k]];
+        return Vec3f(0.0f);
+    };
+    auto smooth_across = [&](const Side& s0, const Side& s1) {
+        if (!corner_normals[s0.tri] || !corner_normals[s1.tri]) return false;
+        return corner_normal(s0.tri, s0.lo) == corner_normal(s1.tri, s1.lo) &&
+               corner_normal(s0.tri, s0.hi) == corner_normal(s1.tri, s1.hi);
+    };
+    // One segment per edge that is a line: each is classified first, and made only if drawn.
+    for (std::size_t e = 0; e < edge_count; ++e) {
+        const std::uint32_t i = edge_first[e], j = edge_first[e + 1];
         const Side& s0 = sides[i];
-        FeatureSegment seg;
-        seg.p0 = scene.positions[mesh.vertex_position[s0.lo]];
-        seg.p1 = scene.positions[mesh.vertex_position[s0.hi]];
-        seg.key0 = {s0.lo, kNoIndex, kNoIndex};
-        seg.key1 = {s0.hi, kNoIndex, kNoIndex};
-        seg.faces = {s0.tri, j - i > 1 ? sides[i + 1].tri : kNoIndex};
-        bool emit = false;
+        const Vec3f p0 = scene.positions[mesh.vertex_position[s0.lo]];
+        EdgeType type = EdgeType::Border;
+        bool certainly_hidden = false;
         if (j - i != 2) {
-            seg.type = EdgeType::Border;
-            emit = settings.borders;
+            if (!settings.borders) continue;
         } else {
             const Side& s1 = sides[i + 1];
             const Vec3f n0 = normal[s0.tri];
             // Consistently wound neighbours run the shared side in opposite directions.
             const Vec3f n1 = s0.forward != s1.forward ? normal[s1.tri] : -normal[s1.tri];
-            const bool front0 = dot(n0, eye - seg.p0) > 0, front1 = dot(n1, eye - seg.p0) > 0;
-            const bool smooth = settings.smooth_contours && smooth_across(s0, s1);
+            const float d0 = dot(n0, eye - p0), d1 = dot(n1, eye - p0);
+            const bool front0 = d0 > 0, front1 = d1 > 0;
+            if (settings.silhouettes && front0 != front1 &&
+                !(settings.smooth_contours && smooth_across(s0, s1)))
+                type = EdgeType::Silhouette;
+            else if (settings.creases && dot(n0, n1) < cos_crease) type = EdgeType::Crease;
+            else if (settings.materials && scene.tri_material[s0.tri] != scene.tri_material[s1.tri])
+                type = EdgeType::Material;
+            else continue;
             const int out = outward[scene.tri_object[s0.tri]];
-            seg.certainly_hidden = out != 0 && front0 == (out < 0) && front1 == (out < 0) &&
-                                   dot(n0, eye - seg.p0) != 0 && dot(n1, eye - seg.p0) != 0;
-            if (settings.silhouettes && front0 != front1 && !smooth) {
-                seg.type = EdgeType::Silhouette;
-                emit = true;
-            } else if (settings.creases && dot(n0, n1) < cos_crease) {
-                seg.type = EdgeType::Crease;
-                emit = true;
-            } else if (settings.materials &&
-                       scene.tri_material[s0.tri] != scene.tri_material[s1.tri]) {
-                seg.type = EdgeType::Material;
-                emit = true;
-            }
+            certainly_hidden =
+                out != 0 && front0 == (out < 0) && front1 == (out < 0) && d0 != 0 && d1 != 0;
+            if (certainly_hidden && !settings.certainly_hidden) continue;
         }
-        if (emit && (settings.certainly_hidden || !seg.certainly_hidden)) segments.push_back(seg);
-        i = j;
+        FeatureSegment& seg = segments.emplace_back();
+        seg.p0 = p0;
+        seg.p1 = scene.positions[mesh.vertex_position[s0.hi]];
+        seg.key0 = {s0.lo, kNoIndex, kNoIndex};
+        seg.key1 = {s0.hi, kNoIndex, kNoIndex};
+        seg.faces = {s0.tri, j - i > 1 ? sides[i + 1].tri : kNoIndex};
+        seg.type = type;
+        seg.certainly_hidden = certainly_hidden;
     }
 
     // Smooth contours: where n . (p - eye), interpolated linearly from the corners, is zero.
     if (settings.silhouettes && settings.smooth_contours) {
         for (std::size_t t = 0; t < n; ++t) {
-            if (!usable(t) || !has_corner_normals(scene, t)) continue;
-            const auto p = corners(scene, t);
+            if (!usable(t) || !corner_normals[t]) continue;
+            const auto& p = tri_corners[t];
             float g[3];
             for (int k = 0; k < 3; ++k) {
                 // Unit normals: the zero's position depends on their lengths.
@@ -350,28 +577,6 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
 
     // Intersection lines: each triangle against the triangles whose boxes overlap its own.
     if (settings.intersections && !bvh.nodes.empty()) {
-        // Boxes and corner positions (canonical: equal for equal coordinates, across objects)
-        // in the BVH's primitive order, so that a leaf's triangles are read together.
-        const std::size_t prims = bvh.prim_indices.size();
-        std::vector<BBox> boxes(prims);
-        std::vector<std::array<std::uint32_t, 3>> tri_position(prims);
-        for (std::size_t i = 0; i < prims; ++i) {
-            const std::uint32_t t = bvh.prim_indices[i];
-            for (const Vec3f& p : corners(scene, t)) boxes[i].extend(p);
-            for (int k = 0; k < 3; ++k)
-                tri_position[i][k] = mesh.vertex_position[mesh.tri_vertices[t][k]];
-        }
-        auto overlap = [](const BBox& a, const BBox& b) {
-            return !(a.lo.x > b.hi.x || a.hi.x < b.lo.x || a.lo.y > b.hi.y || a.hi.y < b.lo.y ||
-                     a.lo.z > b.hi.z || a.hi.z < b.lo.z);
-        };
-        // Pairs of triangles with overlapping boxes, by traversing the BVH against itself:
-        // a pair of nodes is opened only when their boxes overlap, and a node is paired with
-        // itself once, so each triangle pair is met once, in the leaf pair that holds it.
-        // The node pairs are first expanded breadth-first into enough independent tasks for
-        // the threads; the segments are sorted by triangle pair at the end.
-        // Without hidden lines, triangles turned away from the eye on closed solids take no
-        // part, and neither do nodes holding only such triangles.
         // Triangles that take part: usable ones, and without hidden lines only those not turned
         // away from the eye on a closed solid.
         std::vector<std::uint8_t> live_triangle(n);
@@ -389,118 +594,20 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
             stale.assign(n, 1);
             if (same_count)
                 for (std::size_t t = 0; t < n; ++t) {
-                    const auto now = corners(scene, t);
+                    const auto& now = tri_corners[t];
                     stale[t] = !cache->tested[t] ||
                                !std::equal(now.begin(), now.end(), cache->corners[t].begin(), same);
                 }
         }
-        std::vector<std::uint8_t> live(prims);
-        for (std::size_t i = 0; i < prims; ++i) live[i] = live_triangle[bvh.prim_indices[i]];
-        // Per node: whether it holds a live triangle, and (with a cache) a stale one.
-        std::vector<std::uint8_t> node_live(bvh.nodes.size(), 0), node_stale(bvh.nodes.size(), 0);
-        auto mark = [&](auto&& self, std::uint32_t i) -> void {
-            const BvhNode& node = bvh.nodes[i];
-            if (node.is_leaf()) {
-                for (std::uint32_t k = node.first; k < node.first + node.count; ++k) {
-                    node_live[i] |= live[k];
-                    node_stale[i] |= !cache || stale[bvh.prim_indices[k]];
-                }
-                return;
-            }
-            self(self, node.first);
-            self(self, node.first + 1);
-            node_live[i] = node_live[node.first] | node_live[node.first + 1];
-            node_stale[i] = node_stale[node.first] | node_stale[node.first + 1];
-        };
-        mark(mark, 0);
-        // Tests the triangles in primitive slots i and j.
-        auto test_pair = [&](std::uint32_t i, std::uint32_t j, std::vector<PairCrossing>& out) {
-            if (!live[i] || !live[j] || !overlap(boxes[i], boxes[j])) return;
-            std::uint32_t t = bvh.prim_indices[i], u = bvh.prim_indices[j];
-            if (cache && !stale[t] && !stale[u]) return;  // the cache has it
-            // Triangles sharing a corner position (in any object) touch there: no line.
-            const auto& pa = tri_position[i];
-            const auto& pb = tri_position[j];
-            for (std::uint32_t a_corner : pa)
-                if (a_corner == pb[0] || a_corner == pb[1] || a_corner == pb[2]) return;
-            if (u < t) std::swap(t, u);
-            PairCrossing found{t, u, {}};
-            if (intersect_triangles(corners(scene, t), corners(scene, u), found.crossing))
-                out.push_back(found);
-        };
-        using NodePair = std::pair<std::uint32_t, std::uint32_t>;
-        // Opens one node pair: tests the triangles of two leaves (or of one leaf with itself),
-        // or pushes the child pairs whose boxes may overlap.
-        auto expand = [&](NodePair pair, std::vector<NodePair>& next,
-                          std::vector<PairCrossing>& out) {
-            if (!node_live[pair.first] || !node_live[pair.second]) return;
-            if (!node_stale[pair.first] && !node_stale[pair.second]) return;
-            const BvhNode& a = bvh.nodes[pair.first];
-            const BvhNode& b = bvh.nodes[pair.second];
-            if (pair.first == pair.second) {
-                if (a.is_leaf()) {
-                    for (std::uint32_t i = a.first; i < a.first + a.count; ++i)
-                        for (std::uint32_t j = i + 1; j < a.first + a.count; ++j)
-                            test_pair(i, j, out);
-                } else {
-                    next.push_back({a.first, a.first});
-                    next.push_back({a.first + 1, a.first + 1});
-                    next.push_back({a.first, a.first + 1});
-                }
-                return;
-            }
-            if (!overlap(a.bounds, b.bounds)) return;
-            if (a.is_leaf() && b.is_leaf()) {
-                for (std::uint32_t i = a.first; i < a.first + a.count; ++i)
-                    for (std::uint32_t j = b.first; j < b.first + b.count; ++j)
-                        test_pair(i, j, out);
-                return;
-            }
-            // Open the inner node with the larger box (or the only inner one).
-            auto extent = [](const BBox& box) {
-                const Vec3f d = box.hi - box.lo;
-                return d.x + d.y + d.z;
-            };
-            if (b.is_leaf() || (!a.is_leaf() && extent(a.bounds) >= extent(b.bounds))) {
-                next.push_back({a.first, pair.second});
-                next.push_back({a.first + 1, pair.second});
-            } else {
-                next.push_back({pair.first, b.first});
-                next.push_back({pair.first, b.first + 1});
-            }
-        };
-        std::vector<PairCrossing> found;
-        std::vector<NodePair> tasks{{0u, 0u}}, next;
-        const std::size_t wanted_tasks = 256;
-        while (!tasks.empty() && tasks.size() < wanted_tasks) {
-            next.clear();
-            for (const NodePair& pair : tasks) expand(pair, next, found);
-            tasks.swap(next);
-        }
-        auto deeper = gather_chunks<PairCrossing>(
-            static_cast<int>(tasks.size()), 4, threads,
-            [&](int i0, int i1, std::vector<PairCrossing>& out) {
-                std::vector<NodePair> stack, pushed;
-                for (int i = i0; i < i1; ++i) {
-                    stack.assign(1, tasks[static_cast<std::size_t>(i)]);
-                    while (!stack.empty()) {
-                        const NodePair pair = stack.back();
-                        stack.pop_back();
-                        pushed.clear();
-                        expand(pair, pushed, out);
-                        stack.insert(stack.end(), pushed.begin(), pushed.end());
-                    }
-                }
-            });
-        found.insert(found.end(), deeper.begin(), deeper.end());
+        std::vector<PairCrossing> found = find_crossings(bvh, tri_corners, mesh, live_triangle,
+                                                         cache ? &stale : nullptr, threads);
         if (cache) {
             // The cache's crossings of triangles that are not stale and take part now; then
             // the cache is this frame's.
             for (const PairCrossing& c : cache->crossings)
                 if (!stale[c.t] && !stale[c.u] && live_triangle[c.t] && live_triangle[c.u])
                     found.push_back(c);
-            cache->corners.resize(n);
-            for (std::size_t t = 0; t < n; ++t) cache->corners[t] = corners(scene, t);
+            cache->corners.swap(tri_corners);  // not read below
             cache->tested = live_triangle;
         }
         // In the order of the triangle pairs, whatever the tree.
