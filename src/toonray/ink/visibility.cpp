@@ -59,9 +59,10 @@ namespace {
 // Samples traced together are laid out in rows of this many: a packet of 4 x 2 rays is then 8
 // consecutive samples.
 constexpr int kPacketWidth = 4;
-// Segments with at most this many samples trace them one ray at a time (measured on piano
-// frame 30: fewer instructions than packets of 4 x 2 up to 8 samples, more from 32).
-constexpr int kSingleRays = 8;
+// Segments with at most this many samples (one row) trace them one ray at a time: on piano
+// frame 30 that takes 10% less time than a packet of 4 x 2 for them (AVX-512 kernels; with
+// AVX2, 8 samples would still be faster one by one, but not on the teapot with AVX-512).
+constexpr int kSingleRays = 4;
 
 // The part of one segment inside the view, as a line on the image: A + (B - A) s for s in
 // [s_lo, s_hi], and the map from s back to the segment's parameter.
