@@ -199,23 +199,44 @@ bool intersect_triangles(const std::array<Vec3f, 3>& a, const std::array<Vec3f, 
 
 namespace {
 
-// Boxes in the BVH's primitive slots, one array per bound and axis so that the boxes of four
-// neighbouring slots are tested at once. Slots whose triangles take no part hold empty boxes
-// (lo = +inf, hi = -inf), which overlap nothing; kLanes more empty boxes pad the end so that
-// loads of four never read past it.
+// What the intersection search reads per BVH primitive slot, one array per value so that four
+// neighbouring slots are tested at once: the triangle's box (empty, lo = +inf and hi = -inf,
+// when it takes no part, so that it overlaps nothing), its corners' positions (canonical: equal
+// for equal coordinates, across objects) and whether it is stale (all bits set) or not (zero).
+// kLanes more slots pad the end so that loads of four never read past it.
 constexpr std::uint32_t kLanes = 4;
-struct SlotBoxes {
+// Pairs of subtrees of at most this many slots each are tested slot against slot (measured:
+// fewer instructions than 8 or 32 on the scan and the piano).
+constexpr std::uint32_t kSmallSubtree = 16;
+struct Slots {
     std::vector<float> lo[3], hi[3];
+    std::vector<std::uint32_t> corner[3];
+    std::vector<std::uint32_t> stale;
 };
 
-// Bit k is set when the box of slot j + k overlaps the box (lo, hi), each bound broadcast.
-int overlap_mask(const SlotBoxes& boxes, std::uint32_t j, const __m128 (&lo)[3],
-                 const __m128 (&hi)[3]) {
-    __m128 m = _mm_set1_ps(-0.0f);  // all lanes' sign bits set
+// Bit k is set when slot j + k may cross slot i: their boxes overlap, they share no corner
+// position, and one of them is stale.
+int candidate_mask(const Slots& slots, std::uint32_t i, std::uint32_t j) {
+    __m128 box = _mm_castsi128_ps(_mm_set1_epi32(-1));
     for (int a = 0; a < 3; ++a)
-        m = _mm_and_ps(m, _mm_and_ps(_mm_cmple_ps(lo[a], _mm_loadu_ps(&boxes.hi[a][j])),
-                                     _mm_cmpge_ps(hi[a], _mm_loadu_ps(&boxes.lo[a][j]))));
-    return _mm_movemask_ps(m);
+        box = _mm_and_ps(
+            box,
+            _mm_and_ps(_mm_cmple_ps(_mm_set1_ps(slots.lo[a][i]), _mm_loadu_ps(&slots.hi[a][j])),
+                       _mm_cmpge_ps(_mm_set1_ps(slots.hi[a][i]), _mm_loadu_ps(&slots.lo[a][j]))));
+    const int overlap = _mm_movemask_ps(box);
+    if (!overlap) return 0;
+    __m128i shared = _mm_setzero_si128();
+    __m128i other[3];
+    for (int c = 0; c < 3; ++c)
+        other[c] = _mm_loadu_si128(reinterpret_cast<const __m128i*>(&slots.corner[c][j]));
+    for (int c = 0; c < 3; ++c) {
+        const __m128i mine = _mm_set1_epi32(static_cast<int>(slots.corner[c][i]));
+        for (const __m128i& o : other) shared = _mm_or_si128(shared, _mm_cmpeq_epi32(mine, o));
+    }
+    const __m128i stale =
+        _mm_or_si128(_mm_set1_epi32(static_cast<int>(slots.stale[i])),
+                     _mm_loadu_si128(reinterpret_cast<const __m128i*>(&slots.stale[j])));
+    return overlap & _mm_movemask_ps(_mm_castsi128_ps(_mm_andnot_si128(shared, stale)));
 }
 
 // Every pair of triangles that take part (`live`) and cross, as intersect_triangles finds them,
@@ -232,29 +253,31 @@ std::vector<PairCrossing> find_crossings(const Bvh& bvh,
                                          const std::vector<std::uint8_t>* stale, int threads) {
     const std::uint32_t prims = static_cast<std::uint32_t>(bvh.prim_indices.size());
     constexpr float inf = std::numeric_limits<float>::infinity();
-    SlotBoxes boxes;
+    Slots slots;
     for (int a = 0; a < 3; ++a) {
-        boxes.lo[a].assign(prims + kLanes, inf);
-        boxes.hi[a].assign(prims + kLanes, -inf);
+        slots.lo[a].assign(prims + kLanes, inf);
+        slots.hi[a].assign(prims + kLanes, -inf);
+        slots.corner[a].assign(prims + kLanes, kNoIndex);
     }
-    // Per slot: corner positions (canonical: equal for equal coordinates, across objects),
-    // whether the triangle takes part and whether it is stale.
-    std::vector<std::array<std::uint32_t, 3>> tri_position(prims);
-    std::vector<std::uint8_t> live_slot(prims), stale_slot(prims);
+    slots.stale.assign(prims + kLanes, 0);
     for (std::uint32_t i = 0; i < prims; ++i) {
         const std::uint32_t t = bvh.prim_indices[i];
-        for (int k = 0; k < 3; ++k)
-            tri_position[i][k] = mesh.vertex_position[mesh.tri_vertices[t][k]];
-        live_slot[i] = live[t];
-        stale_slot[i] = !stale || (*stale)[t];
         if (!live[t]) continue;
+        for (int k = 0; k < 3; ++k)
+            slots.corner[k][i] = mesh.vertex_position[mesh.tri_vertices[t][k]];
+        slots.stale[i] = !stale || (*stale)[t] ? kNoIndex : 0;
         BBox box;
         for (const Vec3f& p : tri_corners[t]) box.extend(p);
         for (int a = 0; a < 3; ++a) {
-            boxes.lo[a][i] = box.lo[a];
-            boxes.hi[a][i] = box.hi[a];
+            slots.lo[a][i] = box.lo[a];
+            slots.hi[a][i] = box.hi[a];
         }
     }
+    auto live_slot = [&](std::uint32_t i) { return slots.lo[0][i] != inf; };
+    auto slot_box = [&](std::uint32_t i) {
+        return BBox{Vec3f(slots.lo[0][i], slots.lo[1][i], slots.lo[2][i]),
+                    Vec3f(slots.hi[0][i], slots.hi[1][i], slots.hi[2][i])};
+    };
     // Per node: the box of its live triangles (empty without), and whether one is stale.
     // Boxes of live triangles only: nodes of faces turned away from the eye shrink or vanish,
     // and fewer pairs of nodes overlap.
@@ -264,10 +287,9 @@ std::vector<PairCrossing> find_crossings(const Bvh& bvh,
         const BvhNode& node = bvh.nodes[i];
         if (node.is_leaf()) {
             for (std::uint32_t k = node.first; k < node.first + node.count; ++k) {
-                if (!live_slot[k]) continue;
-                live_box[i].extend(BBox{Vec3f(boxes.lo[0][k], boxes.lo[1][k], boxes.lo[2][k]),
-                                        Vec3f(boxes.hi[0][k], boxes.hi[1][k], boxes.hi[2][k])});
-                node_stale[i] |= stale_slot[k];
+                if (!live_slot(k)) continue;
+                live_box[i].extend(slot_box(k));
+                node_stale[i] |= slots.stale[k] != 0;
             }
             continue;
         }
@@ -275,38 +297,42 @@ std::vector<PairCrossing> find_crossings(const Bvh& bvh,
         live_box[i].extend(live_box[node.first + 1]);
         node_stale[i] = node_stale[node.first] | node_stale[node.first + 1];
     }
+    // Per node: its slots, when they are a contiguous range (a subtree's leaves follow each
+    // other in the BVHs built here; kNoIndex otherwise). Pairs of small subtrees are tested
+    // slot against slot rather than opened further.
+    std::vector<std::uint32_t> range_first(bvh.nodes.size()), range_count(bvh.nodes.size());
+    for (std::size_t i = bvh.nodes.size(); i-- > 0;) {
+        const BvhNode& node = bvh.nodes[i];
+        if (node.is_leaf()) {
+            range_first[i] = node.first;
+            range_count[i] = node.count;
+            continue;
+        }
+        const std::uint32_t l = node.first, r = node.first + 1;
+        const bool joined = range_count[l] != kNoIndex && range_count[r] != kNoIndex &&
+                            range_first[l] + range_count[l] == range_first[r];
+        range_first[i] = range_first[l];
+        range_count[i] = joined ? range_count[l] + range_count[r] : kNoIndex;
+    }
     auto overlap = [](const BBox& a, const BBox& b) {
         return !(a.lo.x > b.hi.x || a.hi.x < b.lo.x || a.lo.y > b.hi.y || a.hi.y < b.lo.y ||
                  a.lo.z > b.hi.z || a.hi.z < b.lo.z);
     };
-    // Tests the triangles in slots i and j, whose boxes overlap.
-    auto test_pair = [&](std::uint32_t i, std::uint32_t j, std::vector<PairCrossing>& out) {
-        if (!stale_slot[i] && !stale_slot[j]) return;  // the cache has it
-        const auto& pa = tri_position[i];
-        const auto& pb = tri_position[j];
-        for (std::uint32_t a_corner : pa)
-            if (a_corner == pb[0] || a_corner == pb[1] || a_corner == pb[2]) return;
-        std::uint32_t t = bvh.prim_indices[i], u = bvh.prim_indices[j];
-        if (u < t) std::swap(t, u);
-        PairCrossing found{t, u, {}};
-        if (intersect_triangles(tri_corners[t], tri_corners[u], found.crossing))
-            out.push_back(found);
-    };
-    // Tests slot i against the slots [j0, j1) whose boxes overlap its own.
+    // Tests slot i against the slots [j0, j1) that may cross it.
     auto test_slots = [&](std::uint32_t i, std::uint32_t j0, std::uint32_t j1,
                           std::vector<PairCrossing>& out) {
-        const __m128 lo[3] = {_mm_set1_ps(boxes.lo[0][i]), _mm_set1_ps(boxes.lo[1][i]),
-                              _mm_set1_ps(boxes.lo[2][i])};
-        const __m128 hi[3] = {_mm_set1_ps(boxes.hi[0][i]), _mm_set1_ps(boxes.hi[1][i]),
-                              _mm_set1_ps(boxes.hi[2][i])};
         for (std::uint32_t j = j0; j < j1; j += kLanes) {
-            int mask = overlap_mask(boxes, j, lo, hi);
+            int mask = candidate_mask(slots, i, j);
             if (j1 - j < kLanes) mask &= (1 << (j1 - j)) - 1;
-            for (; mask; mask &= mask - 1)
-                test_pair(
-                    i,
-                    j + static_cast<std::uint32_t>(std::countr_zero(static_cast<unsigned>(mask))),
-                    out);
+            for (; mask; mask &= mask - 1) {
+                const std::uint32_t k =
+                    j + static_cast<std::uint32_t>(std::countr_zero(static_cast<unsigned>(mask)));
+                std::uint32_t t = bvh.prim_indices[i], u = bvh.prim_indices[k];
+                if (u < t) std::swap(t, u);
+                PairCrossing found{t, u, {}};
+                if (intersect_triangles(tri_corners[t], tri_corners[u], found.crossing))
+                    out.push_back(found);
+            }
         }
     };
     using NodePair = std::pair<std::uint32_t, std::uint32_t>;
@@ -319,10 +345,12 @@ std::vector<PairCrossing> find_crossings(const Bvh& bvh,
         if (!overlap(box_a, box_b)) return;  // also when either has no live triangle
         const BvhNode& a = bvh.nodes[pair.first];
         const BvhNode& b = bvh.nodes[pair.second];
+        const std::uint32_t a0 = range_first[pair.first], an = range_count[pair.first];
+        const std::uint32_t b0 = range_first[pair.second], bn = range_count[pair.second];
         if (pair.first == pair.second) {
-            if (a.is_leaf()) {
-                for (std::uint32_t i = a.first; i + 1 < a.first + a.count; ++i)
-                    if (live_slot[i]) test_slots(i, i + 1, a.first + a.count, out);
+            if (a.is_leaf() || an <= kSmallSubtree) {
+                for (std::uint32_t i = a0; i + 1 < a0 + an; ++i)
+                    if (live_slot(i)) test_slots(i, i + 1, a0 + an, out);
             } else {
                 next.push_back({a.first, a.first});
                 next.push_back({a.first + 1, a.first + 1});
@@ -330,9 +358,9 @@ std::vector<PairCrossing> find_crossings(const Bvh& bvh,
             }
             return;
         }
-        if (a.is_leaf() && b.is_leaf()) {
-            for (std::uint32_t i = a.first; i < a.first + a.count; ++i)
-                if (live_slot[i]) test_slots(i, b.first, b.first + b.count, out);
+        if ((a.is_leaf() && b.is_leaf()) || (an <= kSmallSubtree && bn <= kSmallSubtree)) {
+            for (std::uint32_t i = a0; i < a0 + an; ++i)
+                if (live_slot(i) && overlap(slot_box(i), box_b)) test_slots(i, b0, b0 + bn, out);
             return;
         }
         // Open the inner node with the larger box (or the only inner one).
