@@ -4,6 +4,7 @@
 #include <bit>
 #include <limits>
 #include <map>
+#include <memory>
 #include <cmath>
 #include <numbers>
 #include <tuple>
@@ -209,9 +210,18 @@ constexpr std::uint32_t kLanes = 4;
 // fewer instructions than 8 or 32 on the scan and the piano).
 constexpr std::uint32_t kSmallSubtree = 16;
 struct Slots {
-    std::vector<float> lo[3], hi[3];
-    std::vector<std::uint32_t> corner[3];
-    std::vector<std::uint32_t> stale;
+    std::unique_ptr<float[]> lo[3], hi[3];
+    std::unique_ptr<std::uint32_t[]> corner[3];
+    std::unique_ptr<std::uint32_t[]> stale;
+
+    explicit Slots(std::size_t count) {  // values left for the caller to write
+        for (int a = 0; a < 3; ++a) {
+            lo[a] = std::make_unique_for_overwrite<float[]>(count);
+            hi[a] = std::make_unique_for_overwrite<float[]>(count);
+            corner[a] = std::make_unique_for_overwrite<std::uint32_t[]>(count);
+        }
+        stale = std::make_unique_for_overwrite<std::uint32_t[]>(count);
+    }
 };
 
 // Bit k is set when slot j + k may cross slot i: their boxes overlap, they share no corner
@@ -253,16 +263,18 @@ std::vector<PairCrossing> find_crossings(const Bvh& bvh,
                                          const std::vector<std::uint8_t>* stale, int threads) {
     const std::uint32_t prims = static_cast<std::uint32_t>(bvh.prim_indices.size());
     constexpr float inf = std::numeric_limits<float>::infinity();
-    Slots slots;
-    for (int a = 0; a < 3; ++a) {
-        slots.lo[a].assign(prims + kLanes, inf);
-        slots.hi[a].assign(prims + kLanes, -inf);
-        slots.corner[a].assign(prims + kLanes, kNoIndex);
-    }
-    slots.stale.assign(prims + kLanes, 0);
-    for (std::uint32_t i = 0; i < prims; ++i) {
-        const std::uint32_t t = bvh.prim_indices[i];
-        if (!live[t]) continue;
+    Slots slots(prims + kLanes);
+    for (std::uint32_t i = 0; i < prims + kLanes; ++i) {
+        const std::uint32_t t = i < prims ? bvh.prim_indices[i] : kNoIndex;
+        if (t == kNoIndex || !live[t]) {
+            for (int a = 0; a < 3; ++a) {
+                slots.lo[a][i] = inf;
+                slots.hi[a][i] = -inf;
+                slots.corner[a][i] = kNoIndex;
+            }
+            slots.stale[i] = 0;
+            continue;
+        }
         for (int k = 0; k < 3; ++k)
             slots.corner[k][i] = mesh.vertex_position[mesh.tri_vertices[t][k]];
         slots.stale[i] = !stale || (*stale)[t] ? kNoIndex : 0;
@@ -456,7 +468,9 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
         bool forward;  // lo -> hi in the triangle's winding
     };
     for (std::size_t v = 0; v < vertices; ++v) side_offsets[v + 1] += side_offsets[v];
-    std::vector<Side> sides(side_offsets[vertices]);
+    const std::size_t side_count = side_offsets[vertices];
+    // Every side is written below: no need to clear them first.
+    const auto sides = std::make_unique_for_overwrite<Side[]>(side_count);
     {
         std::vector<std::uint32_t> fill(side_offsets.begin(), side_offsets.end() - 1);
         for (std::size_t t = 0; t < n; ++t) {
@@ -473,10 +487,10 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
     // Then the edges, runs of sides with the same ends (edge e is sides [edge_first[e],
     // edge_first[e + 1])), and whether each object is closed.
     std::vector<std::uint32_t> edge_first;
-    edge_first.reserve(sides.size() / 2 + 1);
+    edge_first.reserve(side_count / 2 + 1);
     for (std::size_t v = 0; v < vertices; ++v) {
-        Side* const first = sides.data() + side_offsets[v];
-        Side* const last = sides.data() + side_offsets[v + 1];
+        Side* const first = sides.get() + side_offsets[v];
+        Side* const last = sides.get() + side_offsets[v + 1];
         // By insertion, as a vertex has few sides (but not at the centre of a large fan).
         if (last - first > 32) {
             std::stable_sort(first, last, [](const Side& a, const Side& b) { return a.hi < b.hi; });
@@ -491,13 +505,13 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
         for (const Side* i = first; i < last;) {
             const Side* j = i + 1;
             while (j < last && j->hi == i->hi) ++j;
-            edge_first.push_back(static_cast<std::uint32_t>(i - sides.data()));
+            edge_first.push_back(static_cast<std::uint32_t>(i - sides.get()));
             if (j - i != 2 || i[0].forward == i[1].forward) closed[scene.tri_object[i->tri]] = 0;
             i = j;
         }
     }
     const std::size_t edge_count = edge_first.size();
-    edge_first.push_back(static_cast<std::uint32_t>(sides.size()));
+    edge_first.push_back(static_cast<std::uint32_t>(side_count));
 
     auto eye_outside = [&](const BBox& b) {
         return eye.x < b.lo.x || eye.y < b.lo.y || eye.z < b.lo.z || eye.x > b.hi.x ||
