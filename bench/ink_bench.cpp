@@ -7,20 +7,28 @@
 //
 // Usage: toonray_ink_bench [--repeats N] [--size WxH] [--out DIR] [--quick] [--previous PREV.obj]
 //        [--lines-only] scene.obj ...
+//        toonray_ink_bench --make-scan OUT.obj
 // With --previous, each scene is also timed as the next frame of an animation after PREV.obj
 // (ink at 1 sample, the intersection lines of unmoved triangles kept from PREV.obj).
 // With no scenes: tests/data/teapot.obj. --quick runs each stage once and checks that the
 // ink lines do not depend on the thread count (CTest: ink_bench_quick). --lines-only times
 // the ink stages alone (no whole frames), for profiles: under callgrind,
 // --toggle-collect='*fresh_frame_lines*' counts the frames on their own and
-// --toggle-collect='*next_frame_lines*' the frames after PREV.obj.
+// --toggle-collect='*next_frame_lines*' the frames after PREV.obj. --make-scan writes the
+// 70k-triangle scan of docs/ink.md: tests/data/spot.obj with each triangle split into 4 at its
+// edges' midpoints (shared), then into 3 at its centroid (70,272 triangles, shared vertices, no
+// normals), with a camera block.
 
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -93,6 +101,79 @@ int count_specks(const ImageGray8& lines) {
 }
 
 std::string ms(double s) { return fmt::format("{:.1f} ms", s * 1e3); }
+
+// --make-scan: a scan-like mesh from spot.obj (see the top of this file), computed in double
+// and written with six decimals.
+void make_scan(const fs::path& out_path) {
+    using P = std::array<double, 3>;
+    std::vector<P> v;
+    std::vector<std::array<std::size_t, 3>> faces;
+    std::ifstream in(TOONRAY_BENCH_DATA_DIR "/spot.obj");
+    for (std::string line; std::getline(in, line);) {
+        if (line.rfind("v ", 0) == 0) {
+            P p{};
+            std::sscanf(line.c_str(), "v %lf %lf %lf", &p[0], &p[1], &p[2]);
+            v.push_back(p);
+        } else if (line.rfind("f ", 0) == 0) {
+            std::array<std::size_t, 3> f{};
+            std::size_t at = 2;
+            for (auto& k : f) {
+                k = std::stoul(line.substr(at)) - 1;
+                at = line.find(' ', at) + 1;
+            }
+            faces.push_back(f);
+        }
+    }
+    if (v.empty() || faces.empty()) throw Error("--make-scan: cannot read spot.obj");
+    std::map<std::pair<std::size_t, std::size_t>, std::size_t> midpoints;
+    auto midpoint = [&](std::size_t a, std::size_t b) {
+        auto [it, inserted] = midpoints.try_emplace({std::min(a, b), std::max(a, b)}, v.size());
+        if (inserted)
+            v.push_back(
+                {(v[a][0] + v[b][0]) / 2, (v[a][1] + v[b][1]) / 2, (v[a][2] + v[b][2]) / 2});
+        return it->second;
+    };
+    std::vector<std::array<std::size_t, 3>> quarters;
+    for (const auto& [a, b, c] : faces) {
+        const std::size_t ab = midpoint(a, b), bc = midpoint(b, c), ca = midpoint(c, a);
+        for (const auto& q : {std::array{a, ab, ca}, std::array{ab, b, bc}, std::array{ca, bc, c},
+                              std::array{ab, bc, ca}})
+            quarters.push_back(q);
+    }
+    auto fixed6 = [](const char* tag, const P& p) {  // as printf's %.6f rounds
+        char buffer[128];
+        std::snprintf(buffer, sizeof buffer, "%s %.6f %.6f %.6f\n", tag, p[0], p[1], p[2]);
+        return std::string(buffer);
+    };
+    std::string text;
+    // The camera: from (3.2, 1.0, 1.4) moved 1.35 times as far from (0, 0.11, 0.19), looking
+    // at it with a 48-degree field of view, y up.
+    const P centre{0.0, 0.11, 0.19}, from{3.2, 1.0, 1.4};
+    P eye{}, dir{}, up{};
+    for (int i = 0; i < 3; ++i) eye[i] = centre[i] + 1.35 * (from[i] - centre[i]);
+    for (int i = 0; i < 3; ++i) dir[i] = centre[i] - eye[i];
+    const double dir_len = std::sqrt(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
+    for (double& d : dir) d /= dir_len;
+    for (int i = 0; i < 3; ++i) up[i] = (i == 1 ? 1.0 : 0.0) - dir[1] * dir[i];
+    const double up_len = std::sqrt(up[0] * up[0] + up[1] * up[1] + up[2] * up[2]);
+    for (double& u : up) u /= up_len;
+    text += "# Camera start\n" + fixed6("v", eye) +
+            fixed6("v", {eye[0] + dir[0] * 2.2, eye[1] + dir[1] * 2.2, eye[2] + dir[2] * 2.2}) +
+            fixed6("vn", up) + "c 1 2 1\n# Camera end\n";
+    text += "# spot, each triangle split in 4 at edge midpoints, then in 3 at its centroid\n";
+    std::string faces_text;
+    for (const auto& [a, b, c] : quarters) {
+        const std::size_t g = v.size();
+        v.push_back({(v[a][0] + v[b][0] + v[c][0]) / 3, (v[a][1] + v[b][1] + v[c][1]) / 3,
+                     (v[a][2] + v[b][2] + v[c][2]) / 3});
+        for (const auto& [x, y] : {std::pair{a, b}, std::pair{b, c}, std::pair{c, a}})
+            faces_text += fmt::format("f {} {} {}\n", x + 3, y + 3, g + 3);  // after the camera's
+    }
+    for (const P& p : v) text += fixed6("v", p);
+    text += faces_text;
+    write_file_atomic(out_path,
+                      std::span(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()));
+}
 
 // Medians of the stage times of repeated draws.
 struct StageTimes {
@@ -348,7 +429,10 @@ int main(int argc, char** argv) {
             } else if (arg == "--out") options.out = value();
             else if (arg == "--quick") options.quick = true;
             else if (arg == "--lines-only") options.lines_only = true;
-            else if (arg == "--previous") options.previous = value();
+            else if (arg == "--make-scan") {
+                make_scan(value());
+                return 0;
+            } else if (arg == "--previous") options.previous = value();
             else if (!arg.empty() && arg[0] == '-') throw toonray::Error("unknown option " + arg);
             else options.scenes.emplace_back(arg);
         }
