@@ -121,6 +121,7 @@ std::vector<EdgePiece> split_by_visibility(std::span<const FeatureSegment> segme
     return gather_chunks<EdgePiece>(
         static_cast<int>(segments.size()), 32, threads,
         [&](int i0, int i1, std::vector<EdgePiece>& out) {
+            out.reserve(static_cast<std::size_t>(i1 - i0));
             std::vector<float> cuts;
             std::vector<int> states, sample_states;
             std::vector<Vec3f> dirs, points;
@@ -227,12 +228,10 @@ std::vector<EdgePiece> split_by_visibility(std::span<const FeatureSegment> segme
                 cuts.assign(1, c.s_lo);
                 states.clear();
                 int previous = 0;
-                float previous_s = 0;
                 for (int k = 0; k < n; ++k) {
-                    const float s = sample_s(k);
                     const int state = sample_states[static_cast<std::size_t>(k)];
                     if (k > 0 && state != previous) {
-                        float lo = previous_s, hi = s;
+                        float lo = sample_s(k - 1), hi = sample_s(k);
                         while ((hi - lo) * image_length > settings.precision) {
                             const float mid = 0.5f * (lo + hi);
                             if (mid <= lo || mid >= hi) break;
@@ -242,7 +241,6 @@ std::vector<EdgePiece> split_by_visibility(std::span<const FeatureSegment> segme
                         states.push_back(previous);
                     }
                     previous = state;
-                    previous_s = s;
                 }
                 states.push_back(previous);
                 cuts.push_back(c.s_hi);
