@@ -415,6 +415,101 @@ std::vector<PairCrossing> find_crossings(const Bvh& bvh,
 
 }  // namespace
 
+namespace {
+
+// A side of a usable triangle: from welded vertex lo to hi (lo < hi).
+struct Side {
+    std::uint32_t lo, hi, tri;
+    bool forward;  // lo -> hi in the triangle's winding
+};
+
+}  // namespace
+
+struct MeshTopology {
+    // What it was made from.
+    std::vector<std::array<std::uint32_t, 3>> tri_vertices;
+    std::vector<std::uint32_t> tri_object;
+    std::vector<std::uint8_t> usable;
+    std::size_t objects = 0;
+    /// Every side of a usable triangle, in order of (lo, hi, triangle, corner), so that the
+    /// sides of one edge are adjacent: edge e is sides [edge_first[e], edge_first[e + 1]).
+    std::unique_ptr<Side[]> sides;  // every one written: not cleared first
+    std::vector<std::uint32_t> edge_first;
+    /// Per object: not closed, for an edge without exactly two sides in opposite directions,
+    /// or a triangle that is not usable or has two corners welded together.
+    std::vector<std::uint8_t> open;
+
+    MeshTopology(const Scene& scene, const WeldedMesh& mesh, std::span<const std::uint8_t> usable_,
+                 std::size_t objects_)
+        : tri_vertices(mesh.tri_vertices),
+          tri_object(scene.tri_object.begin(), scene.tri_object.begin() + scene.triangle_count()),
+          usable(usable_.begin(), usable_.end()),
+          objects(objects_),
+          open(objects_, 0) {
+        const std::size_t n = usable.size(), vertices = mesh.vertex_count();
+        // A counting sort by lo over the triangles in order puts each vertex's sides in
+        // (triangle, corner) order; a stable sort by hi within each vertex then gives the
+        // whole order.
+        std::vector<std::uint32_t> offsets(vertices + 1, 0);
+        for (std::size_t t = 0; t < n; ++t) {
+            const auto& w = tri_vertices[t];
+            if (!usable[t] || w[0] == w[1] || w[1] == w[2] || w[2] == w[0]) open[tri_object[t]] = 1;
+            if (!usable[t]) continue;
+            for (int k = 0; k < 3; ++k)
+                if (w[k] != w[(k + 1) % 3]) ++offsets[std::min(w[k], w[(k + 1) % 3]) + 1];
+        }
+        for (std::size_t v = 0; v < vertices; ++v) offsets[v + 1] += offsets[v];
+        const std::size_t side_count = offsets[vertices];
+        sides = std::make_unique_for_overwrite<Side[]>(side_count);
+        {
+            std::vector<std::uint32_t> fill(offsets.begin(), offsets.end() - 1);
+            for (std::size_t t = 0; t < n; ++t) {
+                if (!usable[t]) continue;
+                const auto& w = tri_vertices[t];
+                for (int k = 0; k < 3; ++k) {
+                    const std::uint32_t u = w[k], v = w[(k + 1) % 3];
+                    if (u == v) continue;
+                    const std::uint32_t lo = std::min(u, v);
+                    sides[fill[lo]++] = {lo, std::max(u, v), static_cast<std::uint32_t>(t), u < v};
+                }
+            }
+        }
+        edge_first.reserve(side_count / 2 + 1);
+        for (std::size_t v = 0; v < vertices; ++v) {
+            Side* const first = sides.get() + offsets[v];
+            Side* const last = sides.get() + offsets[v + 1];
+            // By insertion, as a vertex has few sides (but not at the centre of a large fan).
+            if (last - first > 32) {
+                std::stable_sort(first, last,
+                                 [](const Side& a, const Side& b) { return a.hi < b.hi; });
+            } else {
+                for (Side* i = first + 1; i < last; ++i) {
+                    const Side side = *i;
+                    Side* j = i;
+                    for (; j > first && (j - 1)->hi > side.hi; --j) *j = *(j - 1);
+                    *j = side;
+                }
+            }
+            for (const Side* i = first; i < last;) {
+                const Side* j = i + 1;
+                while (j < last && j->hi == i->hi) ++j;
+                edge_first.push_back(static_cast<std::uint32_t>(i - sides.get()));
+                if (j - i != 2 || i[0].forward == i[1].forward) open[tri_object[i->tri]] = 1;
+                i = j;
+            }
+        }
+        edge_first.push_back(static_cast<std::uint32_t>(side_count));
+    }
+
+    [[nodiscard]] bool same(const Scene& scene, const WeldedMesh& mesh,
+                            std::span<const std::uint8_t> usable_, std::size_t objects_) const {
+        return objects_ == objects && usable_.size() == usable.size() &&
+               std::equal(usable.begin(), usable.end(), usable_.begin()) &&
+               mesh.tri_vertices == tri_vertices &&
+               std::equal(tri_object.begin(), tri_object.end(), scene.tri_object.begin());
+    }
+};
+
 std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedMesh& mesh,
                                                const Bvh& bvh, const Vec3f& eye,
                                                const FeatureEdgeSettings& settings, int threads,
@@ -434,84 +529,35 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
 
     // Per triangle, in one pass: its corners (kept by the cache for the next frame), unit
     // normal (zero when degenerate: the triangle is not usable), whether it has a normal at
-    // every corner, its object's box and volume, and the count of its sides at each vertex.
-    const std::size_t vertices = mesh.vertex_count();
+    // every corner, and its object's box and volume.
     std::vector<std::array<Vec3f, 3>> tri_corners;
     std::vector<Vec3f> normal;
-    std::vector<std::uint8_t> corner_normals;
+    std::vector<std::uint8_t> corner_normals, usable_triangle;
     tri_corners.reserve(n);
     normal.reserve(n);
     corner_normals.reserve(n);
-    std::vector<std::uint32_t> side_offsets(vertices + 1, 0);
+    usable_triangle.reserve(n);
     for (std::size_t t = 0; t < n; ++t) {
         const auto& p = tri_corners.emplace_back(corners(scene, t));
-        const Vec3f& nt = normal.emplace_back(face_normal(p));
+        usable_triangle.push_back(normal.emplace_back(face_normal(p)) != Vec3f(0.0f));
         corner_normals.push_back(has_corner_normals(scene, t));
         const std::uint32_t o = scene.tri_object[t];
-        const auto& w = mesh.tri_vertices[t];
-        const bool usable = nt != Vec3f(0.0f);
-        if (!usable || w[0] == w[1] || w[1] == w[2] || w[2] == w[0]) closed[o] = 0;
         for (const Vec3f& q : p) object_box[o].extend(q);
         volume[o] += static_cast<double>(dot(p[0], cross(p[1], p[2])));
-        if (!usable) continue;
-        for (int k = 0; k < 3; ++k)
-            if (w[k] != w[(k + 1) % 3]) ++side_offsets[std::min(w[k], w[(k + 1) % 3]) + 1];
     }
-    auto usable = [&](std::size_t t) { return normal[t] != Vec3f(0.0f); };
+    auto usable = [&](std::size_t t) { return usable_triangle[t] != 0; };
 
-    // Mesh edges: every side of a usable triangle as (lower welded id, higher, triangle,
-    // corner), in that order, so that the sides of one edge are adjacent. A counting sort by
-    // lo over the triangles in order puts each vertex's sides in (triangle, corner) order; a
-    // stable sort by hi within each vertex then gives the whole order.
-    struct Side {
-        std::uint32_t lo, hi, tri;
-        bool forward;  // lo -> hi in the triangle's winding
-    };
-    for (std::size_t v = 0; v < vertices; ++v) side_offsets[v + 1] += side_offsets[v];
-    const std::size_t side_count = side_offsets[vertices];
-    // Every side is written below: no need to clear them first.
-    const auto sides = std::make_unique_for_overwrite<Side[]>(side_count);
-    {
-        std::vector<std::uint32_t> fill(side_offsets.begin(), side_offsets.end() - 1);
-        for (std::size_t t = 0; t < n; ++t) {
-            if (!usable(t)) continue;
-            const auto& w = mesh.tri_vertices[t];
-            for (int k = 0; k < 3; ++k) {
-                const std::uint32_t u = w[k], v = w[(k + 1) % 3];
-                if (u == v) continue;
-                const std::uint32_t lo = std::min(u, v);
-                sides[fill[lo]++] = {lo, std::max(u, v), static_cast<std::uint32_t>(t), u < v};
-            }
-        }
-    }
-    // Then the edges, runs of sides with the same ends (edge e is sides [edge_first[e],
-    // edge_first[e + 1])), and whether each object is closed.
-    std::vector<std::uint32_t> edge_first;
-    edge_first.reserve(side_count / 2 + 1);
-    for (std::size_t v = 0; v < vertices; ++v) {
-        Side* const first = sides.get() + side_offsets[v];
-        Side* const last = sides.get() + side_offsets[v + 1];
-        // By insertion, as a vertex has few sides (but not at the centre of a large fan).
-        if (last - first > 32) {
-            std::stable_sort(first, last, [](const Side& a, const Side& b) { return a.hi < b.hi; });
-        } else {
-            for (Side* i = first + 1; i < last; ++i) {
-                const Side side = *i;
-                Side* j = i;
-                for (; j > first && (j - 1)->hi > side.hi; --j) *j = *(j - 1);
-                *j = side;
-            }
-        }
-        for (const Side* i = first; i < last;) {
-            const Side* j = i + 1;
-            while (j < last && j->hi == i->hi) ++j;
-            edge_first.push_back(static_cast<std::uint32_t>(i - sides.get()));
-            if (j - i != 2 || i[0].forward == i[1].forward) closed[scene.tri_object[i->tri]] = 0;
-            i = j;
-        }
-    }
-    const std::size_t edge_count = edge_first.size();
-    edge_first.push_back(static_cast<std::uint32_t>(side_count));
+    // The mesh edges, as the last frame's when the triangles' welded corners, objects and
+    // usability did not change.
+    std::shared_ptr<const MeshTopology> kept = cache ? cache->topology : nullptr;
+    if (!kept || !kept->same(scene, mesh, usable_triangle, objects))
+        kept = std::make_shared<const MeshTopology>(scene, mesh, usable_triangle, objects);
+    if (cache) cache->topology = kept;
+    const MeshTopology& topology = *kept;
+    const Side* const sides = topology.sides.get();
+    const std::vector<std::uint32_t>& edge_first = topology.edge_first;
+    for (std::size_t o = 0; o < objects; ++o) closed[o] = !topology.open[o];
+    const std::size_t edge_count = edge_first.size() - 1;
 
     auto eye_outside = [&](const BBox& b) {
         return eye.x < b.lo.x || eye.y < b.lo.y || eye.z < b.lo.z || eye.x > b.hi.x ||
