@@ -631,15 +631,25 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
 
     // Smooth contours: where n . (p - eye), interpolated linearly from the corners, is zero.
     if (settings.silhouettes && settings.smooth_contours) {
+        // g at a corner depends on its position and normal only, which most triangles around
+        // a vertex share: kept per position for the last normal it was computed with.
+        std::vector<std::uint32_t> g_normal(scene.positions.size(), kNoIndex);
+        std::vector<float> g_value(scene.positions.size());
         for (std::size_t t = 0; t < n; ++t) {
             if (!usable(t) || !corner_normals[t]) continue;
             const auto& p = tri_corners[t];
             float g[3];
             for (int k = 0; k < 3; ++k) {
-                // Unit normals: the zero's position depends on their lengths.
-                const Vec3f nk = scene.normals[scene.tri_normals[t][k]];
-                const float len = length(nk);
-                g[k] = dot(nk, p[k] - eye) / (len > 0.0f ? len : 1.0f);
+                const std::uint32_t position = scene.tri_positions[t][k],
+                                    normal_index = scene.tri_normals[t][k];
+                if (g_normal[position] != normal_index) {
+                    // Unit normals: the zero's position depends on their lengths.
+                    const Vec3f nk = scene.normals[normal_index];
+                    const float len = length(nk);
+                    g_value[position] = dot(nk, p[k] - eye) / (len > 0.0f ? len : 1.0f);
+                    g_normal[position] = normal_index;
+                }
+                g[k] = g_value[position];
             }
             FeatureSegment seg;
             seg.type = EdgeType::Silhouette;
