@@ -200,10 +200,20 @@ struct Options {
     std::vector<fs::path> scenes;
 };
 
-TriangleAccel build_accel(const Scene& scene) {
+// A scene from an OBJ file with its accelerator and the camera a frame of it would have.
+struct BenchScene {
+    Scene scene;
     TriangleAccel accel;
-    accel.build(scene.positions, scene.tri_positions);
-    return accel;
+    CameraSpec camera;
+};
+
+BenchScene load_bench_scene(const fs::path& path, const FrameOptions& file_options) {
+    BenchScene out;
+    Warnings warnings;
+    load_obj(path, out.scene, warnings);
+    out.accel.build(out.scene.positions, out.scene.tri_positions);
+    out.camera = choose_camera(out.scene, file_options);
+    return out;
 }
 
 // --lines-only: the stages of each scene on its own, and after --previous.
@@ -214,21 +224,13 @@ void run_lines_only(const Options& options) {
     FrameOptions file_options;
     file_options.settings.width = options.width;
     file_options.settings.height = options.height;
-    Scene before;
-    TriangleAccel before_accel;
-    CameraSpec before_camera;
-    if (options.previous) {
-        Warnings warnings;
-        load_obj(*options.previous, before, warnings);
-        before_accel = build_accel(before);
-        before_camera = choose_camera(before, file_options);
-    }
+    BenchScene before;
+    if (options.previous) before = load_bench_scene(*options.previous, file_options);
     for (const fs::path& path : options.scenes) {
-        Scene scene;
-        Warnings warnings;
-        load_obj(path, scene, warnings);
-        const TriangleAccel accel = build_accel(scene);
-        const CameraSpec camera = choose_camera(scene, file_options);
+        const BenchScene loaded = load_bench_scene(path, file_options);
+        const Scene& scene = loaded.scene;
+        const TriangleAccel& accel = loaded.accel;
+        const CameraSpec& camera = loaded.camera;
         ink::InkLines lines;
         StageTimes fresh, next;
         for (int i = 0; i <= options.repeats; ++i) {
@@ -239,8 +241,8 @@ void run_lines_only(const Options& options) {
                    fresh.row());
         if (!options.previous) continue;
         for (int i = 0; i <= options.repeats; ++i) {
-            fresh_frame_lines(before, before_accel, before_camera, options.width, options.height,
-                              lines);
+            fresh_frame_lines(before.scene, before.accel, before.camera, options.width,
+                              options.height, lines);
             next_frame_lines(scene, accel, camera, options.width, options.height, lines);
             if (i > 0 || options.repeats == 0) next.add(lines.timings);
         }
@@ -261,14 +263,13 @@ int run(const Options& options) {
     int failures = 0;
     std::vector<std::string> animation_rows;
     for (const fs::path& path : options.scenes) {
-        Scene scene;
-        Warnings warnings;
-        load_obj(path, scene, warnings);
-        const TriangleAccel accel = build_accel(scene);
         FrameOptions file_options;
         file_options.settings.width = options.width;
         file_options.settings.height = options.height;
-        const CameraSpec camera = choose_camera(scene, file_options);
+        const BenchScene loaded = load_bench_scene(path, file_options);
+        const Scene& scene = loaded.scene;
+        const TriangleAccel& accel = loaded.accel;
+        const CameraSpec& camera = loaded.camera;
         const int repeats = options.quick ? 1 : options.repeats;
 
         // Whole frames on one thread: trace, shade, lines, compose.
@@ -344,12 +345,10 @@ int run(const Options& options) {
         if (options.previous) {
             // As in an animation: the previous frame first, untimed, then this one with what
             // the previous left (the intersection lines of the triangles that did not move).
-            Scene before;
-            Warnings before_warnings;
-            load_obj(*options.previous, before, before_warnings);
-            TriangleAccel before_accel;
-            before_accel.build(before.positions, before.tri_positions);
-            const CameraSpec before_camera = choose_camera(before, file_options);
+            const BenchScene previous = load_bench_scene(*options.previous, file_options);
+            const Scene& before = previous.scene;
+            const TriangleAccel& before_accel = previous.accel;
+            const CameraSpec& before_camera = previous.camera;
             std::vector<double> frame_t, edges_t, visibility_t, chaining_t, drawing_t;
             RenderSettings settings = file_options.settings;
             settings.edges = EdgeMode::Ink;

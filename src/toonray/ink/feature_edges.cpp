@@ -12,6 +12,7 @@
 #include "toonray/core/portable_math.h"
 #include "toonray/core/simd_sse.h"
 #include "toonray/ink/chunks.h"
+#include "toonray/ink/hash.h"
 
 namespace toonray::ink {
 
@@ -77,11 +78,7 @@ WeldedMesh weld_vertices(const Scene& scene) {
     std::vector<std::uint32_t> table(table_size, kNoIndex);
     for (std::uint32_t i = 0; i < positions; ++i) {
         const Bits b = bits(i);
-        std::uint64_t h = (static_cast<std::uint64_t>(b[0]) * 0x9e3779b97f4a7c15ull) ^
-                          (static_cast<std::uint64_t>(b[1]) * 0xc2b2ae3d27d4eb4full) ^
-                          (static_cast<std::uint64_t>(b[2]) * 0x165667b19e3779f9ull);
-        h ^= h >> 29;
-        for (std::size_t slot = static_cast<std::size_t>(h) & mask;; slot = (slot + 1) & mask) {
+        for (std::size_t slot = hash_words(b[0], b[1], b[2]) & mask;; slot = (slot + 1) & mask) {
             if (table[slot] == kNoIndex) {
                 table[slot] = i;
                 canonical[i] = i;

@@ -6,6 +6,7 @@
 #include <tuple>
 
 #include "toonray/core/portable_math.h"
+#include "toonray/ink/hash.h"
 
 namespace toonray::ink {
 
@@ -87,11 +88,7 @@ EndGroups group_ends(const std::vector<Link>& links) {
         const Link& link = links[e / 2];
         const EndpointKey& key = e % 2 ? link.key1 : link.key0;
         if (!has_key(key)) continue;
-        std::uint64_t h = (static_cast<std::uint64_t>(key.a) * 0x9e3779b97f4a7c15ull) ^
-                          (static_cast<std::uint64_t>(key.b) * 0xc2b2ae3d27d4eb4full) ^
-                          (static_cast<std::uint64_t>(key.c) * 0x165667b19e3779f9ull);
-        h ^= h >> 29;
-        std::size_t slot = static_cast<std::size_t>(h) & (table_size - 1);
+        std::size_t slot = hash_words(key.a, key.b, key.c) & (table_size - 1);
         while (table[slot] != kNoIndex && keys[table[slot]] != key)
             slot = (slot + 1) & (table_size - 1);
         if (table[slot] == kNoIndex) {
