@@ -6,18 +6,29 @@
 // image, and with --out writes both, the ink lines over the cel colours, and the SVG.
 //
 // Usage: toonray_ink_bench [--repeats N] [--size WxH] [--out DIR] [--quick] [--previous PREV.obj]
-//        scene.obj ...
+//        [--lines-only] scene.obj ...
+//        toonray_ink_bench --make-scan OUT.obj
 // With --previous, each scene is also timed as the next frame of an animation after PREV.obj
 // (ink at 1 sample, the intersection lines of unmoved triangles kept from PREV.obj).
 // With no scenes: tests/data/teapot.obj. --quick runs each stage once and checks that the
-// ink lines do not depend on the thread count (CTest: ink_bench_quick).
+// ink lines do not depend on the thread count (CTest: ink_bench_quick). --lines-only times
+// the ink stages alone (no whole frames), for profiles: under callgrind,
+// --toggle-collect='*fresh_frame_lines*' counts the frames on their own and
+// --toggle-collect='*next_frame_lines*' the frames after PREV.obj. --make-scan writes the
+// 70k-triangle scan of docs/ink.md: tests/data/spot.obj with each triangle split into 4 at its
+// edges' midpoints (shared), then into 3 at its centroid (70,272 triangles, shared vertices, no
+// normals), with a camera block.
 
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -74,16 +85,177 @@ int count_specks(const ImageGray8& lines) {
     return specks;
 }
 
+// The ink stages of one frame on its own and of one frame after another, in functions of their
+// own so that a profiler can count each case apart.
+[[gnu::noinline]] void fresh_frame_lines(const Scene& scene, const TriangleAccel& accel,
+                                         const CameraSpec& camera, int width, int height,
+                                         ink::InkLines& lines) {
+    lines.intersections = {};  // nothing kept from an earlier frame
+    ink::draw_ink_lines(scene, accel, camera, width, height, {}, 1, lines);
+}
+
+[[gnu::noinline]] void next_frame_lines(const Scene& scene, const TriangleAccel& accel,
+                                        const CameraSpec& camera, int width, int height,
+                                        ink::InkLines& lines) {
+    ink::draw_ink_lines(scene, accel, camera, width, height, {}, 1, lines);
+}
+
+std::string ms(double s) { return fmt::format("{:.1f} ms", s * 1e3); }
+
+// --make-scan: a scan-like mesh from spot.obj (see the top of this file), computed in double
+// and written with six decimals.
+void make_scan(const fs::path& out_path) {
+    using P = std::array<double, 3>;
+    std::vector<P> v;
+    std::vector<std::array<std::size_t, 3>> faces;
+    std::ifstream in(TOONRAY_BENCH_DATA_DIR "/spot.obj");
+    for (std::string line; std::getline(in, line);) {
+        if (line.rfind("v ", 0) == 0) {
+            P p{};
+            std::sscanf(line.c_str(), "v %lf %lf %lf", &p[0], &p[1], &p[2]);
+            v.push_back(p);
+        } else if (line.rfind("f ", 0) == 0) {
+            std::array<std::size_t, 3> f{};
+            std::size_t at = 2;
+            for (auto& k : f) {
+                k = std::stoul(line.substr(at)) - 1;
+                at = line.find(' ', at) + 1;
+            }
+            faces.push_back(f);
+        }
+    }
+    if (v.empty() || faces.empty()) throw Error("--make-scan: cannot read spot.obj");
+    std::map<std::pair<std::size_t, std::size_t>, std::size_t> midpoints;
+    auto midpoint = [&](std::size_t a, std::size_t b) {
+        auto [it, inserted] = midpoints.try_emplace({std::min(a, b), std::max(a, b)}, v.size());
+        if (inserted)
+            v.push_back(
+                {(v[a][0] + v[b][0]) / 2, (v[a][1] + v[b][1]) / 2, (v[a][2] + v[b][2]) / 2});
+        return it->second;
+    };
+    std::vector<std::array<std::size_t, 3>> quarters;
+    for (const auto& [a, b, c] : faces) {
+        const std::size_t ab = midpoint(a, b), bc = midpoint(b, c), ca = midpoint(c, a);
+        for (const auto& q : {std::array{a, ab, ca}, std::array{ab, b, bc}, std::array{ca, bc, c},
+                              std::array{ab, bc, ca}})
+            quarters.push_back(q);
+    }
+    auto fixed6 = [](const char* tag, const P& p) {  // as printf's %.6f rounds
+        char buffer[128];
+        std::snprintf(buffer, sizeof buffer, "%s %.6f %.6f %.6f\n", tag, p[0], p[1], p[2]);
+        return std::string(buffer);
+    };
+    std::string text;
+    // The camera: from (3.2, 1.0, 1.4) moved 1.35 times as far from (0, 0.11, 0.19), looking
+    // at it with a 48-degree field of view, y up.
+    const P centre{0.0, 0.11, 0.19}, from{3.2, 1.0, 1.4};
+    P eye{}, dir{}, up{};
+    for (int i = 0; i < 3; ++i) eye[i] = centre[i] + 1.35 * (from[i] - centre[i]);
+    for (int i = 0; i < 3; ++i) dir[i] = centre[i] - eye[i];
+    const double dir_len = std::sqrt(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
+    for (double& d : dir) d /= dir_len;
+    for (int i = 0; i < 3; ++i) up[i] = (i == 1 ? 1.0 : 0.0) - dir[1] * dir[i];
+    const double up_len = std::sqrt(up[0] * up[0] + up[1] * up[1] + up[2] * up[2]);
+    for (double& u : up) u /= up_len;
+    text += "# Camera start\n" + fixed6("v", eye) +
+            fixed6("v", {eye[0] + dir[0] * 2.2, eye[1] + dir[1] * 2.2, eye[2] + dir[2] * 2.2}) +
+            fixed6("vn", up) + "c 1 2 1\n# Camera end\n";
+    text += "# spot, each triangle split in 4 at edge midpoints, then in 3 at its centroid\n";
+    std::string faces_text;
+    for (const auto& [a, b, c] : quarters) {
+        const std::size_t g = v.size();
+        v.push_back({(v[a][0] + v[b][0] + v[c][0]) / 3, (v[a][1] + v[b][1] + v[c][1]) / 3,
+                     (v[a][2] + v[b][2] + v[c][2]) / 3});
+        for (const auto& [x, y] : {std::pair{a, b}, std::pair{b, c}, std::pair{c, a}})
+            faces_text += fmt::format("f {} {} {}\n", x + 3, y + 3, g + 3);  // after the camera's
+    }
+    for (const P& p : v) text += fixed6("v", p);
+    text += faces_text;
+    write_file_atomic(out_path,
+                      std::span(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()));
+}
+
+// Medians of the stage times of repeated draws.
+struct StageTimes {
+    std::vector<double> edges, visibility, chaining, drawing;
+    void add(const ink::InkTimings& t) {
+        edges.push_back(t.edges);
+        visibility.push_back(t.visibility);
+        chaining.push_back(t.chaining);
+        drawing.push_back(t.drawing);
+    }
+    [[nodiscard]] std::string row() const {
+        return fmt::format("{} | {} | {} | {}", ms(median(edges)), ms(median(visibility)),
+                           ms(median(chaining)), ms(median(drawing)));
+    }
+};
+
 struct Options {
     int repeats = 7;
     int width = 1280, height = 720;
     bool quick = false;
+    bool lines_only = false;  ///< the ink stages only, no whole frames
     std::optional<fs::path> out;
     std::optional<fs::path> previous;  ///< a frame drawn before each scene, as in an animation
     std::vector<fs::path> scenes;
 };
 
+// A scene from an OBJ file with its accelerator and the camera a frame of it would have.
+struct BenchScene {
+    Scene scene;
+    TriangleAccel accel;
+    CameraSpec camera;
+};
+
+BenchScene load_bench_scene(const fs::path& path, const FrameOptions& file_options) {
+    BenchScene out;
+    Warnings warnings;
+    load_obj(path, out.scene, warnings);
+    out.accel.build(out.scene.positions, out.scene.tri_positions);
+    out.camera = choose_camera(out.scene, file_options);
+    return out;
+}
+
+// --lines-only: the stages of each scene on its own, and after --previous.
+void run_lines_only(const Options& options) {
+    fmt::print(
+        "| scene | triangles | ink: edges | visibility | chaining | drawing |\n"
+        "|---|---:|---:|---:|---:|---:|\n");
+    FrameOptions file_options;
+    file_options.settings.width = options.width;
+    file_options.settings.height = options.height;
+    BenchScene before;
+    if (options.previous) before = load_bench_scene(*options.previous, file_options);
+    for (const fs::path& path : options.scenes) {
+        const BenchScene loaded = load_bench_scene(path, file_options);
+        const Scene& scene = loaded.scene;
+        const TriangleAccel& accel = loaded.accel;
+        const CameraSpec& camera = loaded.camera;
+        ink::InkLines lines;
+        StageTimes fresh, next;
+        for (int i = 0; i <= options.repeats; ++i) {
+            fresh_frame_lines(scene, accel, camera, options.width, options.height, lines);
+            if (i > 0 || options.repeats == 0) fresh.add(lines.timings);
+        }
+        fmt::print("| {} | {} | {} |\n", path.filename().string(), scene.triangle_count(),
+                   fresh.row());
+        if (!options.previous) continue;
+        for (int i = 0; i <= options.repeats; ++i) {
+            fresh_frame_lines(before.scene, before.accel, before.camera, options.width,
+                              options.height, lines);
+            next_frame_lines(scene, accel, camera, options.width, options.height, lines);
+            if (i > 0 || options.repeats == 0) next.add(lines.timings);
+        }
+        fmt::print("| {} after {} | | {} |\n", path.filename().string(),
+                   options.previous->filename().string(), next.row());
+    }
+}
+
 int run(const Options& options) {
+    if (options.lines_only) {
+        run_lines_only(options);
+        return 0;
+    }
     fmt::print(
         "| scene | triangles | classic frame | robust frame | ink frame | ink frame, 1 sample | "
         "ink 1 sample / classic | ink: edges | visibility | chaining | drawing | specks robust / ink |\n");
@@ -91,15 +263,13 @@ int run(const Options& options) {
     int failures = 0;
     std::vector<std::string> animation_rows;
     for (const fs::path& path : options.scenes) {
-        Scene scene;
-        Warnings warnings;
-        load_obj(path, scene, warnings);
-        TriangleAccel accel;
-        accel.build(scene.positions, scene.tri_positions);
         FrameOptions file_options;
         file_options.settings.width = options.width;
         file_options.settings.height = options.height;
-        const CameraSpec camera = choose_camera(scene, file_options);
+        const BenchScene loaded = load_bench_scene(path, file_options);
+        const Scene& scene = loaded.scene;
+        const TriangleAccel& accel = loaded.accel;
+        const CameraSpec& camera = loaded.camera;
         const int repeats = options.quick ? 1 : options.repeats;
 
         // Whole frames on one thread: trace, shade, lines, compose.
@@ -143,8 +313,7 @@ int run(const Options& options) {
         ink::InkLines lines;
         std::vector<double> edges, visibility, chaining, drawing, total;
         for (int i = 0; i <= repeats; ++i) {
-            lines.intersections = {};  // one frame on its own
-            ink::draw_ink_lines(scene, accel, camera, options.width, options.height, {}, 1, lines);
+            fresh_frame_lines(scene, accel, camera, options.width, options.height, lines);
             if (i == 0 && repeats > 0) continue;
             edges.push_back(lines.timings.edges);
             visibility.push_back(lines.timings.visibility);
@@ -168,7 +337,6 @@ int run(const Options& options) {
         ink::coverage_to_gray(lines.coverage, ink_gray);
         const int ink_specks = count_specks(ink_gray);
         const int robust_specks = count_specks(robust.aovs().edges);
-        auto ms = [](double s) { return fmt::format("{:.1f} ms", s * 1e3); };
         fmt::print("| {} | {} | {} | {} | {} | {} | {:.2f} | {} | {} | {} | {} | {} / {} |\n",
                    path.filename().string(), scene.triangle_count(), ms(classic_s), ms(robust_s),
                    ms(ink_s), ms(ink1_s), ink1_s / classic_s, ms(median(edges)),
@@ -177,12 +345,10 @@ int run(const Options& options) {
         if (options.previous) {
             // As in an animation: the previous frame first, untimed, then this one with what
             // the previous left (the intersection lines of the triangles that did not move).
-            Scene before;
-            Warnings before_warnings;
-            load_obj(*options.previous, before, before_warnings);
-            TriangleAccel before_accel;
-            before_accel.build(before.positions, before.tri_positions);
-            const CameraSpec before_camera = choose_camera(before, file_options);
+            const BenchScene previous = load_bench_scene(*options.previous, file_options);
+            const Scene& before = previous.scene;
+            const TriangleAccel& before_accel = previous.accel;
+            const CameraSpec& before_camera = previous.camera;
             std::vector<double> frame_t, edges_t, visibility_t, chaining_t, drawing_t;
             RenderSettings settings = file_options.settings;
             settings.edges = EdgeMode::Ink;
@@ -197,8 +363,7 @@ int run(const Options& options) {
                 const double frame_s = std::chrono::duration<double>(Clock::now() - start).count();
                 ink::draw_ink_lines(before, before_accel, before_camera, options.width,
                                     options.height, {}, 1, animated);
-                ink::draw_ink_lines(scene, accel, camera, options.width, options.height, {}, 1,
-                                    animated);
+                next_frame_lines(scene, accel, camera, options.width, options.height, animated);
                 if (i == 0 && repeats > 0) continue;
                 frame_t.push_back(frame_s);
                 edges_t.push_back(animated.timings.edges);
@@ -262,7 +427,11 @@ int main(int argc, char** argv) {
                 options.height = std::stoi(v.substr(x + 1));
             } else if (arg == "--out") options.out = value();
             else if (arg == "--quick") options.quick = true;
-            else if (arg == "--previous") options.previous = value();
+            else if (arg == "--lines-only") options.lines_only = true;
+            else if (arg == "--make-scan") {
+                make_scan(value());
+                return 0;
+            } else if (arg == "--previous") options.previous = value();
             else if (!arg.empty() && arg[0] == '-') throw toonray::Error("unknown option " + arg);
             else options.scenes.emplace_back(arg);
         }

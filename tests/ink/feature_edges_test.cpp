@@ -2,7 +2,12 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <cmath>
 #include <map>
+#include <tuple>
 
 #include "ink/ink_scenes.h"
 
@@ -176,6 +181,123 @@ TEST(FeatureEdges, IntersectionLinesBetweenObjectsAndChainableKeys) {
     }
     EXPECT_NEAR(total, 4.0f, 1e-4f);  // the square's perimeter
     for (const auto& [key, n] : uses) EXPECT_EQ(n, 2) << key.a << " " << key.b << " " << key.c;
+}
+
+// Every pair of usable triangles sharing no corner position, tested directly: the intersection
+// lines find_feature_edges must find, as (t, u) with t < u, and their ends.
+std::map<std::pair<std::uint32_t, std::uint32_t>, std::array<Vec3f, 2>> brute_force_crossings(
+    const Scene& s) {
+    const ink::WeldedMesh mesh = ink::weld_vertices(s);
+    auto corners = [&](std::uint32_t t) {
+        const auto& v = s.tri_positions[t];
+        return std::array<Vec3f, 3>{s.positions[v[0]], s.positions[v[1]], s.positions[v[2]]};
+    };
+    auto usable = [&](std::uint32_t t) {
+        const auto p = corners(t);
+        const float len = length(cross(p[1] - p[0], p[2] - p[0]));
+        return len > 0.0f && std::isfinite(len);
+    };
+    std::map<std::pair<std::uint32_t, std::uint32_t>, std::array<Vec3f, 2>> out;
+    const auto n = static_cast<std::uint32_t>(s.triangle_count());
+    for (std::uint32_t t = 0; t < n; ++t) {
+        if (!usable(t)) continue;
+        for (std::uint32_t u = t + 1; u < n; ++u) {
+            if (!usable(u)) continue;
+            bool share = false;
+            for (std::uint32_t a : mesh.tri_vertices[t])
+                for (std::uint32_t b : mesh.tri_vertices[u])
+                    share = share || mesh.vertex_position[a] == mesh.vertex_position[b];
+            ink::TriangleCrossing c;
+            if (!share && ink::intersect_triangles(corners(t), corners(u), c))
+                out[{t, u}] = {c.p[0], c.p[1]};
+        }
+    }
+    return out;
+}
+
+std::map<std::pair<std::uint32_t, std::uint32_t>, std::array<Vec3f, 2>> intersection_lines(
+    const std::vector<FeatureSegment>& segments, bool visible_only = false) {
+    std::map<std::pair<std::uint32_t, std::uint32_t>, std::array<Vec3f, 2>> out;
+    for (const auto& seg : segments)
+        if (seg.type == EdgeType::Intersection && !(visible_only && seg.certainly_hidden))
+            out[{seg.faces[0], seg.faces[1]}] = {seg.p0, seg.p1};
+    return out;
+}
+
+// A scene with crossings of every kind: a dense random soup, closed solids pushed through each
+// other and through the soup (a sphere, boxes with split vertices), a box sharing a corner
+// position with another object, and a degenerate triangle.
+Scene crossing_scene() {
+    Scene s = test_support::random_scene(400, 11);
+    add_sphere(s, Vec3f(0.1f, 0.2f, 0.0f), 0.6f, 12, 24, 1);
+    add_box(s, Vec3f(-0.3f, -0.9f, -0.4f), Vec3f(0.5f, 0.4f, 0.3f), 2);
+    add_box(s, Vec3f(0.5f, 0.4f, 0.3f), Vec3f(1.2f, 1.1f, 0.9f), 3);  // touches box 2 at a corner
+    const std::uint32_t v = test_support::add_vertex(s, Vec3f(0.2f, 0.2f, 0.2f));
+    s.add_triangle({v, v, v}, 0, 4);
+    return s;
+}
+
+TEST(FeatureEdges, IntersectionLinesAreEveryCrossingOfTestingAllPairs) {
+    const Scene s = crossing_scene();
+    const auto expected = brute_force_crossings(s);
+    ASSERT_GT(expected.size(), 100u);
+    ink::FeatureEdgeSettings settings;
+    const Vec3f eye(3, 2, 4);
+    const auto all = intersection_lines(edges_of(s, eye, settings));
+    EXPECT_EQ(all, expected);
+    // Without the lines on faces turned away from the eye on closed solids: the others, all of
+    // them, and the solids' back faces do cross the soup.
+    settings.certainly_hidden = false;
+    const auto segments = edges_of(s, eye, settings);
+    EXPECT_EQ(intersection_lines(segments), intersection_lines(edges_of(s, eye), true));
+    EXPECT_LT(intersection_lines(segments).size() + 20, expected.size());
+}
+
+bool same_segments(const std::vector<FeatureSegment>& a, const std::vector<FeatureSegment>& b) {
+    auto bits = [](const FeatureSegment& s) {
+        return std::make_tuple(std::bit_cast<std::array<std::uint32_t, 3>>(s.p0),
+                               std::bit_cast<std::array<std::uint32_t, 3>>(s.p1), s.key0, s.key1,
+                               s.type, s.faces, s.smooth, s.certainly_hidden);
+    };
+    return std::equal(a.begin(), a.end(), b.begin(), b.end(),
+                      [&](const auto& x, const auto& y) { return bits(x) == bits(y); });
+}
+
+TEST(FeatureEdges, WhatIsKeptFromTheLastFrameGivesTheSegmentsFoundAnew) {
+    Scene s = crossing_scene();
+    const Vec3f eye(3, 2, 4);
+    ink::IntersectionCache cache;
+    const ink::FeatureEdgeSettings settings;
+    auto find = [&](ink::IntersectionCache* with) {
+        const TriangleAccel accel = build_accel(s);
+        return ink::find_feature_edges(s, ink::weld_vertices(s), accel.bvh(), eye, settings, 2,
+                                       with);
+    };
+    auto check_frame = [&] {
+        const auto kept = find(&cache);
+        EXPECT_TRUE(same_segments(kept, find(nullptr)));
+        EXPECT_EQ(intersection_lines(kept), brute_force_crossings(s));
+    };
+    check_frame();
+    // The sphere moves through the soup and the boxes; the rest stays (the mesh edges are
+    // the same, the intersection lines of the sphere are found again).
+    for (std::size_t t = 0; t < s.triangle_count(); ++t)
+        if (s.tri_object[t] == 1)
+            for (std::uint32_t& v : s.tri_positions[t]) {
+                s.positions.push_back(s.positions[v] + Vec3f(0.15f, -0.1f, 0.05f));
+                v = static_cast<std::uint32_t>(s.positions.size() - 1);
+            }
+    check_frame();
+    check_frame();  // nothing moved
+    // A triangle of box 2 collapses to a line: the box is no longer closed, its mesh edges
+    // change (new borders), and so do the certainly hidden lines.
+    const std::size_t box_triangle = static_cast<std::size_t>(
+        std::find(s.tri_object.begin(), s.tri_object.end(), 2u) - s.tri_object.begin());
+    s.tri_positions[box_triangle][2] = s.tri_positions[box_triangle][1];
+    check_frame();
+    // And back.
+    s = crossing_scene();
+    check_frame();
 }
 
 TEST(FeatureEdges, SameForAnyThreadCount) {

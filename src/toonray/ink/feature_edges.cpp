@@ -2,13 +2,17 @@
 
 #include <algorithm>
 #include <bit>
+#include <limits>
 #include <map>
+#include <memory>
 #include <cmath>
 #include <numbers>
 #include <tuple>
 
 #include "toonray/core/portable_math.h"
+#include "toonray/core/simd_sse.h"
 #include "toonray/ink/chunks.h"
+#include "toonray/ink/hash.h"
 
 namespace toonray::ink {
 
@@ -35,10 +39,8 @@ bool position_less(const Vec3f& a, const Vec3f& b) {
 }
 
 // Unit geometric normal (p1 - p0) x (p2 - p0), or zero for a degenerate triangle.
-Vec3f face_normal(const Scene& scene, std::size_t t) {
-    const auto& v = scene.tri_positions[t];
-    const Vec3f n = cross(scene.positions[v[1]] - scene.positions[v[0]],
-                          scene.positions[v[2]] - scene.positions[v[0]]);
+Vec3f face_normal(const std::array<Vec3f, 3>& p) {
+    const Vec3f n = cross(p[1] - p[0], p[2] - p[0]);
     const float len = length(n);
     if (!(len > 0.0f) || !std::isfinite(len)) return Vec3f(0.0f);
     return n / len;
@@ -60,19 +62,34 @@ std::array<Vec3f, 3> corners(const Scene& scene, std::size_t t) {
 
 WeldedMesh weld_vertices(const Scene& scene) {
     const std::size_t n = scene.triangle_count();
-    // Positions with the same bits share a canonical index, the lowest among them.
-    std::vector<std::uint32_t> order(scene.positions.size()), canonical(scene.positions.size());
-    for (std::size_t i = 0; i < order.size(); ++i) order[i] = static_cast<std::uint32_t>(i);
+    // Positions with the same bits share a canonical index, the lowest among them: each
+    // position, in index order, looks its bits up in an open-addressing table (linear probing,
+    // at most half full) and takes the index found there, or enters its own.
+    const std::size_t positions = scene.positions.size();
+    std::vector<std::uint32_t> canonical(positions);
+    using Bits = std::array<std::uint32_t, 3>;
     auto bits = [&](std::uint32_t i) {
         const Vec3f& p = scene.positions[i];
-        return std::tuple(float_bits(p.x), float_bits(p.y), float_bits(p.z));
+        return Bits{float_bits(p.x), float_bits(p.y), float_bits(p.z)};
     };
-    std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
-        return std::tuple_cat(bits(a), std::tuple(a)) < std::tuple_cat(bits(b), std::tuple(b));
-    });
-    for (std::size_t i = 0; i < order.size(); ++i)
-        canonical[order[i]] =
-            i > 0 && bits(order[i]) == bits(order[i - 1]) ? canonical[order[i - 1]] : order[i];
+    std::size_t table_size = 16;
+    while (table_size < 2 * positions) table_size *= 2;
+    const std::size_t mask = table_size - 1;
+    std::vector<std::uint32_t> table(table_size, kNoIndex);
+    for (std::uint32_t i = 0; i < positions; ++i) {
+        const Bits b = bits(i);
+        for (std::size_t slot = hash_words(b[0], b[1], b[2]) & mask;; slot = (slot + 1) & mask) {
+            if (table[slot] == kNoIndex) {
+                table[slot] = i;
+                canonical[i] = i;
+                break;
+            }
+            if (bits(table[slot]) == b) {
+                canonical[i] = table[slot];
+                break;
+            }
+        }
+    }
     // Welded ids in order of first use by the triangles: one per (object, canonical position).
     // Most positions belong to one object; the few shared by several look the rest up.
     WeldedMesh mesh;
@@ -178,84 +195,367 @@ bool intersect_triangles(const std::array<Vec3f, 3>& a, const std::array<Vec3f, 
     return true;
 }
 
+namespace {
+
+// What the intersection search reads per BVH primitive slot, one array per value so that four
+// neighbouring slots are tested at once: the triangle's box (empty, lo = +inf and hi = -inf,
+// when it takes no part, so that it overlaps nothing), its corners' positions (canonical: equal
+// for equal coordinates, across objects) and whether it is stale (all bits set) or not (zero).
+// kLanes more slots pad the end so that loads of four never read past it.
+constexpr std::uint32_t kLanes = 4;
+// Pairs of subtrees of at most this many slots each are tested slot against slot (measured:
+// fewer instructions than 8 or 32 on the scan and the piano).
+constexpr std::uint32_t kSmallSubtree = 16;
+struct Slots {
+    std::unique_ptr<float[]> lo[3], hi[3];
+    std::unique_ptr<std::uint32_t[]> corner[3];
+    std::unique_ptr<std::uint32_t[]> stale;
+
+    explicit Slots(std::size_t count) {  // values left for the caller to write
+        for (int a = 0; a < 3; ++a) {
+            lo[a] = std::make_unique_for_overwrite<float[]>(count);
+            hi[a] = std::make_unique_for_overwrite<float[]>(count);
+            corner[a] = std::make_unique_for_overwrite<std::uint32_t[]>(count);
+        }
+        stale = std::make_unique_for_overwrite<std::uint32_t[]>(count);
+    }
+};
+
+// Bit k is set when slot j + k may cross slot i: their boxes overlap, they share no corner
+// position, and one of them is stale.
+int candidate_mask(const Slots& slots, std::uint32_t i, std::uint32_t j) {
+    __m128 box = _mm_castsi128_ps(_mm_set1_epi32(-1));
+    for (int a = 0; a < 3; ++a)
+        box = _mm_and_ps(
+            box,
+            _mm_and_ps(_mm_cmple_ps(_mm_set1_ps(slots.lo[a][i]), _mm_loadu_ps(&slots.hi[a][j])),
+                       _mm_cmpge_ps(_mm_set1_ps(slots.hi[a][i]), _mm_loadu_ps(&slots.lo[a][j]))));
+    const int overlap = _mm_movemask_ps(box);
+    if (!overlap) return 0;
+    __m128i shared = _mm_setzero_si128();
+    __m128i other[3];
+    for (int c = 0; c < 3; ++c)
+        other[c] = _mm_loadu_si128(reinterpret_cast<const __m128i*>(&slots.corner[c][j]));
+    for (int c = 0; c < 3; ++c) {
+        const __m128i mine = _mm_set1_epi32(static_cast<int>(slots.corner[c][i]));
+        for (const __m128i& o : other) shared = _mm_or_si128(shared, _mm_cmpeq_epi32(mine, o));
+    }
+    const __m128i stale =
+        _mm_or_si128(_mm_set1_epi32(static_cast<int>(slots.stale[i])),
+                     _mm_loadu_si128(reinterpret_cast<const __m128i*>(&slots.stale[j])));
+    return overlap & _mm_movemask_ps(_mm_castsi128_ps(_mm_andnot_si128(shared, stale)));
+}
+
+// Every pair of triangles that take part (`live`) and cross, as intersect_triangles finds them,
+// with (when `stale` is given) at least one stale triangle; in no particular order. Candidate
+// pairs are those whose boxes overlap, from a traversal of the BVH against itself: a pair of
+// nodes is opened only when the boxes of their live triangles overlap, and a node is paired with
+// itself once, so each triangle pair is met once, in the leaf pair that holds it. The node pairs
+// are first expanded breadth-first into enough independent tasks for the threads. Triangles
+// that share a corner position (in any object) touch there and are not tested.
+std::vector<PairCrossing> find_crossings(const Bvh& bvh,
+                                         const std::vector<std::array<Vec3f, 3>>& tri_corners,
+                                         const WeldedMesh& mesh,
+                                         const std::vector<std::uint8_t>& live,
+                                         const std::vector<std::uint8_t>* stale, int threads) {
+    const std::uint32_t prims = static_cast<std::uint32_t>(bvh.prim_indices.size());
+    constexpr float inf = std::numeric_limits<float>::infinity();
+    Slots slots(prims + kLanes);
+    for (std::uint32_t i = 0; i < prims + kLanes; ++i) {
+        const std::uint32_t t = i < prims ? bvh.prim_indices[i] : kNoIndex;
+        if (t == kNoIndex || !live[t]) {
+            for (int a = 0; a < 3; ++a) {
+                slots.lo[a][i] = inf;
+                slots.hi[a][i] = -inf;
+                slots.corner[a][i] = kNoIndex;
+            }
+            slots.stale[i] = 0;
+            continue;
+        }
+        for (int k = 0; k < 3; ++k)
+            slots.corner[k][i] = mesh.vertex_position[mesh.tri_vertices[t][k]];
+        slots.stale[i] = !stale || (*stale)[t] ? kNoIndex : 0;
+        BBox box;
+        for (const Vec3f& p : tri_corners[t]) box.extend(p);
+        for (int a = 0; a < 3; ++a) {
+            slots.lo[a][i] = box.lo[a];
+            slots.hi[a][i] = box.hi[a];
+        }
+    }
+    auto live_slot = [&](std::uint32_t i) { return slots.lo[0][i] != inf; };
+    auto slot_box = [&](std::uint32_t i) {
+        return BBox{Vec3f(slots.lo[0][i], slots.lo[1][i], slots.lo[2][i]),
+                    Vec3f(slots.hi[0][i], slots.hi[1][i], slots.hi[2][i])};
+    };
+    // Per node: the box of its live triangles (empty without), and whether one is stale.
+    // Boxes of live triangles only: nodes of faces turned away from the eye shrink or vanish,
+    // and fewer pairs of nodes overlap.
+    std::vector<BBox> live_box(bvh.nodes.size());
+    std::vector<std::uint8_t> node_stale(bvh.nodes.size(), 0);
+    for (std::size_t i = bvh.nodes.size(); i-- > 0;) {  // children come after parents
+        const BvhNode& node = bvh.nodes[i];
+        if (node.is_leaf()) {
+            for (std::uint32_t k = node.first; k < node.first + node.count; ++k) {
+                if (!live_slot(k)) continue;
+                live_box[i].extend(slot_box(k));
+                node_stale[i] |= slots.stale[k] != 0;
+            }
+            continue;
+        }
+        live_box[i] = live_box[node.first];
+        live_box[i].extend(live_box[node.first + 1]);
+        node_stale[i] = node_stale[node.first] | node_stale[node.first + 1];
+    }
+    // Per node: its slots, when they are a contiguous range (a subtree's leaves follow each
+    // other in the BVHs built here; kNoIndex otherwise). Pairs of small subtrees are tested
+    // slot against slot rather than opened further.
+    std::vector<std::uint32_t> range_first(bvh.nodes.size()), range_count(bvh.nodes.size());
+    for (std::size_t i = bvh.nodes.size(); i-- > 0;) {
+        const BvhNode& node = bvh.nodes[i];
+        if (node.is_leaf()) {
+            range_first[i] = node.first;
+            range_count[i] = node.count;
+            continue;
+        }
+        const std::uint32_t l = node.first, r = node.first + 1;
+        const bool joined = range_count[l] != kNoIndex && range_count[r] != kNoIndex &&
+                            range_first[l] + range_count[l] == range_first[r];
+        range_first[i] = range_first[l];
+        range_count[i] = joined ? range_count[l] + range_count[r] : kNoIndex;
+    }
+    auto overlap = [](const BBox& a, const BBox& b) {
+        return !(a.lo.x > b.hi.x || a.hi.x < b.lo.x || a.lo.y > b.hi.y || a.hi.y < b.lo.y ||
+                 a.lo.z > b.hi.z || a.hi.z < b.lo.z);
+    };
+    // Tests slot i against the slots [j0, j1) that may cross it.
+    auto test_slots = [&](std::uint32_t i, std::uint32_t j0, std::uint32_t j1,
+                          std::vector<PairCrossing>& out) {
+        for (std::uint32_t j = j0; j < j1; j += kLanes) {
+            int mask = candidate_mask(slots, i, j);
+            if (j1 - j < kLanes) mask &= (1 << (j1 - j)) - 1;
+            for (; mask; mask &= mask - 1) {
+                const std::uint32_t k =
+                    j + static_cast<std::uint32_t>(std::countr_zero(static_cast<unsigned>(mask)));
+                std::uint32_t t = bvh.prim_indices[i], u = bvh.prim_indices[k];
+                if (u < t) std::swap(t, u);
+                PairCrossing found{t, u, {}};
+                if (intersect_triangles(tri_corners[t], tri_corners[u], found.crossing))
+                    out.push_back(found);
+            }
+        }
+    };
+    using NodePair = std::pair<std::uint32_t, std::uint32_t>;
+    // Opens one node pair: tests the triangles of two leaves (or of one leaf with itself), or
+    // pushes the child pairs whose boxes may overlap.
+    auto expand = [&](NodePair pair, std::vector<NodePair>& next, std::vector<PairCrossing>& out) {
+        if (!node_stale[pair.first] && !node_stale[pair.second]) return;
+        const BBox& box_a = live_box[pair.first];
+        const BBox& box_b = live_box[pair.second];
+        if (!overlap(box_a, box_b)) return;  // also when either has no live triangle
+        const BvhNode& a = bvh.nodes[pair.first];
+        const BvhNode& b = bvh.nodes[pair.second];
+        const std::uint32_t a0 = range_first[pair.first], an = range_count[pair.first];
+        const std::uint32_t b0 = range_first[pair.second], bn = range_count[pair.second];
+        if (pair.first == pair.second) {
+            if (a.is_leaf() || an <= kSmallSubtree) {
+                for (std::uint32_t i = a0; i + 1 < a0 + an; ++i)
+                    if (live_slot(i)) test_slots(i, i + 1, a0 + an, out);
+            } else {
+                next.push_back({a.first, a.first});
+                next.push_back({a.first + 1, a.first + 1});
+                next.push_back({a.first, a.first + 1});
+            }
+            return;
+        }
+        if ((a.is_leaf() && b.is_leaf()) || (an <= kSmallSubtree && bn <= kSmallSubtree)) {
+            for (std::uint32_t i = a0; i < a0 + an; ++i)
+                if (live_slot(i) && overlap(slot_box(i), box_b)) test_slots(i, b0, b0 + bn, out);
+            return;
+        }
+        // Open the inner node with the larger box (or the only inner one).
+        auto extent = [](const BBox& box) {
+            const Vec3f d = box.hi - box.lo;
+            return d.x + d.y + d.z;
+        };
+        if (b.is_leaf() || (!a.is_leaf() && extent(box_a) >= extent(box_b))) {
+            next.push_back({a.first, pair.second});
+            next.push_back({a.first + 1, pair.second});
+        } else {
+            next.push_back({pair.first, b.first});
+            next.push_back({pair.first, b.first + 1});
+        }
+    };
+    std::vector<PairCrossing> found;
+    std::vector<NodePair> tasks{{0u, 0u}}, next;
+    const std::size_t wanted_tasks = 256;
+    while (!tasks.empty() && tasks.size() < wanted_tasks) {
+        next.clear();
+        for (const NodePair& pair : tasks) expand(pair, next, found);
+        tasks.swap(next);
+    }
+    auto deeper =
+        gather_chunks<PairCrossing>(static_cast<int>(tasks.size()), 4, threads,
+                                    [&](int i0, int i1, std::vector<PairCrossing>& out) {
+                                        std::vector<NodePair> stack;
+                                        for (int i = i0; i < i1; ++i) {
+                                            stack.assign(1, tasks[static_cast<std::size_t>(i)]);
+                                            while (!stack.empty()) {
+                                                const NodePair pair = stack.back();
+                                                stack.pop_back();
+                                                expand(pair, stack, out);
+                                            }
+                                        }
+                                    });
+    found.insert(found.end(), deeper.begin(), deeper.end());
+    return found;
+}
+
+}  // namespace
+
+namespace {
+
+// A side of a usable triangle: from welded vertex lo to hi (lo < hi).
+struct Side {
+    std::uint32_t lo, hi, tri;
+    bool forward;  // lo -> hi in the triangle's winding
+};
+
+}  // namespace
+
+struct MeshTopology {
+    // What it was made from.
+    std::vector<std::array<std::uint32_t, 3>> tri_vertices;
+    std::vector<std::uint32_t> tri_object;
+    std::vector<std::uint8_t> usable;
+    std::size_t objects = 0;
+    /// Every side of a usable triangle, in order of (lo, hi, triangle, corner), so that the
+    /// sides of one edge are adjacent: edge e is sides [edge_first[e], edge_first[e + 1]).
+    std::unique_ptr<Side[]> sides;  // every one written: not cleared first
+    std::vector<std::uint32_t> edge_first;
+    /// Per object: not closed, for an edge without exactly two sides in opposite directions,
+    /// or a triangle that is not usable or has two corners welded together.
+    std::vector<std::uint8_t> open;
+
+    MeshTopology(const Scene& scene, const WeldedMesh& mesh, std::span<const std::uint8_t> usable_,
+                 std::size_t objects_)
+        : tri_vertices(mesh.tri_vertices),
+          tri_object(scene.tri_object.begin(), scene.tri_object.begin() + scene.triangle_count()),
+          usable(usable_.begin(), usable_.end()),
+          objects(objects_),
+          open(objects_, 0) {
+        const std::size_t n = usable.size(), vertices = mesh.vertex_count();
+        // A counting sort by lo over the triangles in order puts each vertex's sides in
+        // (triangle, corner) order; a stable sort by hi within each vertex then gives the
+        // whole order.
+        std::vector<std::uint32_t> offsets(vertices + 1, 0);
+        for (std::size_t t = 0; t < n; ++t) {
+            const auto& w = tri_vertices[t];
+            if (!usable[t] || w[0] == w[1] || w[1] == w[2] || w[2] == w[0]) open[tri_object[t]] = 1;
+            if (!usable[t]) continue;
+            for (int k = 0; k < 3; ++k)
+                if (w[k] != w[(k + 1) % 3]) ++offsets[std::min(w[k], w[(k + 1) % 3]) + 1];
+        }
+        for (std::size_t v = 0; v < vertices; ++v) offsets[v + 1] += offsets[v];
+        const std::size_t side_count = offsets[vertices];
+        sides = std::make_unique_for_overwrite<Side[]>(side_count);
+        {
+            std::vector<std::uint32_t> fill(offsets.begin(), offsets.end() - 1);
+            for (std::size_t t = 0; t < n; ++t) {
+                if (!usable[t]) continue;
+                const auto& w = tri_vertices[t];
+                for (int k = 0; k < 3; ++k) {
+                    const std::uint32_t u = w[k], v = w[(k + 1) % 3];
+                    if (u == v) continue;
+                    const std::uint32_t lo = std::min(u, v);
+                    sides[fill[lo]++] = {lo, std::max(u, v), static_cast<std::uint32_t>(t), u < v};
+                }
+            }
+        }
+        edge_first.reserve(side_count / 2 + 1);
+        for (std::size_t v = 0; v < vertices; ++v) {
+            Side* const first = sides.get() + offsets[v];
+            Side* const last = sides.get() + offsets[v + 1];
+            // By insertion, as a vertex has few sides (but not at the centre of a large fan).
+            if (last - first > 32) {
+                std::stable_sort(first, last,
+                                 [](const Side& a, const Side& b) { return a.hi < b.hi; });
+            } else {
+                for (Side* i = first + 1; i < last; ++i) {
+                    const Side side = *i;
+                    Side* j = i;
+                    for (; j > first && (j - 1)->hi > side.hi; --j) *j = *(j - 1);
+                    *j = side;
+                }
+            }
+            for (const Side* i = first; i < last;) {
+                const Side* j = i + 1;
+                while (j < last && j->hi == i->hi) ++j;
+                edge_first.push_back(static_cast<std::uint32_t>(i - sides.get()));
+                if (j - i != 2 || i[0].forward == i[1].forward) open[tri_object[i->tri]] = 1;
+                i = j;
+            }
+        }
+        edge_first.push_back(static_cast<std::uint32_t>(side_count));
+    }
+
+    [[nodiscard]] bool same(const Scene& scene, const WeldedMesh& mesh,
+                            std::span<const std::uint8_t> usable_, std::size_t objects_) const {
+        return objects_ == objects && usable_.size() == usable.size() &&
+               std::equal(usable.begin(), usable.end(), usable_.begin()) &&
+               mesh.tri_vertices == tri_vertices &&
+               std::equal(tri_object.begin(), tri_object.end(), scene.tri_object.begin());
+    }
+};
+
 std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedMesh& mesh,
                                                const Bvh& bvh, const Vec3f& eye,
                                                const FeatureEdgeSettings& settings, int threads,
                                                IntersectionCache* cache) {
     const std::size_t n = scene.triangle_count();
-    std::vector<Vec3f> normal(n);
-    for (std::size_t t = 0; t < n; ++t) normal[t] = face_normal(scene, t);
-    auto usable = [&](std::size_t t) { return normal[t] != Vec3f(0.0f); };
     std::vector<FeatureSegment> segments;
-
-    // Mesh edges: every triangle side as (lower welded id, higher, triangle, forward), sorted so
-    // that the sides of one edge are adjacent.
-    struct Side {
-        std::uint32_t lo, hi, tri;
-        bool forward;  // lo -> hi in the triangle's winding
-        int corner;    // the corner the side starts from in the winding
-    };
-    // The sides are gathered vertex by vertex from the triangles around each welded vertex:
-    // at vertex lo, the sides from lo to a higher id, sorted by (hi, triangle). That is the
-    // order of a sort of all sides by (lo, hi, triangle), without sorting them all.
-    std::vector<Side> sides;
-    sides.reserve(n * 3);
-    for (std::uint32_t lo = 0; lo < mesh.vertex_count(); ++lo) {
-        const std::size_t first = sides.size();
-        for (std::uint32_t r = mesh.ring_offsets[lo]; r < mesh.ring_offsets[lo + 1]; ++r) {
-            const std::uint32_t t = mesh.ring_triangles[r];
-            if (!usable(t)) continue;
-            const auto& w = mesh.tri_vertices[t];
-            for (int k = 0; k < 3; ++k) {
-                const std::uint32_t u = w[k], v = w[(k + 1) % 3];
-                if (u == v || std::min(u, v) != lo) continue;
-                sides.push_back({lo, std::max(u, v), t, u < v, k});
-            }
-        }
-        std::sort(sides.begin() + static_cast<std::ptrdiff_t>(first), sides.end(),
-                  [](const Side& a, const Side& b) {
-                      return std::tie(a.hi, a.tri, a.corner) < std::tie(b.hi, b.tri, b.corner);
-                  });
-    }
-    const float cos_crease =
-        portable::cos(settings.crease_angle * std::numbers::pi_v<float> / 180.0f);
-    // Shading is smooth across a side shared by two triangles when both have a normal at every
-    // corner and the same normals at the side's two ends.
-    auto corner_normal = [&](std::uint32_t t, std::uint32_t welded) {
-        for (int k = 0; k < 3; ++k)
-            if (mesh.tri_vertices[t][k] == welded) return scene.normals[scene.tri_normals[t][k]];
-        return Vec3f(0.0f);
-    };
-    auto smooth_across = [&](const Side& s0, const Side& s1) {
-        if (!has_corner_normals(scene, s0.tri) || !has_corner_normals(scene, s1.tri)) return false;
-        return corner_normal(s0.tri, s0.lo) == corner_normal(s1.tri, s1.lo) &&
-               corner_normal(s0.tri, s0.hi) == corner_normal(s1.tri, s1.hi);
-    };
+    std::size_t objects = scene.objects.size();
+    for (std::size_t t = 0; t < n; ++t)
+        objects = std::max<std::size_t>(objects, scene.tri_object[t] + std::size_t{1});
     // Objects whose lines on faces turned away from the eye are certainly hidden: closed
     // (every edge has two faces, wound in opposite directions along it), with a non-zero
     // volume, and not around the eye. A line of sight from such a line into the eye starts
     // inside the solid, so it must leave it through the surface on the way.
-    std::size_t objects = scene.objects.size();
-    for (std::size_t t = 0; t < n; ++t)
-        objects = std::max<std::size_t>(objects, scene.tri_object[t] + std::size_t{1});
     std::vector<std::uint8_t> closed(objects, 1);
     std::vector<double> volume(objects, 0.0);
     std::vector<BBox> object_box(objects);
+
+    // Per triangle, in one pass: its corners (kept by the cache for the next frame), unit
+    // normal (zero when degenerate: the triangle is not usable), whether it has a normal at
+    // every corner, and its object's box and volume.
+    std::vector<std::array<Vec3f, 3>> tri_corners;
+    std::vector<Vec3f> normal;
+    std::vector<std::uint8_t> corner_normals, usable_triangle;
+    tri_corners.reserve(n);
+    normal.reserve(n);
+    corner_normals.reserve(n);
+    usable_triangle.reserve(n);
     for (std::size_t t = 0; t < n; ++t) {
+        const auto& p = tri_corners.emplace_back(corners(scene, t));
+        usable_triangle.push_back(normal.emplace_back(face_normal(p)) != Vec3f(0.0f));
+        corner_normals.push_back(has_corner_normals(scene, t));
         const std::uint32_t o = scene.tri_object[t];
-        const auto& w = mesh.tri_vertices[t];
-        if (!usable(t) || w[0] == w[1] || w[1] == w[2] || w[2] == w[0]) closed[o] = 0;
-        const auto p = corners(scene, t);
         for (const Vec3f& q : p) object_box[o].extend(q);
         volume[o] += static_cast<double>(dot(p[0], cross(p[1], p[2])));
     }
-    for (std::size_t i = 0; i < sides.size();) {
-        std::size_t j = i + 1;
-        while (j < sides.size() && sides[j].lo == sides[i].lo && sides[j].hi == sides[i].hi) ++j;
-        const std::uint32_t o = scene.tri_object[sides[i].tri];
-        if (j - i != 2 || sides[i].forward == sides[i + 1].forward) closed[o] = 0;
-        i = j;
-    }
+    auto usable = [&](std::size_t t) { return usable_triangle[t] != 0; };
+
+    // The mesh edges, as the last frame's when the triangles' welded corners, objects and
+    // usability did not change.
+    std::shared_ptr<const MeshTopology> kept = cache ? cache->topology : nullptr;
+    if (!kept || !kept->same(scene, mesh, usable_triangle, objects))
+        kept = std::make_shared<const MeshTopology>(scene, mesh, usable_triangle, objects);
+    if (cache) cache->topology = kept;
+    const MeshTopology& topology = *kept;
+    const Side* const sides = topology.sides.get();
+    const std::vector<std::uint32_t>& edge_first = topology.edge_first;
+    for (std::size_t o = 0; o < objects; ++o) closed[o] = !topology.open[o];
+    const std::size_t edge_count = edge_first.size() - 1;
+
     auto eye_outside = [&](const BBox& b) {
         return eye.x < b.lo.x || eye.y < b.lo.y || eye.z < b.lo.z || eye.x > b.hi.x ||
                eye.y > b.hi.y || eye.z > b.hi.z;
@@ -270,61 +570,83 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
     std::vector<std::uint8_t> turned_away(n, 0);
     for (std::size_t t = 0; t < n; ++t) {
         const int out = outward[scene.tri_object[t]];
-        const float facing = dot(normal[t], eye - scene.positions[scene.tri_positions[t][0]]);
+        const float facing = dot(normal[t], eye - tri_corners[t][0]);
         turned_away[t] = out != 0 && usable(t) && (out > 0 ? facing < 0 : facing > 0);
     }
 
-    for (std::size_t i = 0; i < sides.size();) {
-        std::size_t j = i + 1;
-        while (j < sides.size() && sides[j].lo == sides[i].lo && sides[j].hi == sides[i].hi) ++j;
+    const float cos_crease =
+        portable::cos(settings.crease_angle * std::numbers::pi_v<float> / 180.0f);
+    // Shading is smooth across a side shared by two triangles when both have a normal at every
+    // corner and the same normals at the side's two ends.
+    auto corner_normal = [&](std::uint32_t t, std::uint32_t welded) {
+        for (int k = 0; k < 3; ++k)
+            if (mesh.tri_vertices[t][k] == welded) return scene.normals[scene.tri_normals[t][k]];
+        return Vec3f(0.0f);
+    };
+    auto smooth_across = [&](const Side& s0, const Side& s1) {
+        if (!corner_normals[s0.tri] || !corner_normals[s1.tri]) return false;
+        return corner_normal(s0.tri, s0.lo) == corner_normal(s1.tri, s1.lo) &&
+               corner_normal(s0.tri, s0.hi) == corner_normal(s1.tri, s1.hi);
+    };
+    // One segment per edge that is a line: each is classified first, and made only if drawn.
+    for (std::size_t e = 0; e < edge_count; ++e) {
+        const std::uint32_t i = edge_first[e], j = edge_first[e + 1];
         const Side& s0 = sides[i];
-        FeatureSegment seg;
-        seg.p0 = scene.positions[mesh.vertex_position[s0.lo]];
-        seg.p1 = scene.positions[mesh.vertex_position[s0.hi]];
-        seg.key0 = {s0.lo, kNoIndex, kNoIndex};
-        seg.key1 = {s0.hi, kNoIndex, kNoIndex};
-        seg.faces = {s0.tri, j - i > 1 ? sides[i + 1].tri : kNoIndex};
-        bool emit = false;
+        const Vec3f p0 = scene.positions[mesh.vertex_position[s0.lo]];
+        EdgeType type = EdgeType::Border;
+        bool certainly_hidden = false;
         if (j - i != 2) {
-            seg.type = EdgeType::Border;
-            emit = settings.borders;
+            if (!settings.borders) continue;
         } else {
             const Side& s1 = sides[i + 1];
             const Vec3f n0 = normal[s0.tri];
             // Consistently wound neighbours run the shared side in opposite directions.
             const Vec3f n1 = s0.forward != s1.forward ? normal[s1.tri] : -normal[s1.tri];
-            const bool front0 = dot(n0, eye - seg.p0) > 0, front1 = dot(n1, eye - seg.p0) > 0;
-            const bool smooth = settings.smooth_contours && smooth_across(s0, s1);
+            const float d0 = dot(n0, eye - p0), d1 = dot(n1, eye - p0);
+            const bool front0 = d0 > 0, front1 = d1 > 0;
+            if (settings.silhouettes && front0 != front1 &&
+                !(settings.smooth_contours && smooth_across(s0, s1)))
+                type = EdgeType::Silhouette;
+            else if (settings.creases && dot(n0, n1) < cos_crease) type = EdgeType::Crease;
+            else if (settings.materials && scene.tri_material[s0.tri] != scene.tri_material[s1.tri])
+                type = EdgeType::Material;
+            else continue;
             const int out = outward[scene.tri_object[s0.tri]];
-            seg.certainly_hidden = out != 0 && front0 == (out < 0) && front1 == (out < 0) &&
-                                   dot(n0, eye - seg.p0) != 0 && dot(n1, eye - seg.p0) != 0;
-            if (settings.silhouettes && front0 != front1 && !smooth) {
-                seg.type = EdgeType::Silhouette;
-                emit = true;
-            } else if (settings.creases && dot(n0, n1) < cos_crease) {
-                seg.type = EdgeType::Crease;
-                emit = true;
-            } else if (settings.materials &&
-                       scene.tri_material[s0.tri] != scene.tri_material[s1.tri]) {
-                seg.type = EdgeType::Material;
-                emit = true;
-            }
+            certainly_hidden =
+                out != 0 && front0 == (out < 0) && front1 == (out < 0) && d0 != 0 && d1 != 0;
+            if (certainly_hidden && !settings.certainly_hidden) continue;
         }
-        if (emit && (settings.certainly_hidden || !seg.certainly_hidden)) segments.push_back(seg);
-        i = j;
+        FeatureSegment& seg = segments.emplace_back();
+        seg.p0 = p0;
+        seg.p1 = scene.positions[mesh.vertex_position[s0.hi]];
+        seg.key0 = {s0.lo, kNoIndex, kNoIndex};
+        seg.key1 = {s0.hi, kNoIndex, kNoIndex};
+        seg.faces = {s0.tri, j - i > 1 ? sides[i + 1].tri : kNoIndex};
+        seg.type = type;
+        seg.certainly_hidden = certainly_hidden;
     }
 
     // Smooth contours: where n . (p - eye), interpolated linearly from the corners, is zero.
     if (settings.silhouettes && settings.smooth_contours) {
+        // g at a corner depends on its position and normal only, which most triangles around
+        // a vertex share: kept per position for the last normal it was computed with.
+        std::vector<std::uint32_t> g_normal(scene.positions.size(), kNoIndex);
+        std::vector<float> g_value(scene.positions.size());
         for (std::size_t t = 0; t < n; ++t) {
-            if (!usable(t) || !has_corner_normals(scene, t)) continue;
-            const auto p = corners(scene, t);
+            if (!usable(t) || !corner_normals[t]) continue;
+            const auto& p = tri_corners[t];
             float g[3];
             for (int k = 0; k < 3; ++k) {
-                // Unit normals: the zero's position depends on their lengths.
-                const Vec3f nk = scene.normals[scene.tri_normals[t][k]];
-                const float len = length(nk);
-                g[k] = dot(nk, p[k] - eye) / (len > 0.0f ? len : 1.0f);
+                const std::uint32_t position = scene.tri_positions[t][k],
+                                    normal_index = scene.tri_normals[t][k];
+                if (g_normal[position] != normal_index) {
+                    // Unit normals: the zero's position depends on their lengths.
+                    const Vec3f nk = scene.normals[normal_index];
+                    const float len = length(nk);
+                    g_value[position] = dot(nk, p[k] - eye) / (len > 0.0f ? len : 1.0f);
+                    g_normal[position] = normal_index;
+                }
+                g[k] = g_value[position];
             }
             FeatureSegment seg;
             seg.type = EdgeType::Silhouette;
@@ -350,28 +672,6 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
 
     // Intersection lines: each triangle against the triangles whose boxes overlap its own.
     if (settings.intersections && !bvh.nodes.empty()) {
-        // Boxes and corner positions (canonical: equal for equal coordinates, across objects)
-        // in the BVH's primitive order, so that a leaf's triangles are read together.
-        const std::size_t prims = bvh.prim_indices.size();
-        std::vector<BBox> boxes(prims);
-        std::vector<std::array<std::uint32_t, 3>> tri_position(prims);
-        for (std::size_t i = 0; i < prims; ++i) {
-            const std::uint32_t t = bvh.prim_indices[i];
-            for (const Vec3f& p : corners(scene, t)) boxes[i].extend(p);
-            for (int k = 0; k < 3; ++k)
-                tri_position[i][k] = mesh.vertex_position[mesh.tri_vertices[t][k]];
-        }
-        auto overlap = [](const BBox& a, const BBox& b) {
-            return !(a.lo.x > b.hi.x || a.hi.x < b.lo.x || a.lo.y > b.hi.y || a.hi.y < b.lo.y ||
-                     a.lo.z > b.hi.z || a.hi.z < b.lo.z);
-        };
-        // Pairs of triangles with overlapping boxes, by traversing the BVH against itself:
-        // a pair of nodes is opened only when their boxes overlap, and a node is paired with
-        // itself once, so each triangle pair is met once, in the leaf pair that holds it.
-        // The node pairs are first expanded breadth-first into enough independent tasks for
-        // the threads; the segments are sorted by triangle pair at the end.
-        // Without hidden lines, triangles turned away from the eye on closed solids take no
-        // part, and neither do nodes holding only such triangles.
         // Triangles that take part: usable ones, and without hidden lines only those not turned
         // away from the eye on a closed solid.
         std::vector<std::uint8_t> live_triangle(n);
@@ -389,118 +689,20 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
             stale.assign(n, 1);
             if (same_count)
                 for (std::size_t t = 0; t < n; ++t) {
-                    const auto now = corners(scene, t);
+                    const auto& now = tri_corners[t];
                     stale[t] = !cache->tested[t] ||
                                !std::equal(now.begin(), now.end(), cache->corners[t].begin(), same);
                 }
         }
-        std::vector<std::uint8_t> live(prims);
-        for (std::size_t i = 0; i < prims; ++i) live[i] = live_triangle[bvh.prim_indices[i]];
-        // Per node: whether it holds a live triangle, and (with a cache) a stale one.
-        std::vector<std::uint8_t> node_live(bvh.nodes.size(), 0), node_stale(bvh.nodes.size(), 0);
-        auto mark = [&](auto&& self, std::uint32_t i) -> void {
-            const BvhNode& node = bvh.nodes[i];
-            if (node.is_leaf()) {
-                for (std::uint32_t k = node.first; k < node.first + node.count; ++k) {
-                    node_live[i] |= live[k];
-                    node_stale[i] |= !cache || stale[bvh.prim_indices[k]];
-                }
-                return;
-            }
-            self(self, node.first);
-            self(self, node.first + 1);
-            node_live[i] = node_live[node.first] | node_live[node.first + 1];
-            node_stale[i] = node_stale[node.first] | node_stale[node.first + 1];
-        };
-        mark(mark, 0);
-        // Tests the triangles in primitive slots i and j.
-        auto test_pair = [&](std::uint32_t i, std::uint32_t j, std::vector<PairCrossing>& out) {
-            if (!live[i] || !live[j] || !overlap(boxes[i], boxes[j])) return;
-            std::uint32_t t = bvh.prim_indices[i], u = bvh.prim_indices[j];
-            if (cache && !stale[t] && !stale[u]) return;  // the cache has it
-            // Triangles sharing a corner position (in any object) touch there: no line.
-            const auto& pa = tri_position[i];
-            const auto& pb = tri_position[j];
-            for (std::uint32_t a_corner : pa)
-                if (a_corner == pb[0] || a_corner == pb[1] || a_corner == pb[2]) return;
-            if (u < t) std::swap(t, u);
-            PairCrossing found{t, u, {}};
-            if (intersect_triangles(corners(scene, t), corners(scene, u), found.crossing))
-                out.push_back(found);
-        };
-        using NodePair = std::pair<std::uint32_t, std::uint32_t>;
-        // Opens one node pair: tests the triangles of two leaves (or of one leaf with itself),
-        // or pushes the child pairs whose boxes may overlap.
-        auto expand = [&](NodePair pair, std::vector<NodePair>& next,
-                          std::vector<PairCrossing>& out) {
-            if (!node_live[pair.first] || !node_live[pair.second]) return;
-            if (!node_stale[pair.first] && !node_stale[pair.second]) return;
-            const BvhNode& a = bvh.nodes[pair.first];
-            const BvhNode& b = bvh.nodes[pair.second];
-            if (pair.first == pair.second) {
-                if (a.is_leaf()) {
-                    for (std::uint32_t i = a.first; i < a.first + a.count; ++i)
-                        for (std::uint32_t j = i + 1; j < a.first + a.count; ++j)
-                            test_pair(i, j, out);
-                } else {
-                    next.push_back({a.first, a.first});
-                    next.push_back({a.first + 1, a.first + 1});
-                    next.push_back({a.first, a.first + 1});
-                }
-                return;
-            }
-            if (!overlap(a.bounds, b.bounds)) return;
-            if (a.is_leaf() && b.is_leaf()) {
-                for (std::uint32_t i = a.first; i < a.first + a.count; ++i)
-                    for (std::uint32_t j = b.first; j < b.first + b.count; ++j)
-                        test_pair(i, j, out);
-                return;
-            }
-            // Open the inner node with the larger box (or the only inner one).
-            auto extent = [](const BBox& box) {
-                const Vec3f d = box.hi - box.lo;
-                return d.x + d.y + d.z;
-            };
-            if (b.is_leaf() || (!a.is_leaf() && extent(a.bounds) >= extent(b.bounds))) {
-                next.push_back({a.first, pair.second});
-                next.push_back({a.first + 1, pair.second});
-            } else {
-                next.push_back({pair.first, b.first});
-                next.push_back({pair.first, b.first + 1});
-            }
-        };
-        std::vector<PairCrossing> found;
-        std::vector<NodePair> tasks{{0u, 0u}}, next;
-        const std::size_t wanted_tasks = 256;
-        while (!tasks.empty() && tasks.size() < wanted_tasks) {
-            next.clear();
-            for (const NodePair& pair : tasks) expand(pair, next, found);
-            tasks.swap(next);
-        }
-        auto deeper = gather_chunks<PairCrossing>(
-            static_cast<int>(tasks.size()), 4, threads,
-            [&](int i0, int i1, std::vector<PairCrossing>& out) {
-                std::vector<NodePair> stack, pushed;
-                for (int i = i0; i < i1; ++i) {
-                    stack.assign(1, tasks[static_cast<std::size_t>(i)]);
-                    while (!stack.empty()) {
-                        const NodePair pair = stack.back();
-                        stack.pop_back();
-                        pushed.clear();
-                        expand(pair, pushed, out);
-                        stack.insert(stack.end(), pushed.begin(), pushed.end());
-                    }
-                }
-            });
-        found.insert(found.end(), deeper.begin(), deeper.end());
+        std::vector<PairCrossing> found = find_crossings(bvh, tri_corners, mesh, live_triangle,
+                                                         cache ? &stale : nullptr, threads);
         if (cache) {
             // The cache's crossings of triangles that are not stale and take part now; then
             // the cache is this frame's.
             for (const PairCrossing& c : cache->crossings)
                 if (!stale[c.t] && !stale[c.u] && live_triangle[c.t] && live_triangle[c.u])
                     found.push_back(c);
-            cache->corners.resize(n);
-            for (std::size_t t = 0; t < n; ++t) cache->corners[t] = corners(scene, t);
+            cache->corners.swap(tri_corners);  // not read below
             cache->tested = live_triangle;
         }
         // In the order of the triangle pairs, whatever the tree.

@@ -4,6 +4,7 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "toonray/accel/bvh.h"
@@ -106,6 +107,9 @@ struct PairCrossing {
 /// depends only on their corners, so a pair of triangles that both took part in the last frame
 /// and did not move (corners equal bit for bit) gives the same crossing; only pairs with another
 /// triangle are tested again. Between two frames of the piano most triangles do not move.
+/// The mesh edges of a welded mesh: which triangles' sides make each edge (feature_edges.cpp).
+struct MeshTopology;
+
 struct IntersectionCache {
     std::vector<std::array<Vec3f, 3>> corners;  ///< each triangle's corners in the last frame
     /// Per triangle: it took part in the last frame (without hidden lines, triangles turned
@@ -113,6 +117,9 @@ struct IntersectionCache {
     /// `crossings`.
     std::vector<std::uint8_t> tested;
     std::vector<PairCrossing> crossings;  ///< of those pairs, by (t, u)
+    /// The last frame's mesh edges, the same while the welded triangles, their objects and
+    /// which of them are usable (not degenerate) stay the same.
+    std::shared_ptr<const MeshTopology> topology;
 };
 
 /// All feature segments of the scene seen from `eye`, in a fixed order (mesh edges by welded

@@ -6,6 +6,7 @@
 #include <tuple>
 
 #include "toonray/core/portable_math.h"
+#include "toonray/ink/hash.h"
 
 namespace toonray::ink {
 
@@ -51,13 +52,61 @@ struct Link {
     Vec3f w0, w1;  // the ends in the world
 };
 
-// Which points Douglas-Peucker keeps.
-std::vector<bool> simplified(std::span<const Point2> points, float tolerance) {
-    if (points.size() <= 2 || !(tolerance > 0.0f)) return std::vector<bool>(points.size(), true);
-    std::vector<bool> keep(points.size(), false);
+// Which points Douglas-Peucker keeps, into `keep` (resized to the points).
+void simplified(std::span<const Point2> points, float tolerance, std::vector<bool>& keep) {
+    if (points.size() <= 2 || !(tolerance > 0.0f)) {
+        keep.assign(points.size(), true);
+        return;
+    }
+    keep.assign(points.size(), false);
     keep.front() = keep.back() = true;
     douglas_peucker(points, 0, points.size() - 1, tolerance, keep);
-    return keep;
+}
+
+// The link ends grouped by endpoint key: end 2 l + side of link l (side 0: key0, 1: key1) is in
+// group end_group[2 l + side] (kNoIndex without a key), and a group lists its ends in order of
+// (link, side), as a sort of all ends by (key, link, side) would.
+struct EndGroups {
+    std::vector<std::uint32_t> end_group, offsets, ends;
+
+    [[nodiscard]] std::span<const std::uint32_t> group(std::uint32_t g) const {
+        return {ends.data() + offsets[g], ends.data() + offsets[g + 1]};
+    }
+};
+
+EndGroups group_ends(const std::vector<Link>& links) {
+    EndGroups out;
+    const std::size_t count = links.size() * 2;
+    out.end_group.assign(count, kNoIndex);
+    // Keys to group numbers in an open-addressing table (linear probing, at most half full).
+    std::size_t table_size = 16;
+    while (table_size < 2 * count) table_size *= 2;
+    std::vector<std::uint32_t> table(table_size, kNoIndex);
+    std::vector<EndpointKey> keys;
+    std::vector<std::uint32_t> sizes;
+    for (std::size_t e = 0; e < count; ++e) {
+        const Link& link = links[e / 2];
+        const EndpointKey& key = e % 2 ? link.key1 : link.key0;
+        if (!has_key(key)) continue;
+        std::size_t slot = hash_words(key.a, key.b, key.c) & (table_size - 1);
+        while (table[slot] != kNoIndex && keys[table[slot]] != key)
+            slot = (slot + 1) & (table_size - 1);
+        if (table[slot] == kNoIndex) {
+            table[slot] = static_cast<std::uint32_t>(keys.size());
+            keys.push_back(key);
+            sizes.push_back(0);
+        }
+        out.end_group[e] = table[slot];
+        ++sizes[table[slot]];
+    }
+    out.offsets.assign(keys.size() + 1, 0);
+    for (std::size_t g = 0; g < keys.size(); ++g) out.offsets[g + 1] = out.offsets[g] + sizes[g];
+    out.ends.resize(out.offsets.back());
+    std::vector<std::uint32_t> fill(out.offsets.begin(), out.offsets.end() - 1);
+    for (std::size_t e = 0; e < count; ++e)
+        if (out.end_group[e] != kNoIndex)
+            out.ends[fill[out.end_group[e]]++] = static_cast<std::uint32_t>(e);
+    return out;
 }
 
 }  // namespace
@@ -69,7 +118,8 @@ float polyline_length(std::span<const Point2> points) {
 }
 
 std::vector<Point2> simplify_polyline(std::span<const Point2> points, float tolerance) {
-    const std::vector<bool> keep = simplified(points, tolerance);
+    std::vector<bool> keep;
+    simplified(points, tolerance, keep);
     std::vector<Point2> out;
     for (std::size_t i = 0; i < points.size(); ++i)
         if (keep[i]) out.push_back(points[i]);
@@ -81,10 +131,12 @@ std::vector<Stroke> chain_pieces(std::span<const EdgePiece> pieces, const ChainS
     // 1. Per segment: absorb sub-pixel pieces into their neighbours, then merge runs of one
     //    visibility into links.
     std::vector<Link> links;
+    links.reserve(pieces.size());
+    std::vector<char> visible;
     for (std::size_t i = 0; i < pieces.size();) {
         std::size_t j = i + 1;
         while (j < pieces.size() && pieces[j].segment == pieces[i].segment) ++j;
-        std::vector<bool> visible;
+        visible.clear();
         for (std::size_t k = i; k < j; ++k) visible.push_back(pieces[k].visible());
         const std::size_t n = j - i;
         if (n > 1)
@@ -96,7 +148,8 @@ std::vector<Stroke> chain_pieces(std::span<const EdgePiece> pieces, const ChainS
                 // Only when cut from both sides, and contiguous with them (not cut by clipping).
                 const bool contiguous = (k == 0 || pieces[i + k - 1].t1 == p.t0) &&
                                         (k + 1 == n || pieces[i + k + 1].t0 == p.t1);
-                if (before == after && before != visible[k] && contiguous) visible[k] = before;
+                if (before == after && before != static_cast<bool>(visible[k]) && contiguous)
+                    visible[k] = before;
             }
         for (std::size_t k = 0; k < n; ++k) {
             const EdgePiece& p = pieces[i + k];
@@ -111,100 +164,92 @@ std::vector<Stroke> chain_pieces(std::span<const EdgePiece> pieces, const ChainS
             const std::uint16_t style = p.segment < segment_styles.size()
                                             ? segment_styles[p.segment][visible[k] ? 0 : 1]
                                             : 0;
-            links.push_back({p.type, visible[k], p.s0, p.s1, p.key0, p.key1, style, p.p0, p.p1});
+            links.push_back(
+                {p.type, visible[k] != 0, p.s0, p.s1, p.key0, p.key1, style, p.p0, p.p1});
         }
         i = j;
     }
 
     // 2. Link ends by key.
-    struct End {
-        EndpointKey key;
-        std::uint32_t link;
-        std::uint8_t side;  // 0: s0/key0, 1: s1/key1
-    };
-    std::vector<End> ends;
-    for (std::size_t l = 0; l < links.size(); ++l) {
-        if (has_key(links[l].key0))
-            ends.push_back({links[l].key0, static_cast<std::uint32_t>(l), 0});
-        if (has_key(links[l].key1))
-            ends.push_back({links[l].key1, static_cast<std::uint32_t>(l), 1});
-    }
-    std::sort(ends.begin(), ends.end(), [](const End& a, const End& b) {
-        return std::tie(a.key, a.link, a.side) < std::tie(b.key, b.link, b.side);
-    });
-    auto ends_at = [&](const EndpointKey& key) {
-        auto lo = std::lower_bound(ends.begin(), ends.end(), key,
-                                   [](const End& e, const EndpointKey& k) { return e.key < k; });
-        auto hi = std::upper_bound(ends.begin(), ends.end(), key,
-                                   [](const EndpointKey& k, const End& e) { return k < e.key; });
-        return std::span<const End>(&*lo, static_cast<std::size_t>(hi - lo));
-    };
+    const EndGroups groups = group_ends(links);
     const float cos_max_turn =
         portable::cos(settings.max_turn * std::numbers::pi_v<float> / 180.0f);
 
-    std::vector<bool> used(links.size(), false);
+    std::vector<char> used(links.size(), 0);
     std::vector<Stroke> strokes;
+    // Buffers for one stroke at a time.
+    std::vector<Point2> forward, backward, points, spaced;
+    std::vector<Vec3f> forward_world, backward_world, world;
+    std::vector<std::size_t> spaced_at;
+    std::vector<bool> keep;
     for (std::size_t start = 0; start < links.size(); ++start) {
         if (used[start]) continue;
         used[start] = true;
         const Link& first = links[start];
         // Points from the start's s0 through its s1, grown at the back; then the front.
-        std::vector<Point2> forward{first.s0, first.s1}, backward;
-        std::vector<Vec3f> forward_world{first.w0, first.w1}, backward_world;
+        forward.assign({first.s0, first.s1});
+        forward_world.assign({first.w0, first.w1});
+        backward.clear();
+        backward_world.clear();
         bool closed = false;
         for (int direction = 0; direction < 2 && !closed; ++direction) {
             std::vector<Point2>& pts = direction == 0 ? forward : backward;
-            std::vector<Vec3f>& world = direction == 0 ? forward_world : backward_world;
+            std::vector<Vec3f>& wpts = direction == 0 ? forward_world : backward_world;
             EndpointKey key = direction == 0 ? first.key1 : first.key0;
+            std::uint32_t group = groups.end_group[2 * start + (direction == 0 ? 1 : 0)];
             Point2 tip = direction == 0 ? first.s1 : first.s0;
             Point2 previous = direction == 0 ? first.s0 : first.s1;
-            while (has_key(key)) {
+            while (group != kNoIndex) {
                 // Unused matching links at this key; a link touching it with both ends counts once.
-                const End* best = nullptr;
+                std::uint32_t best = kNoIndex;
                 int candidates = 0;
                 float best_cos = -2.0f;
                 const float hx = tip.x - previous.x, hy = tip.y - previous.y;
                 const float hlen = portable::hypot(hx, hy);
                 std::uint32_t last_link = kNoIndex;
-                for (const End& e : ends_at(key)) {
-                    const Link& l = links[e.link];
-                    if (used[e.link] || l.type != first.type || l.visible != first.visible ||
-                        l.style != first.style || e.link == last_link)
+                for (const std::uint32_t e : groups.group(group)) {
+                    const std::uint32_t link = e / 2;
+                    const Link& l = links[link];
+                    if (used[link] || l.type != first.type || l.visible != first.visible ||
+                        l.style != first.style || link == last_link)
                         continue;
-                    last_link = e.link;
+                    last_link = link;
                     ++candidates;
-                    const Point2 next = e.side == 0 ? l.s1 : l.s0;
+                    const Point2 next = e % 2 == 0 ? l.s1 : l.s0;
                     const float nx = next.x - tip.x, ny = next.y - tip.y;
                     const float nlen = portable::hypot(nx, ny);
                     const float c =
                         hlen > 0 && nlen > 0 ? (hx * nx + hy * ny) / (hlen * nlen) : 1.0f;
                     if (c > best_cos) {
                         best_cos = c;
-                        best = &e;
+                        best = e;
                     }
                 }
                 if (candidates == 0 && direction == 0 && key == first.key0) closed = true;
-                if (!best || (candidates > 1 && best_cos < cos_max_turn)) break;
-                used[best->link] = true;
-                const Link& l = links[best->link];
+                if (best == kNoIndex || (candidates > 1 && best_cos < cos_max_turn)) break;
+                const std::uint32_t link = best / 2;
+                const bool at_start = best % 2 == 0;  // entered at s0: continue from s1
+                used[link] = true;
+                const Link& l = links[link];
                 previous = tip;
-                tip = best->side == 0 ? l.s1 : l.s0;
-                key = best->side == 0 ? l.key1 : l.key0;
+                tip = at_start ? l.s1 : l.s0;
+                key = at_start ? l.key1 : l.key0;
+                group = groups.end_group[2 * link + (at_start ? 1 : 0)];
                 pts.push_back(tip);
-                world.push_back(best->side == 0 ? l.w1 : l.w0);
+                wpts.push_back(at_start ? l.w1 : l.w0);
             }
         }
-        std::vector<Point2> points(backward.rbegin(), backward.rend());
+        points.assign(backward.rbegin(), backward.rend());
         points.insert(points.end(), forward.begin(), forward.end());
-        std::vector<Vec3f> world(backward_world.rbegin(), backward_world.rend());
+        world.assign(backward_world.rbegin(), backward_world.rend());
         world.insert(world.end(), forward_world.begin(), forward_world.end());
         if (closed) {
             points.back() = points.front();
             world.back() = world.front();
         }
         // Thin out points closer than min_spacing, keeping both ends.
-        std::vector<std::size_t> spaced_at{0};
-        std::vector<Point2> spaced{points.front()};
+        spaced_at.assign(1, 0);
+        spaced.assign(1, points.front());
         for (std::size_t i = 1; i + 1 < points.size(); ++i)
             if (distance(points[i], spaced.back()) >= settings.min_spacing) {
                 spaced.push_back(points[i]);
@@ -217,7 +262,10 @@ std::vector<Stroke> chain_pieces(std::span<const EdgePiece> pieces, const ChainS
         stroke.visible = first.visible;
         stroke.style = first.style;
         stroke.closed = closed;
-        const std::vector<bool> keep = simplified(spaced, settings.simplify);
+        simplified(spaced, settings.simplify, keep);
+        const auto kept = static_cast<std::size_t>(std::count(keep.begin(), keep.end(), true));
+        stroke.points.reserve(kept);
+        if (settings.eye) stroke.depth.reserve(kept);
         for (std::size_t i = 0; i < spaced.size(); ++i) {
             if (!keep[i]) continue;
             stroke.points.push_back(spaced[i]);
