@@ -158,9 +158,9 @@ std::uint64_t bucket_buffer_bytes(const RenderSettings& settings) {
     const std::uint64_t tile_rays = TriangleAccel::kTileSize * TriangleAccel::kTileSize;
     std::uint64_t bytes = tile_rays * ray + 2 * TriangleAccel::kTileSize * sizeof(int);
     // The first samples, with their colours as bytes and keys, the differences to their
-    // neighbours, and a row of no differences.
+    // neighbours, whether lines hide them, and a row of no differences.
     bytes = add_saturated(
-        bytes, mul_saturated(traced, surface + sizeof(Rgb8) + sizeof(std::uint32_t) + 2));
+        bytes, mul_saturated(traced, surface + sizeof(Rgb8) + sizeof(std::uint32_t) + 3));
     bytes = add_saturated(bytes, side(w, halo + 1));
     // Every other sample of every decided pixel, with its slot and flag.
     bytes = add_saturated(

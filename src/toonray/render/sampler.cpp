@@ -79,7 +79,7 @@ std::uint64_t SurfaceSamples::bytes() const {
 std::uint64_t BucketSampler::bytes() const {
     return first_.bytes() + rest_.bytes() + refine_.capacity() + first_bytes_.capacity() +
            key_.capacity() * sizeof(std::uint32_t) + differs_right_.capacity() +
-           differs_below_.capacity() + no_differences_.capacity() +
+           differs_below_.capacity() + no_differences_.capacity() + hidden_.capacity() +
            (refined_pixels_.capacity() + refined_slot_.capacity()) * sizeof(std::uint32_t) +
            (dirs_.capacity() + rest_dirs_.capacity()) * sizeof(Vec3f) +
            hits_.capacity() * sizeof(Hit) + hit_found_size_ +
@@ -179,6 +179,12 @@ void neighbours_differ(const std::uint8_t* __restrict right, std::uint8_t left_o
     for (int x = 1; x < n; ++x) out[x] = right[x] | right[x - 1] | below[x] | above[x];
 }
 
+// pair[x] = 0 where pixel x or its partner x + offset is hidden, for x in [0, n).
+void clear_hidden_pairs(const std::uint8_t* __restrict hidden, int offset, int n,
+                        std::uint8_t* __restrict pair) {
+    for (int x = 0; x < n; ++x) pair[x] = pair[x] & ((hidden[x] | hidden[x + offset]) ^ 1);
+}
+
 // Pixels the lines hide take no more samples.
 void keep_visible(const std::uint8_t* __restrict hidden, int n, std::uint8_t* __restrict refine) {
     for (int x = 0; x < n; ++x) refine[x] = refine[x] & (hidden[x] ^ 1);
@@ -186,7 +192,8 @@ void keep_visible(const std::uint8_t* __restrict hidden, int n, std::uint8_t* __
 
 }  // namespace
 
-void BucketSampler::mark_differences(const RefineRule& rule) {
+void BucketSampler::mark_differences(const RefineRule& rule, const std::uint8_t* hidden,
+                                     int width) {
     // Each pair of 4-neighbours of the traced pixels once: with the pixel to the right, and
     // with the one below. Pixels at the traced rectangle's edge have no pair beyond it.
     const int tw = traced_.width(), th = traced_.height();
@@ -207,6 +214,21 @@ void BucketSampler::mark_differences(const RefineRule& rule) {
         for (int x = 0; x < tw; ++x)
             below[x] |= surfaces_differ(first_, row + x, row + x + tw, rule);
     }
+    if (!hidden) return;
+    // A pixel that lines hide completely is not compared with its neighbours: lines are
+    // centred on the edges they draw and hide a pixel only within half a pixel of their
+    // centreline, so the edge between it and a visible neighbour lies under the line, beyond
+    // that neighbour's own samples (at most 0.36 pixel from its centre).
+    hidden_.resize(n);
+    for (int y = 0; y < th; ++y)
+        std::memcpy(hidden_.data() + static_cast<std::size_t>(y) * tw,
+                    hidden + static_cast<std::size_t>(traced_.y0 + y) * width + traced_.x0, tw);
+    for (int y = 0; y < th; ++y) {
+        const std::size_t row = static_cast<std::size_t>(y) * tw;
+        clear_hidden_pairs(hidden_.data() + row, 1, tw - 1, differs_right_.data() + row);
+        if (y + 1 < th)
+            clear_hidden_pairs(hidden_.data() + row, tw, tw, differs_below_.data() + row);
+    }
 }
 
 void BucketSampler::decide(const SamplerFrame& frame) {
@@ -214,7 +236,7 @@ void BucketSampler::decide(const SamplerFrame& frame) {
     const bool all = !frame.adaptive && sub_ > 1;
     refine_.assign(static_cast<std::size_t>(dw) * dh, all ? 1 : 0);
     if (all || sub_ == 1) return;
-    mark_differences(frame.rule);
+    mark_differences(frame.rule, frame.hidden, frame.width);
     // A pixel takes all its samples when it differs from a neighbour (which the precondition
     // on `decided` puts inside `traced` whenever it is inside the image), row by row.
     const int tw = traced_.width();

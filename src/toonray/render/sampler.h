@@ -125,7 +125,7 @@ private:
     void trace_first(const SamplerFrame& frame);
     void decide(const SamplerFrame& frame);
     void trace_refined(const SamplerFrame& frame);
-    void mark_differences(const RefineRule& rule);
+    void mark_differences(const RefineRule& rule, const std::uint8_t* hidden, int width);
     [[nodiscard]] bool depth_step(const SamplerFrame& frame, int x, int y) const;
 
     const SamplerFrame* frame_ = nullptr;
@@ -140,6 +140,7 @@ private:
     /// Per pixel of traced_: whether it differs from the pixel to its right, and below.
     std::vector<std::uint8_t> differs_right_, differs_below_;
     std::vector<std::uint8_t> no_differences_;  ///< zeros: the row above the image
+    std::vector<std::uint8_t> hidden_;          ///< per pixel of traced_: SamplerFrame::hidden
     /// Refined pixels (indices into decided_) and their other sub * sub - 1 samples, pixel by
     /// pixel, each pixel's in row order without the first.
     std::vector<std::uint32_t> refined_pixels_;
