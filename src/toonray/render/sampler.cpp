@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
-#include <limits>
 
 #include "toonray/render/classic.h"
 #include "toonray/render/shade_samples.h"
@@ -12,7 +11,6 @@
 namespace toonray {
 namespace {
 
-constexpr float kInf = std::numeric_limits<float>::infinity();
 constexpr int kTile = TriangleAccel::kTileSize;
 // Refined samples are traced as a grid this many rays wide, so that each 4 x 2 packet of
 // intersect_tile holds 8 consecutive samples of the list (neighbouring pixels' samples).
@@ -144,9 +142,10 @@ namespace {
 // their ids or normals differ. Whether they hit at all is in their colour keys.
 inline bool surfaces_differ(const SurfaceSamples& s, std::size_t a, std::size_t b,
                             const RefineRule& rule) {
-    return (s.found[a] & s.found[b]) &
-           ((s.object[a] != s.object[b]) | (s.material[a] != s.material[b]) |
-            (dot(s.normal[a], s.normal[b]) < rule.cos_normal));
+    // Bitwise on 0/1 integers rather than && and ||: no branches in the caller's row loops.
+    const int ids = int{s.object[a] != s.object[b]} | int{s.material[a] != s.material[b]};
+    const int normals = int{dot(s.normal[a], s.normal[b]) < rule.cos_normal};
+    return (s.found[a] & s.found[b] & (ids | normals)) != 0;
 }
 
 }  // namespace
