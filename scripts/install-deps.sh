@@ -42,6 +42,8 @@ test_packages=(
 # Cross building for 64-bit ARM: the libraries toonray and its unit tests link, for arm64.
 aarch64_packages=(
   g++-aarch64-linux-gnu qemu-user
+  # SIMDe: the SSE intrinsics on ARM (core/simd_sse.h); headers only, for any architecture
+  libsimde-dev
   libfmt-dev:arm64 libtbb-dev:arm64 libdeflate-dev:arm64 libpng-dev:arm64
   libfluidsynth-dev:arm64 libgtest-dev:arm64 libgmock-dev:arm64
   libtinyobjloader-dev:arm64  # the OBJ loader tests compare with it
