@@ -18,22 +18,70 @@ namespace fs = std::filesystem;
 
 namespace {
 
-Scene parse(std::string_view text, Warnings* warnings_out = nullptr,
-            const fs::path& path = "test.obj") {
+// Bit for bit: -0 and 0 differ.
+template <typename T>
+bool same_bits(const std::vector<T>& a, const std::vector<T>& b) {
+    return a.size() == b.size() &&
+           (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
+}
+
+bool same_scene(const Scene& a, const Scene& b) {
+    std::vector<std::string> names_a = a.objects, names_b = b.objects;
+    for (const Material& m : a.materials) names_a.push_back(m.name + "/" + m.map_kd);
+    for (const Material& m : b.materials) names_b.push_back(m.name + "/" + m.map_kd);
+    const bool same_camera =
+        a.camera.has_value() == b.camera.has_value() &&
+        (!a.camera || std::memcmp(&*a.camera, &*b.camera, sizeof(CameraSpec)) == 0);
+    return same_bits(a.positions, b.positions) && same_bits(a.normals, b.normals) &&
+           same_bits(a.texcoords, b.texcoords) && same_bits(a.tri_positions, b.tri_positions) &&
+           same_bits(a.tri_normals, b.tri_normals) && same_bits(a.tri_texcoords, b.tri_texcoords) &&
+           same_bits(a.tri_material, b.tri_material) && same_bits(a.tri_object, b.tri_object) &&
+           same_bits(a.polylines, b.polylines) && same_bits(a.polyline_points, b.polyline_points) &&
+           names_a == names_b && same_camera;
+}
+
+// What parse_obj makes of a text: the scene and its warnings, or the error.
+struct Parsed {
     Scene scene;
     Warnings warnings;
-    parse_obj(text, path, scene, warnings);
-    if (warnings_out) *warnings_out = warnings;
-    return scene;
+    std::string error;
+};
+
+Parsed parse_text(std::string_view text, const fs::path& path) {
+    Parsed out;
+    try {
+        parse_obj(text, path, out.scene, out.warnings);
+    } catch (const Error& e) {
+        out.error = e.what();
+    }
+    return out;
+}
+
+// Every text is read twice: as it is, where a short text is left to the general path, and
+// followed by a padding comment, which puts all of it in the fast path's padded zone
+// (obj_fast_path.h). Both must read it the same. An empty line comes first: a last line
+// continued with `\` is then joined with nothing, as at the end of the text.
+Parsed parse_both_ways(std::string_view text, const fs::path& path) {
+    Parsed plain = parse_text(text, path);
+    const Parsed padded =
+        parse_text(std::string(text) + "\n\n#" + std::string(80, ' ') + "\n", path);
+    EXPECT_EQ(plain.error, padded.error) << text;
+    EXPECT_EQ(plain.warnings, padded.warnings) << text;
+    EXPECT_TRUE(same_scene(plain.scene, padded.scene)) << text;
+    return plain;
+}
+
+Scene parse(std::string_view text, Warnings* warnings_out = nullptr,
+            const fs::path& path = "test.obj") {
+    Parsed parsed = parse_both_ways(text, path);
+    if (!parsed.error.empty()) throw Error(parsed.error);
+    if (warnings_out) *warnings_out = parsed.warnings;
+    return std::move(parsed.scene);
 }
 
 std::string error_of(std::string_view text, const fs::path& path = "test.obj") {
-    try {
-        parse(text, nullptr, path);
-    } catch (const Error& e) {
-        return e.what();
-    }
-    return "(no error)";
+    const Parsed parsed = parse_both_ways(text, path);
+    return parsed.error.empty() ? "(no error)" : parsed.error;
 }
 
 fs::path temp_dir(const std::string& name) {

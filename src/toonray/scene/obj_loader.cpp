@@ -1,12 +1,15 @@
 #include "toonray/scene/obj_loader.h"
 
 #include <algorithm>
+#include <bit>
 #include <charconv>
 #include <cstring>
 #include <fmt/format.h>
+#include <span>
 #include <string>
 #include <unordered_map>
 
+#include "toonray/core/simd_sse.h"
 #include "toonray/io/file.h"
 #include "toonray/scene/mtl_loader.h"
 #include "toonray/scene/obj_fast_path.h"
@@ -27,43 +30,60 @@ std::uint32_t intern(std::unordered_map<std::string, std::uint32_t>& ids,
     return it->second;
 }
 
-// Counts the statements that add vertices and faces (a cheap pass over line starts) and
-// reserves for them: growing the arrays by doubling costs more than the count. Faces are
-// counted as one triangle each, the common case; polygons simply grow the arrays.
-// The counts come from the file, so they are held to the limits first: a file of 700 million
-// "f" lines must fail at the limit's line with its message, not in a 30 GB reservation.
-void reserve_for(std::string_view text, Scene& scene, const Limits& limits) {
-    std::size_t v = 0, vn = 0, vt = 0, f = 0;
-    const char* p = text.data();
-    const char* end = p + text.size();
-    while (p < end) {
-        if (end - p >= 2) {
-            if (p[0] == 'v') {
-                if (p[1] == ' ' || p[1] == '\t') ++v;
-                else if (p[1] == 'n') ++vn;
-                else if (p[1] == 't') ++vt;
-            } else if (p[0] == 'f' && (p[1] == ' ' || p[1] == '\t')) {
-                ++f;
-            }
-        }
-        const void* nl = std::memchr(p, '\n', static_cast<std::size_t>(end - p));
-        if (!nl) break;
-        p = static_cast<const char*>(nl) + 1;
+// The lines of the text, counted 16 bytes at a time, and whether it holds a NUL byte
+// (refuse_binary), found in the same pass.
+struct TextCounts {
+    std::uint64_t lines = 1;
+    bool nul = false;
+};
+
+TextCounts count_lines(std::string_view text) {
+    TextCounts counts;
+    const char* s = text.data();
+    const std::size_t size = text.size();
+    const __m128i newline = _mm_set1_epi8('\n'), zero = _mm_setzero_si128();
+    __m128i nul = zero;
+    std::size_t i = 0;
+    for (; i + 16 <= size; i += 16) {
+        const __m128i chars = _mm_loadu_si128(reinterpret_cast<const __m128i*>(s + i));
+        nul = _mm_or_si128(nul, _mm_cmpeq_epi8(chars, zero));
+        counts.lines += static_cast<unsigned>(std::popcount(
+            static_cast<unsigned>(_mm_movemask_epi8(_mm_cmpeq_epi8(chars, newline)))));
     }
-    const std::uint64_t max_vertices = std::min(limits.max_vertices, kMaxIndexable);
-    v = std::min<std::uint64_t>(v, max_vertices);
-    vn = std::min<std::uint64_t>(vn, max_vertices);
-    vt = std::min<std::uint64_t>(vt, max_vertices);
-    f = std::min<std::uint64_t>(f, std::min(limits.max_triangles, kMaxIndexable));
-    if (scene_bytes(v + vn + vt, f) > limits.max_memory) return;  // the parse stops at the limit
+    counts.nul = _mm_movemask_epi8(nul) != 0;
+    for (; i < size; ++i) {
+        counts.lines += s[i] == '\n';
+        counts.nul = counts.nul || s[i] == '\0';
+    }
+    return counts;
+}
+
+// Reserves for as many vertices of each kind and triangles as the text has lines: growing the
+// arrays by doubling costs more than that count, and counting each kind of statement costs
+// more than reserving too much. What is reserved and not used is never touched, so it costs
+// address space only. A polygon's extra triangles simply grow the arrays. The count comes
+// from the file, so it is held to the limits first: a file of 700 million "f" lines must fail
+// at the limit's line with its message, not in a 30 GB reservation.
+void reserve_for(std::uint64_t lines, Scene& scene, const Limits& limits) {
+    const std::uint64_t v = std::min({lines, limits.max_vertices, kMaxIndexable});
+    const std::uint64_t f = std::min({lines, limits.max_triangles, kMaxIndexable});
+    if (scene_bytes(3 * v, f) > limits.max_memory) return;  // the parse stops at the limit
     scene.positions.reserve(v);
-    scene.normals.reserve(vn);
-    scene.texcoords.reserve(vt);
+    scene.normals.reserve(v);
+    scene.texcoords.reserve(v);
     scene.tri_positions.reserve(f);
     scene.tri_normals.reserve(f);
     scene.tri_texcoords.reserve(f);
     scene.tri_material.reserve(f);
     scene.tri_object.reserve(f);
+}
+
+/// A face's triangles, a fan from its first corner.
+void append_fan(Scene& scene, const Corner* c, std::size_t count, std::uint32_t material,
+                std::uint32_t object) {
+    for (std::size_t i = 1; i + 1 < count; ++i)
+        scene.add_triangle({c[0].v, c[i].v, c[i + 1].v}, material, object,
+                           {c[0].n, c[i].n, c[i + 1].n}, {c[0].t, c[i].t, c[i + 1].t});
 }
 
 /// The corners of an 'f' statement in any form, with a precise message for each malformed
@@ -247,13 +267,12 @@ void parse_obj(std::string_view text, const std::filesystem::path& path, Scene& 
                Warnings& warnings, const ObjOptions& options) {
     scene.clear();
     const std::string file = path.string();
-    refuse_binary(text, file, "an OBJ");
+    const TextCounts counts = count_lines(text);
+    if (counts.nul) refuse_binary(text, file, "an OBJ");
     const Limits& lim = options.limits;
     LineReader reader(text, file, lim.max_line_bytes);
-    std::string_view line;
-    std::size_t line_number = 0;
     WarningSink warn(warnings, file);
-    reserve_for(text, scene, options.limits);
+    reserve_for(counts.lines, scene, options.limits);
 
     std::unordered_map<std::string, std::uint32_t> object_ids{{"(default)", 0}};
     std::unordered_map<std::string, std::uint32_t> warned_materials, warned_statements;
@@ -299,9 +318,9 @@ void parse_obj(std::string_view text, const std::filesystem::path& path, Scene& 
         return i != kNoIndex && i < flags.size() && flags[i] != 0;
     };
     // False when the face must be dropped; clears non-finite normals and texture coordinates.
-    auto usable_face = [&](std::size_t line) {
+    auto usable_face = [&](std::size_t line, std::span<Corner> face) {
         bool normals_ok = true, texcoords_ok = true;
-        for (const Corner& c : corners) {
+        for (const Corner& c : face) {
             if (flagged(nonfinite_position, c.v)) {
                 warn.add(located(file, line,
                                  "face uses a vertex with a non-finite coordinate; dropped"));
@@ -310,7 +329,7 @@ void parse_obj(std::string_view text, const std::filesystem::path& path, Scene& 
             normals_ok = normals_ok && !flagged(nonfinite_normal, c.n);
             texcoords_ok = texcoords_ok && !flagged(nonfinite_texcoord, c.t);
         }
-        for (Corner& c : corners) {
+        for (Corner& c : face) {
             if (!normals_ok) c.n = kNoIndex;
             if (!texcoords_ok) c.t = kNoIndex;
         }
@@ -348,7 +367,7 @@ void parse_obj(std::string_view text, const std::filesystem::path& path, Scene& 
     };
 
     // What both paths do before adding an element (so a limit names the line that exceeds it),
-    // and the face's triangles from `corners`.
+    // and a face's triangles.
     auto adding_position = [&](const LineParser& parse) {
         check_count(parse, scene.positions.size() + 1, max_vertices, "vertices ('v')",
                     Limit::Vertices);
@@ -364,67 +383,53 @@ void parse_obj(std::string_view text, const std::filesystem::path& path, Scene& 
                     Limit::Vertices);
         grew(parse);
     };
-    auto add_face = [&](const LineParser& parse, std::size_t line) {
-        if (nonfinite_count != 0 && !usable_face(line)) [[unlikely]]
+    auto add_face = [&](const LineParser& parse, std::size_t line, std::span<Corner> face) {
+        if (nonfinite_count != 0 && !usable_face(line, face)) [[unlikely]]
             return;
-        if (scene.triangle_count() + (corners.size() - 2) > max_triangles)
+        if (scene.triangle_count() + (face.size() - 2) > max_triangles)
             parse.fail_limit(Limit::Triangles,
                              fmt::format("more than {} triangles (the limit)", max_triangles));
         grew(parse);
-        for (std::size_t i = 1; i + 1 < corners.size(); ++i) {
-            const Corner& a = corners[0];
-            const Corner& b = corners[i];
-            const Corner& c = corners[i + 1];
-            scene.add_triangle({a.v, b.v, c.v}, material, object, {a.n, b.n, c.n}, {a.t, b.t, c.t});
-        }
+        append_fan(scene, face.data(), face.size(), material, object);
     };
 
-    for (;;) {
-        // The common statements in their plain form, straight from the text (obj_fast_path.h).
-        // A line longer than the limit goes the general way, which reports it.
-        const char* begin = reader.cursor();
-        const char* end = reader.end();
-        if (end - begin >= 2 && (begin[0] == 'v' || begin[0] == 'f')) {
-            auto within_limit = [&](const char* next) {
-                return next && static_cast<std::uint64_t>(next - begin) <= reader.max_line();
-            };
-            float f[3];
-            const char* next;
-            if (begin[0] == 'f') {
-                if (is_blank(begin[1]) &&
-                    within_limit(next = read_face_line(begin + 1, end, scene, corners))) {
-                    const std::size_t n = reader.consumed_line(next);
-                    add_face(LineParser(file, n), n);
-                    continue;
-                }
-            } else if (is_blank(begin[1])) {
-                if (within_limit(next = read_numbers_line(begin + 1, end, f, 3))) {
-                    adding_position(LineParser(file, reader.consumed_line(next)));
-                    scene.positions.push_back({f[0], f[1], f[2]});
-                    keep_flags(nonfinite_position, scene.positions.size());
-                    continue;
-                }
-            } else if (begin[1] == 'n' && end - begin >= 3 && is_blank(begin[2])) {
-                if (within_limit(next = read_numbers_line(begin + 2, end, f, 3))) {
-                    adding_normal(LineParser(file, reader.consumed_line(next)));
-                    scene.normals.push_back({f[0], f[1], f[2]});
-                    keep_flags(nonfinite_normal, scene.normals.size());
-                    continue;
-                }
-            } else if (begin[1] == 't' && end - begin >= 3 && is_blank(begin[2])) {
-                if (within_limit(next = read_numbers_line(begin + 2, end, f, 2))) {
-                    adding_texcoord(LineParser(file, reader.consumed_line(next)));
-                    scene.texcoords.push_back({f[0], f[1]});
-                    keep_flags(nonfinite_texcoord, scene.texcoords.size());
-                    continue;
-                }
-            }
+    // The fast path skips those checks while `headroom` lasts: how many vertices or triangles
+    // can be added before a count could pass its limit or the memory estimate is due. Each
+    // element takes it down by what it adds; at 0 (and always once a non-finite value was
+    // read, whose flags must be kept) an element takes the checked way, which does exactly
+    // what the general path does.
+    std::uint64_t headroom = 0;
+    auto refresh_headroom = [&] {
+        headroom =
+            nonfinite_count != 0
+                ? 0
+                : std::min({max_vertices - scene.positions.size(),
+                            max_vertices - scene.normals.size(),
+                            max_vertices - scene.texcoords.size(),
+                            max_triangles - scene.triangle_count(),
+                            memory.until_due(scene.positions.size() + scene.normals.size() +
+                                             scene.texcoords.size() + scene.triangle_count() +
+                                             scene.objects.size())});
+    };
+    // A plain v, vn or vt line read by the fast path.
+    auto add_vertex = [&]<typename T>(std::vector<T>& values, const T& value,
+                                      std::vector<std::uint8_t>& flags, std::size_t line,
+                                      const auto& adding) {
+        if (headroom != 0) [[likely]] {
+            --headroom;
+            values.push_back(value);
+            return;
         }
+        adding(LineParser(file, line));
+        values.push_back(value);
+        keep_flags(flags, values.size());
+        refresh_headroom();
+    };
 
-        // Everything else: the general path.
-        if (!reader.next(line, line_number)) break;
+    // Any statement in any form, with its precise messages.
+    auto read_statement = [&](std::string_view line, std::size_t line_number) {
         Tokens t(line);
-        if (t.at_end()) continue;
+        if (t.at_end()) return;
         std::string_view kw = t.next();
         LineParser parse(file, line_number);
 
@@ -440,7 +445,7 @@ void parse_obj(std::string_view text, const std::filesystem::path& path, Scene& 
             if (read_face_corners(parse, t, scene, corners, [&](std::string message) {
                     warn.add(located(file, line_number, message));
                 }))
-                add_face(parse, line_number);
+                add_face(parse, line_number, corners);
         } else if (kw == "vn") {
             adding_normal(parse);
             bool finite = true;
@@ -500,7 +505,7 @@ void parse_obj(std::string_view text, const std::filesystem::path& path, Scene& 
             object = name.empty() ? 0 : intern(object_ids, scene.objects, name);
             grew(parse);
         } else if (kw == "mtllib") {
-            if (!options.load_materials) continue;
+            if (!options.load_materials) return;
             for (const std::string& name : library_names(t.rest())) {
                 std::filesystem::path library = (path.parent_path() / name).lexically_normal();
                 // Each library once: "mtllib a.mtl a.mtl ..." must not read a.mtl again and again.
@@ -518,6 +523,73 @@ void parse_obj(std::string_view text, const std::filesystem::path& path, Scene& 
                    warned_statements.emplace(std::string(kw), 0).second) {
             warn.add(located(file, line_number, fmt::format("unknown statement '{}' ignored", kw)));
         }
+    };
+
+    // The common statements in their plain form, straight from the padded zone of the text
+    // (obj_fast_path.h); lines past it and any other form go the general way. A line longer
+    // than the limit also goes the general way, which reports it.
+    const char* const padded_end = padded_zone_end(text);
+    Corner face[kMaxFastCorners];
+    refresh_headroom();
+    std::string_view line;
+    std::size_t line_number = 0;
+    for (;;) {
+        const char* begin = reader.cursor();
+        if (begin < padded_end) {
+            auto within_limit = [&](const char* next) {
+                return next && static_cast<std::uint64_t>(next - begin) <= reader.max_line();
+            };
+            float f[3];
+            const char* next;
+            if (begin[0] == 'f') {
+                std::size_t count = 0;
+                if (is_blank(begin[1]) &&
+                    within_limit(
+                        next = read_face_line(
+                            begin + 1, padded_end,
+                            {scene.positions.size(), scene.texcoords.size(), scene.normals.size()},
+                            face, count))) {
+                    const std::size_t n = reader.consumed_line(next);
+                    if (count - 2 <= headroom) [[likely]] {
+                        headroom -= count - 2;
+                        if (count == 3)
+                            scene.add_triangle({face[0].v, face[1].v, face[2].v}, material, object,
+                                               {face[0].n, face[1].n, face[2].n},
+                                               {face[0].t, face[1].t, face[2].t});
+                        else append_fan(scene, face, count, material, object);
+                    } else {
+                        add_face(LineParser(file, n), n, {face, count});
+                        refresh_headroom();
+                    }
+                    continue;
+                }
+            } else if (begin[0] == 'v') {
+                if (is_blank(begin[1])) {
+                    if (within_limit(next = read_numbers_line(begin + 1, padded_end, f, 3))) {
+                        add_vertex(scene.positions, Vec3f{f[0], f[1], f[2]}, nonfinite_position,
+                                   reader.consumed_line(next), adding_position);
+                        continue;
+                    }
+                } else if (begin[1] == 'n' && is_blank(begin[2])) {
+                    if (within_limit(next = read_numbers_line(begin + 2, padded_end, f, 3))) {
+                        add_vertex(scene.normals, Vec3f{f[0], f[1], f[2]}, nonfinite_normal,
+                                   reader.consumed_line(next), adding_normal);
+                        continue;
+                    }
+                } else if (begin[1] == 't' && is_blank(begin[2])) {
+                    if (within_limit(next = read_numbers_line(begin + 2, padded_end, f, 2))) {
+                        add_vertex(scene.texcoords, Vec2f{f[0], f[1]}, nonfinite_texcoord,
+                                   reader.consumed_line(next), adding_texcoord);
+                        continue;
+                    }
+                }
+            }
+        }
+
+        // Everything else: the general path.
+        if (!reader.next(line, line_number)) break;
+        read_statement(line, line_number);
+        refresh_headroom();
     }
     check_estimate(LineParser(file, 0));
 }

@@ -43,6 +43,10 @@ public:
         next_ = count * 2;
         return true;
     }
+    /// How many more elements `count` may grow by before the check is due.
+    [[nodiscard]] std::uint64_t until_due(std::uint64_t count) const {
+        return count < next_ ? next_ - count : 0;
+    }
 
 private:
     std::uint64_t next_ = 1 << 16;
