@@ -1,7 +1,7 @@
 // OBJ text (materials not followed: the fuzzer must not read files). Checks that a scene that
 // loads is consistent: every index in range, every number finite; and that the text reads the
-// same when a padding comment follows it, which puts all of it in the fast path's padded zone
-// (obj_fast_path.h): the fast path must never change what a line means.
+// same on the fast path (obj_fast_path.h) and in chunks read ahead and merged: neither may
+// change what a line means.
 
 #include <cmath>
 #include <cstring>
@@ -9,6 +9,7 @@
 
 #include "fuzz_util.h"
 #include "toonray/core/error.h"
+#include "toonray/scene/obj_fast_path.h"
 #include "toonray/scene/obj_loader.h"
 
 using namespace toonray;
@@ -21,56 +22,67 @@ bool same_bytes(const std::vector<T>& a, const std::vector<T>& b) {
            (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
 }
 
-// The padded text reads to the same scene, warnings and error as the text itself. An empty line
-// comes first: a last line continued with `\` is then joined with nothing, as at the end.
-void check_padded_reads_the_same(std::string_view text, const Scene& scene,
-                                 const Warnings& warnings, const std::string& error) {
-    const std::string padded = std::string(text) + "\n\n#" + std::string(80, ' ') + "\n";
-    Scene other;
-    Warnings other_warnings;
-    ObjOptions options;
-    options.load_materials = false;
-    std::string other_error;
+// What parse_obj (or another way of reading) makes of a text.
+struct Reading {
+    Scene scene;
+    Warnings warnings;
+    std::string error;
+};
+
+template <typename Read>
+Reading reading(const Read& read) {
+    Reading out;
     try {
-        parse_obj(padded, "fuzz.obj", other, other_warnings, options);
+        read(out.scene, out.warnings);
     } catch (const Error& e) {
-        other_error = e.what();
+        out.error = e.what();
     }
-    FUZZ_CHECK(error == other_error);
-    FUZZ_CHECK(warnings == other_warnings);
-    if (!error.empty()) return;
-    FUZZ_CHECK(same_bytes(scene.positions, other.positions));
-    FUZZ_CHECK(same_bytes(scene.normals, other.normals));
-    FUZZ_CHECK(same_bytes(scene.texcoords, other.texcoords));
-    FUZZ_CHECK(same_bytes(scene.tri_positions, other.tri_positions));
-    FUZZ_CHECK(same_bytes(scene.tri_normals, other.tri_normals));
-    FUZZ_CHECK(same_bytes(scene.tri_texcoords, other.tri_texcoords));
-    FUZZ_CHECK(same_bytes(scene.tri_material, other.tri_material));
-    FUZZ_CHECK(same_bytes(scene.tri_object, other.tri_object));
-    FUZZ_CHECK(same_bytes(scene.polyline_points, other.polyline_points));
-    FUZZ_CHECK(same_bytes(scene.polylines, other.polylines));
-    FUZZ_CHECK(scene.objects == other.objects);
-    FUZZ_CHECK(scene.camera.has_value() == other.camera.has_value());
-    FUZZ_CHECK(!scene.camera ||
-               std::memcmp(&*scene.camera, &*other.camera, sizeof(CameraSpec)) == 0);
+    return out;
+}
+
+void check_same(const Reading& a, const Reading& b) {
+    FUZZ_CHECK(a.error == b.error);
+    FUZZ_CHECK(a.warnings == b.warnings);
+    if (!a.error.empty()) return;
+    FUZZ_CHECK(same_bytes(a.scene.positions, b.scene.positions));
+    FUZZ_CHECK(same_bytes(a.scene.normals, b.scene.normals));
+    FUZZ_CHECK(same_bytes(a.scene.texcoords, b.scene.texcoords));
+    FUZZ_CHECK(same_bytes(a.scene.tri_positions, b.scene.tri_positions));
+    FUZZ_CHECK(same_bytes(a.scene.tri_normals, b.scene.tri_normals));
+    FUZZ_CHECK(same_bytes(a.scene.tri_texcoords, b.scene.tri_texcoords));
+    FUZZ_CHECK(same_bytes(a.scene.tri_material, b.scene.tri_material));
+    FUZZ_CHECK(same_bytes(a.scene.tri_object, b.scene.tri_object));
+    FUZZ_CHECK(same_bytes(a.scene.polyline_points, b.scene.polyline_points));
+    FUZZ_CHECK(same_bytes(a.scene.polylines, b.scene.polylines));
+    FUZZ_CHECK(a.scene.objects == b.scene.objects);
+    FUZZ_CHECK(a.scene.camera.has_value() == b.scene.camera.has_value());
+    FUZZ_CHECK(!a.scene.camera ||
+               std::memcmp(&*a.scene.camera, &*b.scene.camera, sizeof(CameraSpec)) == 0);
 }
 
 }  // namespace
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
-    Scene scene;
-    Warnings warnings;
     ObjOptions options;
     options.load_materials = false;
     const std::string_view text = toonray_fuzz::as_text(data, size);
-    std::string error;
-    try {
+    const Reading plain = reading([&](Scene& scene, Warnings& warnings) {
         parse_obj(text, "fuzz.obj", scene, warnings, options);
-    } catch (const Error& e) {
-        error = e.what();
-    }
-    check_padded_reads_the_same(text, scene, warnings, error);
-    if (!error.empty()) return 0;
+    });
+    // The same text followed by a padding comment, which puts all of it in the fast path's
+    // padded zone (an empty line first: a last line continued with `\` is then joined with
+    // nothing, as at the end of the text); and that read in chunks of a few bytes, each read
+    // ahead and merged. Every way must read the same.
+    const std::string padded = std::string(text) + "\n\n#" + std::string(80, ' ') + "\n";
+    check_same(plain, reading([&](Scene& scene, Warnings& warnings) {
+                   parse_obj(padded, "fuzz.obj", scene, warnings, options);
+               }));
+    check_same(plain, reading([&](Scene& scene, Warnings& warnings) {
+                   wavefront::parse_obj_in_chunks(padded, "fuzz.obj", scene, warnings, options,
+                                                  1 + size % 61, 0);
+               }));
+    if (!plain.error.empty()) return 0;
+    const Scene& scene = plain.scene;
     const std::size_t n = scene.triangle_count();
     FUZZ_CHECK(scene.tri_normals.size() == n && scene.tri_texcoords.size() == n);
     FUZZ_CHECK(scene.tri_material.size() == n && scene.tri_object.size() == n);

@@ -126,12 +126,27 @@ TEST(ReadNumber, FormsAndWhereTheyEnd) {
         const char* token;
         bool read;
     };
-    for (const Case c : {Case{"0", true}, {"-0", true}, {"5.", true}, {".5", true},
-                         {"-.5", true}, {"1e5", true}, {"1E-05", true}, {"1.5e+3", true},
-                         {"12345678.25", true}, {"12345678.5", false}, {"123456789012345", true},
-                         {"1234567890123456", false}, {"0.1234567890123456", false},
-                         {"+1", false}, {".", false}, {"-", false}, {"e5", false}, {"1e", false},
-                         {"1e1234", false}, {"1e-50", false}, {"nan", false}}) {
+    for (const Case c : {Case{"0", true},
+                         {"-0", true},
+                         {"5.", true},
+                         {".5", true},
+                         {"-.5", true},
+                         {"1e5", true},
+                         {"1E-05", true},
+                         {"1.5e+3", true},
+                         {"12345678.25", true},
+                         {"12345678.5", false},
+                         {"123456789012345", true},
+                         {"1234567890123456", false},
+                         {"0.1234567890123456", false},
+                         {"+1", false},
+                         {".", false},
+                         {"-", false},
+                         {"e5", false},
+                         {"1e", false},
+                         {"1e1234", false},
+                         {"1e-50", false},
+                         {"nan", false}}) {
         const Padded padded(c.token);
         const char* p = padded.begin();
         float v;
@@ -151,15 +166,17 @@ TEST(ReadIndex, ResolvedLikeTheGeneralPath) {
         std::string token = rng() % 8 == 0 ? (rng() % 2 ? "-" : "+") : "";
         token += random_digits(rng, 1 + static_cast<int>(rng() % 20));
         const std::size_t count = rng() % 2 ? rng() % 100 : rng();
+        const bool relative = rng() % 2;  // negative indices read, or refused
         const Padded padded(token);
         const char* p = padded.begin();
         std::uint32_t fast = 0;
-        const bool read = read_index(p, padded.end(), count, fast);
+        const bool read = read_index(p, padded.end(), count, relative, fast);
         const char* q = token.data();
         long long index;
         std::uint32_t expect = 0;
         const bool valid = parse_index(q, token.data() + token.size(), index) &&
-                           q == token.data() + token.size() && resolve_index(index, count, expect);
+                           q == token.data() + token.size() && (relative || index > 0) &&
+                           resolve_index(index, count, expect);
         ASSERT_EQ(read, valid) << token << " of " << count;
         if (!valid) continue;
         EXPECT_EQ(fast, expect) << token;

@@ -5,6 +5,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstring>
+#include <fmt/format.h>
 #include <random>
 
 #include <filesystem>
@@ -12,6 +13,7 @@
 
 #include "toonray/core/error.h"
 #include "toonray/scene/mtl_loader.h"
+#include "toonray/scene/obj_fast_path.h"
 
 using namespace toonray;
 namespace fs = std::filesystem;
@@ -47,40 +49,56 @@ struct Parsed {
     std::string error;
 };
 
-Parsed parse_text(std::string_view text, const fs::path& path) {
+template <typename Read>
+Parsed parsed_by(const Read& read) {
     Parsed out;
     try {
-        parse_obj(text, path, out.scene, out.warnings);
+        read(out.scene, out.warnings);
     } catch (const Error& e) {
         out.error = e.what();
     }
     return out;
 }
 
-// Every text is read twice: as it is, where a short text is left to the general path, and
+void expect_same(const Parsed& a, const Parsed& b, std::string_view text, std::string_view how) {
+    EXPECT_EQ(a.error, b.error) << how << ": " << text;
+    EXPECT_EQ(a.warnings, b.warnings) << how << ": " << text;
+    EXPECT_TRUE(same_scene(a.scene, b.scene)) << how << ": " << text;
+}
+
+// Every text is read in every way: as it is, where a short text is left to the general path;
 // followed by a padding comment, which puts all of it in the fast path's padded zone
-// (obj_fast_path.h). Both must read it the same. An empty line comes first: a last line
-// continued with `\` is then joined with nothing, as at the end of the text.
-Parsed parse_both_ways(std::string_view text, const fs::path& path) {
-    Parsed plain = parse_text(text, path);
-    const Parsed padded =
-        parse_text(std::string(text) + "\n\n#" + std::string(80, ' ') + "\n", path);
-    EXPECT_EQ(plain.error, padded.error) << text;
-    EXPECT_EQ(plain.warnings, padded.warnings) << text;
-    EXPECT_TRUE(same_scene(plain.scene, padded.scene)) << text;
+// (obj_fast_path.h); and that in chunks of a line or a few, read ahead on this thread or by
+// others and merged. All must read it the same. An empty line comes first in the padding: a
+// last line continued with `\` is then joined with nothing, as at the end of the text.
+Parsed parse_every_way(std::string_view text, const fs::path& path) {
+    Parsed plain = parsed_by(
+        [&](Scene& scene, Warnings& warnings) { parse_obj(text, path, scene, warnings); });
+    const std::string padded = std::string(text) + "\n\n#" + std::string(80, ' ') + "\n";
+    expect_same(plain, parsed_by([&](Scene& scene, Warnings& warnings) {
+                    parse_obj(padded, path, scene, warnings);
+                }),
+                text, "padded");
+    for (const auto& [chunk_bytes, threads] : {std::pair{1, 0}, {13, 0}, {1, 3}, {40, 2}})
+        expect_same(plain, parsed_by([&](Scene& scene, Warnings& warnings) {
+                        wavefront::parse_obj_in_chunks(padded, path, scene, warnings, {},
+                                                       static_cast<std::size_t>(chunk_bytes),
+                                                       threads);
+                    }),
+                    text, fmt::format("chunks of {} bytes, {} threads", chunk_bytes, threads));
     return plain;
 }
 
 Scene parse(std::string_view text, Warnings* warnings_out = nullptr,
             const fs::path& path = "test.obj") {
-    Parsed parsed = parse_both_ways(text, path);
+    Parsed parsed = parse_every_way(text, path);
     if (!parsed.error.empty()) throw Error(parsed.error);
     if (warnings_out) *warnings_out = parsed.warnings;
     return std::move(parsed.scene);
 }
 
 std::string error_of(std::string_view text, const fs::path& path = "test.obj") {
-    const Parsed parsed = parse_both_ways(text, path);
+    const Parsed parsed = parse_every_way(text, path);
     return parsed.error.empty() ? "(no error)" : parsed.error;
 }
 

@@ -20,6 +20,7 @@
 
 #include "toonray/core/index.h"
 #include "toonray/scene/obj_lexer.h"
+#include "toonray/scene/obj_loader.h"
 
 namespace toonray::wavefront {
 
@@ -197,9 +198,10 @@ inline bool read_number(const char*& pos, const char* end, float& out) {
 }
 
 /// A face index of the padded zone, "[+-]digits" (parse_index), resolved against `count`
-/// (resolve_index); up to 7 digits without a sign are read at once. False when malformed or
-/// out of range.
-inline bool read_index(const char*& pos, const char* end, std::size_t count, std::uint32_t& out) {
+/// (resolve_index), negative (relative) ones only when `relative`; up to 7 digits without a
+/// sign are read at once. False when malformed or out of range.
+inline bool read_index(const char*& pos, const char* end, std::size_t count, bool relative,
+                       std::uint32_t& out) {
     const std::uint64_t w = load_chars(pos);
     const int digits = leading_digits(w);
     if (static_cast<unsigned>(digits - 1) < 7) [[likely]] {
@@ -210,7 +212,8 @@ inline bool read_index(const char*& pos, const char* end, std::size_t count, std
         return true;
     }
     long long index;
-    return parse_index(pos, end, index) && resolve_index(index, count, out);
+    return parse_index(pos, end, index) && (relative || index > 0) &&
+           resolve_index(index, count, out);
 }
 
 /// Skips blanks, then expects the end of the line; returns the start of the next line.
@@ -235,22 +238,25 @@ inline const char* read_numbers_line(const char* p, const char* end, float* out,
 /// The most corners a face may have on the fast path; longer polygons go the general way.
 inline constexpr std::size_t kMaxFastCorners = 64;
 
-/// Counts of the elements a face's indices are resolved against: those defined so far.
+/// Counts of the elements a face's indices are resolved against: those defined so far; and
+/// whether relative (negative) indices are read.
 struct Defined {
     std::size_t positions, texcoords, normals;
+    bool relative;
 };
 
 /// A face corner "v", "v/t", "v//n" or "v/t/n", resolved.
 inline bool read_corner(const char*& pos, const char* end, const Defined& defined, Corner& c) {
     const char* p = pos;
     c.t = c.n = kNoIndex;
-    if (!read_index(p, end, defined.positions, c.v)) return false;
+    if (!read_index(p, end, defined.positions, defined.relative, c.v)) return false;
     if (*p == '/') {
         ++p;
-        if (*p != '/' && !read_index(p, end, defined.texcoords, c.t)) return false;
+        if (*p != '/' && !read_index(p, end, defined.texcoords, defined.relative, c.t))
+            return false;
         if (*p == '/') {
             ++p;
-            if (!read_index(p, end, defined.normals, c.n)) return false;
+            if (!read_index(p, end, defined.normals, defined.relative, c.n)) return false;
         }
     }
     pos = p;
@@ -272,5 +278,12 @@ inline const char* read_face_line(const char* p, const char* end, const Defined&
     count = n;
     return after_line_end(p);
 }
+
+/// parse_obj with the padded zone in chunks of about `chunk_bytes`, read ahead by up to
+/// `threads` - 1 other threads (0: every chunk read ahead on this thread first, then merged).
+/// The result is the same for any chunks and threads; parse_obj chooses them, tests vary them.
+void parse_obj_in_chunks(std::string_view text, const std::filesystem::path& path, Scene& scene,
+                         Warnings& warnings, const ObjOptions& options, std::size_t chunk_bytes,
+                         int threads);
 
 }  // namespace toonray::wavefront

@@ -44,6 +44,11 @@ public:
         pos_ = static_cast<std::size_t>(next_line - text_.data());
         return ++physical_;
     }
+    /// Marks `lines` plain physical lines, read by the caller, as consumed up to `next_line`.
+    void skip_lines(const char* next_line, std::size_t lines) {
+        pos_ = static_cast<std::size_t>(next_line - text_.data());
+        physical_ += lines;
+    }
 
 private:
     std::string_view take_physical();
