@@ -49,8 +49,8 @@ Read expect_chunks_read_the_same(const std::string& text, const ObjOptions& opti
     for (const std::size_t chunk_bytes : {std::size_t{1}, std::size_t{100}, std::size_t{4096}})
         for (const int threads : {0, 2, 4}) {
             const Read chunked = read(text, options, chunk_bytes, threads);
-            const std::string how = fmt::format("chunks of {} bytes, {} threads", chunk_bytes,
-                                                threads);
+            const std::string how =
+                fmt::format("chunks of {} bytes, {} threads", chunk_bytes, threads);
             EXPECT_EQ(serial.error, chunked.error) << how;
             EXPECT_EQ(serial.warnings, chunked.warnings) << how;
             if (!serial.error.empty()) continue;
@@ -81,33 +81,35 @@ std::string mixed_text(unsigned seed, int lines) {
     };
     for (int i = 0; i < lines; ++i) {
         switch (rng() % 17) {
-        case 0: case 1: case 2:
-            text += fmt::format("v {} {:.4f} {}e-2\n", rng() % 100, (rng() % 1000) / 7.0,
-                                rng() % 50);
-            ++v;
-            break;
-        case 3: text += "vn 0 0.6 -0.8\n", ++vn; break;
-        case 4: text += fmt::format("vt 0.{} 1\n", rng() % 1000), ++vt; break;
-        case 5: case 6: case 7:
-            text += fmt::format("f {} {} {}\n", index(v), index(v), index(v));
-            break;
-        case 8:
-            text += fmt::format("f {0}/{1}/{2} {3}/{1}/{2} {4}//{2} {0}/{1}\n", index(v),
-                                index(vt), index(vn), index(v), index(v));
-            break;
-        case 9: text += fmt::format("o part{}\nusemtl m{}\n", rng() % 5, rng() % 3); break;
-        case 10: text += rng() % 2 ? "# a comment\n" : "\n"; break;
-        case 11: text += "s 1\r\n"; break;
-        case 15:  // a comment is never continued; a '#' after a vertical tab is no comment
-            text += "\t# comment \\\n\v# joined \\\nv 9 9 9\n";
-            break;
-        case 12: text += fmt::format("l {} {}\n", index(v), index(v)); break;
-        case 13: text += "v 1 2 \\\n 3\n", ++v; break;          // continued
-        case 14:  // non-finite values, in some texts: their faces are dropped
-            text += seed % 2 ? "v 1e300 0 0\nv nan 1 1\n" : "v 1 1 1\nv 2 2 2\n";
-            v += 2;
-            break;
-        default: text += fmt::format("f {} {} {} {}\n", index(v), index(v), index(v), index(v));
+            case 0:
+            case 1:
+            case 2:
+                text += fmt::format("v {} {:.4f} {}e-2\n", rng() % 100, (rng() % 1000) / 7.0,
+                                    rng() % 50);
+                ++v;
+                break;
+            case 3: text += "vn 0 0.6 -0.8\n", ++vn; break;
+            case 4: text += fmt::format("vt 0.{} 1\n", rng() % 1000), ++vt; break;
+            case 5:
+            case 6:
+            case 7: text += fmt::format("f {} {} {}\n", index(v), index(v), index(v)); break;
+            case 8:
+                text += fmt::format("f {0}/{1}/{2} {3}/{1}/{2} {4}//{2} {0}/{1}\n", index(v),
+                                    index(vt), index(vn), index(v), index(v));
+                break;
+            case 9: text += fmt::format("o part{}\nusemtl m{}\n", rng() % 5, rng() % 3); break;
+            case 10: text += rng() % 2 ? "# a comment\n" : "\n"; break;
+            case 11: text += "s 1\r\n"; break;
+            case 15:  // a comment is never continued; a '#' after a vertical tab is no comment
+                text += "\t# comment \\\n\v# joined \\\nv 9 9 9\n";
+                break;
+            case 12: text += fmt::format("l {} {}\n", index(v), index(v)); break;
+            case 13: text += "v 1 2 \\\n 3\n", ++v; break;  // continued
+            case 14:  // non-finite values, in some texts: their faces are dropped
+                text += seed % 2 ? "v 1e300 0 0\nv nan 1 1\n" : "v 1 1 1\nv 2 2 2\n";
+                v += 2;
+                break;
+            default: text += fmt::format("f {} {} {} {}\n", index(v), index(v), index(v), index(v));
         }
     }
     return text;
@@ -169,4 +171,13 @@ TEST(ObjChunks, TheMemoryEstimateKeepsItsPace) {
                 << mib << " MiB: " << r.error;
         }
     }
+}
+
+TEST(ObjChunks, ABinaryFileIsRefusedWhateverTheThreads) {
+    // Larger than the 4 MiB from which lines (and NUL bytes) are counted on several threads.
+    std::string text;
+    for (int i = 0; i < 300'000; ++i) text += "v 0.5 0.25 0.125\n";
+    text[text.size() - 1000] = '\0';
+    const Read r = expect_chunks_read_the_same(text);
+    EXPECT_EQ(r.error, "chunks.obj:299942: binary data (NUL byte): not an OBJ text file");
 }

@@ -2,7 +2,7 @@
 /// The plain forms of the statements that make up nearly all of an OBJ file (v, vn, vt, f),
 /// read in one pass over the text (internal to the scene module): no line splitting ahead, no
 /// tokens, no keyword comparisons. Each reader returns where the next line starts, or nullptr
-/// when the line has any other form (a trailing comment, a continuation, an exponent, an
+/// when the line has any other form (a trailing comment, a continuation, a long number, an
 /// error, ...); it has then changed nothing, and parse_obj's general path reads the line with
 /// its precise messages. So this path decides only how fast a line is read, never what it
 /// means.
@@ -10,7 +10,7 @@
 /// The readers run only on the padded zone of the text (padded_zone_end): lines that end at
 /// least kFastPathPadding bytes before the end of the text. A line end stops every scan, so
 /// they need no bounds checks, and a number's digits are read 8 at a time (SWAR: one 64-bit
-/// word holds 8 characters), which may read up to 32 bytes past the line.
+/// word holds 8 characters), which may read up to 17 bytes past the line.
 
 #include <bit>
 #include <cstddef>

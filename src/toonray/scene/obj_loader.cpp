@@ -1,5 +1,7 @@
 #include "toonray/scene/obj_loader.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_reduce.h>
 #include <tbb/task_arena.h>
 #include <tbb/task_group.h>
 
@@ -35,32 +37,46 @@ std::uint32_t intern(std::unordered_map<std::string, std::uint32_t>& ids,
     return it->second;
 }
 
-// The lines of the text, counted 16 bytes at a time, and whether it holds a NUL byte
+// The line ends of a text, counted 16 bytes at a time, and whether it holds a NUL byte
 // (refuse_binary), found in the same pass.
 struct TextCounts {
-    std::uint64_t lines = 1;
+    std::uint64_t line_ends = 0;
     bool nul = false;
 };
 
-TextCounts count_lines(std::string_view text) {
+TextCounts count_line_ends(const char* s, std::size_t size) {
     TextCounts counts;
-    const char* s = text.data();
-    const std::size_t size = text.size();
     const __m128i newline = _mm_set1_epi8('\n'), zero = _mm_setzero_si128();
     __m128i nul = zero;
     std::size_t i = 0;
     for (; i + 16 <= size; i += 16) {
         const __m128i chars = _mm_loadu_si128(reinterpret_cast<const __m128i*>(s + i));
         nul = _mm_or_si128(nul, _mm_cmpeq_epi8(chars, zero));
-        counts.lines += static_cast<unsigned>(std::popcount(
+        counts.line_ends += static_cast<unsigned>(std::popcount(
             static_cast<unsigned>(_mm_movemask_epi8(_mm_cmpeq_epi8(chars, newline)))));
     }
     counts.nul = _mm_movemask_epi8(nul) != 0;
     for (; i < size; ++i) {
-        counts.lines += s[i] == '\n';
+        counts.line_ends += s[i] == '\n';
         counts.nul = counts.nul || s[i] == '\0';
     }
     return counts;
+}
+
+// The same for the whole text, in blocks of 1 MiB on the threads there are when it is larger
+// than a few: memory, not the count, is what takes time.
+TextCounts count_line_ends(std::string_view text, int threads) {
+    constexpr std::size_t kBlock = 1 << 20;
+    if (threads == 1 || text.size() < 4 * kBlock) return count_line_ends(text.data(), text.size());
+    return tbb::parallel_reduce(
+        tbb::blocked_range<std::size_t>(0, text.size(), kBlock), TextCounts{},
+        [&](const tbb::blocked_range<std::size_t>& r, TextCounts counts) {
+            const TextCounts block = count_line_ends(text.data() + r.begin(), r.size());
+            return TextCounts{counts.line_ends + block.line_ends, counts.nul || block.nul};
+        },
+        [](const TextCounts& a, const TextCounts& b) {
+            return TextCounts{a.line_ends + b.line_ends, a.nul || b.nul};
+        });
 }
 
 // Reserves for as many vertices of each kind and triangles as the text has lines: growing the
@@ -850,20 +866,40 @@ void ObjReader::read_in_chunks(std::size_t chunk_bytes, int threads) {
     // for a chunk no one has started, and one thread (or none free) simply reads it all.
     chunks[0]->state = Chunk::kMain;
     std::atomic<bool> stop{false};
+    // What is read ahead is held until merged, so it never holds more elements than the
+    // limits let the scene hold: a file past a limit then fails at the same line without
+    // first filling the memory with what comes after that line. A chunk has at most an
+    // element for every 2 bytes (a polygon's corner " 1"); what it did not use is given back.
+    std::atomic<std::int64_t> budget{static_cast<std::int64_t>(
+        std::min({max_vertices_, max_triangles_,
+                  lim_.max_memory > estimate()
+                      ? (lim_.max_memory - estimate()) /
+                            (scene_bytes(1, 1) * std::max<std::uint64_t>(lim_.scenes_in_flight, 1))
+                      : 0}))};
     auto read_ahead_from_the_end = [&] {
         for (std::size_t i = chunks.size(); i-- > 1 && !stop.load(std::memory_order_relaxed);) {
+            Chunk& chunk = *chunks[i];
+            const auto most = static_cast<std::int64_t>(chunk.end - chunk.begin) / 2 + 1;
+            if (budget.fetch_sub(most) < most) {
+                budget.fetch_add(most);
+                return;
+            }
             int state = Chunk::kUnclaimed;
-            if (!chunks[i]->state.compare_exchange_strong(state, Chunk::kReading)) {
+            if (!chunk.state.compare_exchange_strong(state, Chunk::kReading)) {
+                budget.fetch_add(most);
                 if (state == Chunk::kMain) return;  // met this thread
                 continue;                           // another thread's
             }
             try {
-                read_ahead(*chunks[i], padded_end_, max_line);
+                read_ahead(chunk, padded_end_, max_line);
             } catch (...) {  // out of memory: this thread then reads it itself
-                chunks[i]->failed = true;
+                chunk.failed = true;
             }
-            chunks[i]->state.store(Chunk::kRead);
-            chunks[i]->state.notify_one();
+            budget.fetch_add(most - static_cast<std::int64_t>(
+                                        chunk.positions.size() + chunk.normals.size() +
+                                        chunk.texcoords.size() + chunk.tri_positions.size()));
+            chunk.state.store(Chunk::kRead);
+            chunk.state.notify_one();
         }
     };
     tbb::task_group helpers;
@@ -891,7 +927,8 @@ void ObjReader::read_in_chunks(std::size_t chunk_bytes, int threads) {
 }
 
 void ObjReader::read(std::size_t chunk_bytes, int threads) {
-    if (static_cast<std::size_t>(padded_end_ - reader_.cursor()) >= 2 * chunk_bytes && threads != 1)
+    if (threads != 1 &&
+        padded_end_ - reader_.cursor() >= 2 * static_cast<std::ptrdiff_t>(chunk_bytes))
         read_in_chunks(chunk_bytes, threads);
     read_until(text_.data() + text_.size());
     check_estimate(LineParser(file_, 0));
@@ -905,9 +942,9 @@ void parse_obj_in_chunks(std::string_view text, const std::filesystem::path& pat
                          Warnings& warnings, const ObjOptions& options, std::size_t chunk_bytes,
                          int threads) {
     scene.clear();
-    const TextCounts counts = count_lines(text);
+    const TextCounts counts = count_line_ends(text, threads);
     if (counts.nul) refuse_binary(text, path.string(), "an OBJ");
-    reserve_for(counts.lines, scene, options.limits);
+    reserve_for(counts.line_ends + 1, scene, options.limits);
     ObjReader(text, path, scene, warnings, options).read(chunk_bytes, threads);
 }
 
