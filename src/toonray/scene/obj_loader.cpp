@@ -862,8 +862,8 @@ void ObjReader::read_in_chunks(std::size_t chunk_bytes, int threads) {
     if (chunks.size() < 2) return;
     const std::uint64_t max_line = reader_.max_line();
     // Other threads read chunks ahead from the last one back, while this one reads from the
-    // first on; where they meet, this one merges what they read. So this thread never waits
-    // for a chunk no one has started, and one thread (or none free) simply reads it all.
+    // first on; where they meet, this one merges what they read. So this thread never waits,
+    // and one thread (or none free) simply reads it all.
     chunks[0]->state = Chunk::kMain;
     std::atomic<bool> stop{false};
     // What is read ahead is held until merged, so it never holds more elements than the
@@ -899,7 +899,6 @@ void ObjReader::read_in_chunks(std::size_t chunk_bytes, int threads) {
                                         chunk.positions.size() + chunk.normals.size() +
                                         chunk.texcoords.size() + chunk.tri_positions.size()));
             chunk.state.store(Chunk::kRead);
-            chunk.state.notify_one();
         }
     };
     tbb::task_group helpers;
@@ -915,12 +914,13 @@ void ObjReader::read_in_chunks(std::size_t chunk_bytes, int threads) {
     for (int i = 1; i < threads; ++i) helpers.run(read_ahead_from_the_end);
     for (std::unique_ptr<Chunk>& chunk : chunks) {
         int state = Chunk::kUnclaimed;
+        // A chunk still being read ahead is read here too, rather than waited for: that costs
+        // at most a chunk's reading, and never waits on a thread the machine has put aside.
         if (chunk->state.load() == Chunk::kMain ||
-            chunk->state.compare_exchange_strong(state, Chunk::kMain)) {
+            chunk->state.compare_exchange_strong(state, Chunk::kMain) || state == Chunk::kReading) {
             read_until(chunk->end);
             continue;
         }
-        while ((state = chunk->state.load()) == Chunk::kReading) chunk->state.wait(Chunk::kReading);
         merge(*chunk);
         chunk->release();
     }
