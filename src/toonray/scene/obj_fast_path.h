@@ -198,8 +198,8 @@ inline bool read_number(const char*& pos, const char* end, float& out) {
 }
 
 /// A face index of the padded zone, "[+-]digits" (parse_index), resolved against `count`
-/// (resolve_index), negative (relative) ones only when `relative`; up to 7 digits without a
-/// sign are read at once. False when malformed or out of range.
+/// (resolve_index), negative (relative) ones only when `relative`; up to 7 digits, without a
+/// sign or after '-', are read at once. False when malformed or out of range.
 inline bool read_index(const char*& pos, const char* end, std::size_t count, bool relative,
                        std::uint32_t& out) {
     const std::uint64_t w = load_chars(pos);
@@ -210,6 +210,17 @@ inline bool read_index(const char*& pos, const char* end, std::size_t count, boo
         if (index - 1 >= count) return false;  // also 0, which wraps
         out = static_cast<std::uint32_t>(index - 1);
         return true;
+    }
+    if (digits == 0 && *pos == '-' && relative) {  // relative: "-3" is the third from the last
+        const std::uint64_t after = load_chars(pos + 1);
+        const int back_digits = leading_digits(after);
+        if (static_cast<unsigned>(back_digits - 1) < 7) {
+            const std::uint64_t back = digits_value(after, back_digits);
+            pos += 1 + back_digits;
+            if (back - 1 >= count) return false;  // also 0, which wraps
+            out = static_cast<std::uint32_t>(count - back);
+            return true;
+        }
     }
     long long index;
     return parse_index(pos, end, index) && (relative || index > 0) &&

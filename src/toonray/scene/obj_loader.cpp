@@ -301,7 +301,7 @@ struct Chunk {
     std::vector<Vec2f> texcoords;
     std::vector<std::array<std::uint32_t, 3>> tri_positions, tri_normals, tri_texcoords;
     std::vector<Mark> others;  ///< the lines left to the general path
-    Mark stop;                 ///< where reading ahead stopped: `end`, or a continued line
+    Mark stop;  ///< where reading ahead stopped: `end`, a continued line, a relative index
     /// The most elements of each kind that must be defined before the chunk: each face index
     /// minus the elements of its kind the chunk defines before it.
     std::int64_t need_positions = 0, need_texcoords = 0, need_normals = 0;
@@ -381,15 +381,17 @@ void read_ahead(Chunk& chunk, const char* padded_end, std::uint64_t max_line) {
             continue;
         }
         // Any other line. One continued with `\` goes on into the next (LineReader: unless a
-        // comment, '#' after blanks): reading ahead stops there. Lines with no statement
-        // (only spaces, or a '#' after them: Tokens) mean nothing; the rest is the general
-        // path's.
+        // comment, '#' after blanks): reading ahead stops there; so it does at a face with a
+        // relative index, which the fast path reads here but the general path would in the
+        // merge (a file that has one likely has them all). Lines with no statement (only
+        // spaces, or a '#' after them: Tokens) mean nothing; the rest is the general path's.
         const char* last = p;
         while (*last != '\n' && *last != '\r') ++last;
         next = last + 1 + (*last == '\r' && last[1] == '\n');
         const char* first = p;
         while (first < last && is_blank(*first)) ++first;
         if (last > p && last[-1] == '\\' && (first == last || *first != '#')) break;
+        if (p[0] == 'f' && std::memchr(p, '-', static_cast<std::size_t>(last - p))) break;
         while (first < last && is_space(*first)) ++first;
         if (static_cast<std::uint64_t>(last - p) <= max_line && (first == last || *first == '#')) {
             p = next;
