@@ -197,6 +197,26 @@ inline bool read_number(const char*& pos, const char* end, float& out) {
     return true;
 }
 
+/// read_index's other forms: a sign, 8 digits or more. Apart, so that the common form is
+/// small enough to be inlined.
+[[gnu::noinline]] inline bool read_other_index(const char*& pos, const char* end, std::size_t count,
+                                               bool relative, std::uint32_t& out) {
+    if (*pos == '-' && relative) {  // relative: "-3" is the third from the last
+        const std::uint64_t after = load_chars(pos + 1);
+        const int back_digits = leading_digits(after);
+        if (static_cast<unsigned>(back_digits - 1) < 7) {
+            const std::uint64_t back = digits_value(after, back_digits);
+            pos += 1 + back_digits;
+            if (back - 1 >= count) return false;  // also 0, which wraps
+            out = static_cast<std::uint32_t>(count - back);
+            return true;
+        }
+    }
+    long long index;
+    return parse_index(pos, end, index) && (relative || index > 0) &&
+           resolve_index(index, count, out);
+}
+
 /// A face index of the padded zone, "[+-]digits" (parse_index), resolved against `count`
 /// (resolve_index), negative (relative) ones only when `relative`; up to 7 digits, without a
 /// sign or after '-', are read at once. False when malformed or out of range.
@@ -211,20 +231,7 @@ inline bool read_index(const char*& pos, const char* end, std::size_t count, boo
         out = static_cast<std::uint32_t>(index - 1);
         return true;
     }
-    if (digits == 0 && *pos == '-' && relative) {  // relative: "-3" is the third from the last
-        const std::uint64_t after = load_chars(pos + 1);
-        const int back_digits = leading_digits(after);
-        if (static_cast<unsigned>(back_digits - 1) < 7) {
-            const std::uint64_t back = digits_value(after, back_digits);
-            pos += 1 + back_digits;
-            if (back - 1 >= count) return false;  // also 0, which wraps
-            out = static_cast<std::uint32_t>(count - back);
-            return true;
-        }
-    }
-    long long index;
-    return parse_index(pos, end, index) && (relative || index > 0) &&
-           resolve_index(index, count, out);
+    return read_other_index(pos, end, count, relative, out);
 }
 
 /// Skips blanks, then expects the end of the line; returns the start of the next line.
