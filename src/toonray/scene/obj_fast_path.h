@@ -192,7 +192,9 @@ inline bool read_number(const char*& pos, const char* end, float& out) {
             v = static_cast<float>(product);
         }
     }
-    out = negative ? -v : v;
+    // The sign without a branch: signs follow no pattern a branch predictor could learn.
+    out = std::bit_cast<float>(std::bit_cast<std::uint32_t>(v) |
+                               static_cast<std::uint32_t>(negative) << 31);
     pos = p;
     return true;
 }
