@@ -79,13 +79,13 @@ Parsed parse_every_way(std::string_view text, const fs::path& path) {
                     parse_obj(padded, path, scene, warnings);
                 }),
                 text, "padded");
-    for (const auto& [chunk_bytes, threads] : {std::pair{1, 0}, {13, 0}, {1, 3}, {40, 2}})
+    for (const std::pair<std::size_t, int>& way :
+         {std::pair<std::size_t, int>{1, 0}, {13, 0}, {1, 3}, {40, 2}})
         expect_same(plain, parsed_by([&](Scene& scene, Warnings& warnings) {
-                        wavefront::parse_obj_in_chunks(padded, path, scene, warnings, {},
-                                                       static_cast<std::size_t>(chunk_bytes),
-                                                       threads);
+                        wavefront::parse_obj_in_chunks(padded, path, scene, warnings, {}, way.first,
+                                                       way.second);
                     }),
-                    text, fmt::format("chunks of {} bytes, {} threads", chunk_bytes, threads));
+                    text, fmt::format("chunks of {} bytes, {} threads", way.first, way.second));
     return plain;
 }
 
