@@ -69,6 +69,7 @@ TEST(Tokens, RestKeepsHashesInsideNames) {
 TEST(ScanShortDecimal, BitForBitFromChars) {
     std::mt19937 rng(5);
     std::uniform_int_distribution<int> digits(1, 15), pick(0, 9);
+    int declined = 0;
     for (int i = 0; i < 200'000; ++i) {
         std::string s = rng() % 2 ? "-" : "";
         const int n = digits(rng);
@@ -79,17 +80,37 @@ TEST(ScanShortDecimal, BitForBitFromChars) {
         }
         const char* p = s.data();
         float fast;
-        ASSERT_TRUE(scan_short_decimal(p, s.data() + s.size(), fast)) << s;
-        ASSERT_EQ(p, s.data() + s.size()) << s;
         float reference;
         std::from_chars(s.data(), s.data() + s.size(), reference);
+        // Declined only where the double lands halfway between two floats (nearest_float):
+        // mostly integers above 2^24, where every odd integer is such a midpoint.
+        if (!scan_short_decimal(p, s.data() + s.size(), fast)) {
+            ++declined;
+            continue;
+        }
+        ASSERT_EQ(p, s.data() + s.size()) << s;
         ASSERT_EQ(bits(fast), bits(reference)) << s;
     }
+    EXPECT_LT(declined, 2000);
     // Not the short form: left to from_chars.
     for (const char* s : {"1e5", "1234567890123456", "", "-", "."}) {
         const char* p = s;
         float v;
         EXPECT_FALSE(scan_short_decimal(p, s + std::strlen(s), v) && p == s + std::strlen(s)) << s;
+    }
+}
+
+TEST(ScanShortDecimal, DeclinesDecimalsJustOffAMidpointBetweenFloats) {
+    // Rounded to double, these land exactly halfway between two floats, and rounding that
+    // again to float would go the wrong way: the decimal lies just past the midpoint.
+    for (const char* s : {"0.83888378739357", "0.92586949467659", "0.85585156083107"}) {
+        const char* p = s;
+        float v;
+        EXPECT_FALSE(scan_short_decimal(p, s + std::strlen(s), v)) << s;
+        float reference;
+        std::from_chars(s, s + std::strlen(s), reference);
+        Tokens t(s);
+        EXPECT_EQ(bits(LineParser("t.obj", 1).number(t, "v")), bits(reference)) << s;
     }
 }
 

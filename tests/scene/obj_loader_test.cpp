@@ -5,6 +5,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstring>
+#include <fmt/format.h>
 #include <random>
 
 #include <filesystem>
@@ -12,28 +13,93 @@
 
 #include "toonray/core/error.h"
 #include "toonray/scene/mtl_loader.h"
+#include "toonray/scene/obj_fast_path.h"
 
 using namespace toonray;
 namespace fs = std::filesystem;
 
 namespace {
 
-Scene parse(std::string_view text, Warnings* warnings_out = nullptr,
-            const fs::path& path = "test.obj") {
+// Bit for bit: -0 and 0 differ.
+template <typename T>
+bool same_bits(const std::vector<T>& a, const std::vector<T>& b) {
+    return a.size() == b.size() &&
+           (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
+}
+
+bool same_scene(const Scene& a, const Scene& b) {
+    std::vector<std::string> names_a = a.objects, names_b = b.objects;
+    for (const Material& m : a.materials) names_a.push_back(m.name + "/" + m.map_kd);
+    for (const Material& m : b.materials) names_b.push_back(m.name + "/" + m.map_kd);
+    const bool same_camera =
+        a.camera.has_value() == b.camera.has_value() &&
+        (!a.camera || std::memcmp(&*a.camera, &*b.camera, sizeof(CameraSpec)) == 0);
+    return same_bits(a.positions, b.positions) && same_bits(a.normals, b.normals) &&
+           same_bits(a.texcoords, b.texcoords) && same_bits(a.tri_positions, b.tri_positions) &&
+           same_bits(a.tri_normals, b.tri_normals) && same_bits(a.tri_texcoords, b.tri_texcoords) &&
+           same_bits(a.tri_material, b.tri_material) && same_bits(a.tri_object, b.tri_object) &&
+           same_bits(a.polylines, b.polylines) && same_bits(a.polyline_points, b.polyline_points) &&
+           names_a == names_b && same_camera;
+}
+
+// What parse_obj makes of a text: the scene and its warnings, or the error.
+struct Parsed {
     Scene scene;
     Warnings warnings;
-    parse_obj(text, path, scene, warnings);
-    if (warnings_out) *warnings_out = warnings;
-    return scene;
+    std::string error;
+};
+
+template <typename Read>
+Parsed parsed_by(const Read& read) {
+    Parsed out;
+    try {
+        read(out.scene, out.warnings);
+    } catch (const Error& e) {
+        out.error = e.what();
+    }
+    return out;
+}
+
+void expect_same(const Parsed& a, const Parsed& b, std::string_view text, std::string_view how) {
+    EXPECT_EQ(a.error, b.error) << how << ": " << text;
+    EXPECT_EQ(a.warnings, b.warnings) << how << ": " << text;
+    EXPECT_TRUE(same_scene(a.scene, b.scene)) << how << ": " << text;
+}
+
+// Every text is read in every way: as it is, where a short text is left to the general path;
+// followed by a padding comment, which puts all of it in the fast path's padded zone
+// (obj_fast_path.h); and that in chunks of a line or a few, read ahead on this thread or by
+// others and merged. All must read it the same. An empty line comes first in the padding: a
+// last line continued with `\` is then joined with nothing, as at the end of the text.
+Parsed parse_every_way(std::string_view text, const fs::path& path) {
+    Parsed plain = parsed_by(
+        [&](Scene& scene, Warnings& warnings) { parse_obj(text, path, scene, warnings); });
+    const std::string padded = std::string(text) + "\n\n#" + std::string(80, ' ') + "\n";
+    expect_same(plain, parsed_by([&](Scene& scene, Warnings& warnings) {
+                    parse_obj(padded, path, scene, warnings);
+                }),
+                text, "padded");
+    for (const std::pair<std::size_t, int>& way :
+         {std::pair<std::size_t, int>{1, 0}, {13, 0}, {1, 3}, {40, 2}})
+        expect_same(plain, parsed_by([&](Scene& scene, Warnings& warnings) {
+                        wavefront::parse_obj_in_chunks(padded, path, scene, warnings, {}, way.first,
+                                                       way.second);
+                    }),
+                    text, fmt::format("chunks of {} bytes, {} threads", way.first, way.second));
+    return plain;
+}
+
+Scene parse(std::string_view text, Warnings* warnings_out = nullptr,
+            const fs::path& path = "test.obj") {
+    Parsed parsed = parse_every_way(text, path);
+    if (!parsed.error.empty()) throw Error(parsed.error);
+    if (warnings_out) *warnings_out = parsed.warnings;
+    return std::move(parsed.scene);
 }
 
 std::string error_of(std::string_view text, const fs::path& path = "test.obj") {
-    try {
-        parse(text, nullptr, path);
-    } catch (const Error& e) {
-        return e.what();
-    }
-    return "(no error)";
+    const Parsed parsed = parse_every_way(text, path);
+    return parsed.error.empty() ? "(no error)" : parsed.error;
 }
 
 fs::path temp_dir(const std::string& name) {

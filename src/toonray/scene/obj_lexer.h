@@ -3,6 +3,7 @@
 /// (LF, CRLF and CR endings, `\` continuations, line numbers for messages), whitespace-separated
 /// tokens, numbers and face indices, and the located errors of one statement.
 
+#include <bit>
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -42,6 +43,11 @@ public:
     std::size_t consumed_line(const char* next_line) {
         pos_ = static_cast<std::size_t>(next_line - text_.data());
         return ++physical_;
+    }
+    /// Marks `lines` plain physical lines, read by the caller, as consumed up to `next_line`.
+    void skip_lines(const char* next_line, std::size_t lines) {
+        pos_ = static_cast<std::size_t>(next_line - text_.data());
+        physical_ += lines;
     }
 
 private:
@@ -92,14 +98,28 @@ struct Tokens {
     }
 };
 
+/// The float nearest to a decimal whose value was computed as `d`, one correctly rounded double
+/// operation on exact operands (m / 10^k or m * 10^k, m < 2^53, k <= 22): rounding `d` to float
+/// gives it, unless `d` lies exactly halfway between two floats. Rounding to double never moves
+/// a value across such a midpoint, only onto it (midpoints are doubles), so the exact value is
+/// on the same side as `d` of every midpoint but that one; on it, the exact value may be just
+/// off it either way ("0.83888378739357" is), and this returns false. For results in the
+/// range of normal floats.
+inline bool nearest_float(double d, float& out) {
+    const auto bits = std::bit_cast<std::uint64_t>(d);
+    // The 29 low bits of the significand, which a float drops: 1000...0 is a midpoint.
+    if ((bits & 0x1FFFFFFFu) == 0x10000000u) return false;
+    out = static_cast<float>(d);
+    return true;
+}
+
 /// The common case of OBJ numbers, "[-]ddd.ddd" with up to 15 significant digits and at most
 /// 15 decimals, parsed without from_chars. The mantissa m < 10^15 and 10^k are exact doubles,
-/// so m / 10^k rounds once to double; rounding that to float gives the correctly rounded float
-/// of the decimal because double rounding is innocuous for division when 53 >= 2 * 24 + 2
-/// (Figueroa, "When is double rounding innocuous?", 1995). So the result is bit for bit what
-/// from_chars<float> gives. Reads from `p` up to the first character that cannot continue the
-/// number and advances `p` there; the caller checks what follows (a separator, or the end of
-/// the token). Returns false, `p` unspecified, for anything else (exponents, longer numbers).
+/// so m / 10^k rounds once to double, and nearest_float gives the float from_chars<float>
+/// gives, bit for bit (or declines). Reads from `p` up to the first character that cannot
+/// continue the number and advances `p` there; the caller checks what follows (a separator,
+/// or the end of the token). Returns false, `p` unspecified, for anything else (exponents,
+/// longer numbers, the rare values nearest_float declines).
 inline bool scan_short_decimal(const char*& pos, const char* e, float& out) {
     static constexpr double kPow10[16] = {1e0, 1e1, 1e2,  1e3,  1e4,  1e5,  1e6,  1e7,
                                           1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15};
@@ -115,7 +135,8 @@ inline bool scan_short_decimal(const char*& pos, const char* e, float& out) {
     digits += decimals;
     // Past 15 digits m may have wrapped, but then the result is not used.
     if (digits == 0 || digits > 15) return false;
-    const float v = static_cast<float>(static_cast<double>(m) / kPow10[decimals]);
+    float v;
+    if (!nearest_float(static_cast<double>(m) / kPow10[decimals], v)) return false;
     out = negative ? -v : v;
     pos = p;
     return true;

@@ -1,6 +1,8 @@
 #pragma once
 /// Wavefront OBJ reading, with the MTL libraries a file names, written for speed (one pass, no
-/// per-line allocation).
+/// per-line allocation; the common lines read without bounds checks, digits 8 at a time; a
+/// large text read in chunks on the threads of the current TBB arena, with the same result on
+/// any number of them).
 ///
 /// Reads: v (optional w or colour values ignored), vt, vn, f with 3 or more corners in all four
 /// index forms (v, v/vt, v//vn, v/vt/vn), negative (relative) indices, o, g, usemtl, mtllib

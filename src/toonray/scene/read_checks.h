@@ -43,6 +43,16 @@ public:
         next_ = count * 2;
         return true;
     }
+    /// As due() for each count from `first` to `first + n - 1` in turn, without checking: the
+    /// pace of the checks is the same as if each had been asked.
+    void skip(std::uint64_t first, std::uint64_t n) {
+        for (std::uint64_t count = std::max(first, next_); count < first + n; count = next_)
+            next_ = count * 2;
+    }
+    /// How many more elements `count` may grow by before the check is due.
+    [[nodiscard]] std::uint64_t until_due(std::uint64_t count) const {
+        return count < next_ ? next_ - count : 0;
+    }
 
 private:
     std::uint64_t next_ = 1 << 16;
