@@ -11,8 +11,8 @@ Scenes (written once into the work directory, then reused):
   * the piano: `toonray piano --export-obj` at 6 s into the score (34,476 triangles, with its
     camera block), rendered at 720p, 1080p, 1440p and 4K.
 Each point is the median wall time of `toonray render` from process start to exit (parse, BVH
-build, trace, shade, lines, PNG encode and the atomic write), for both line modes on 1 thread and
-on all threads. Runs of one configuration alternate with the others, so load drifts on a shared
+build, trace, shade, lines, PNG encode and the atomic write), for the default line mode (ink) and
+classic on 1 thread and on all threads. Runs of one configuration alternate with the others, so load drifts on a shared
 machine spread over every row rather than one.
 
 No third-party Python modules: the plot is written as SVG by hand.
@@ -30,7 +30,9 @@ TRIANGLES = [10_000, 30_000, 100_000, 300_000, 1_000_000, 2_000_000, 4_000_000]
 QUICK_TRIANGLES = [10_000, 100_000]
 RESOLUTIONS = [(1280, 720), (1920, 1080), (2560, 1440), (3840, 2160)]
 QUICK_RESOLUTIONS = [(320, 180), (640, 360)]
-MODES = ["classic", "robust"]
+# The line modes timed: the default (ink) and the seed's classic pipeline.
+MODES = ["ink", "classic"]
+LABELS = {"ink": "default (ink)", "classic": "classic", "robust": "robust"}
 
 
 def write_sphere(path, triangles):
@@ -112,8 +114,9 @@ def ms(s):
 
 def table(title, rows, medians, label):
     lines = [f"#### {title}", "",
-             f"| {label} | classic, 1 thread | classic, all threads | robust, 1 thread | robust, all threads |",
-             "|---|--:|--:|--:|--:|"]
+             f"| {label} | " + " | ".join(f"{LABELS[m]}, {'1 thread' if t == 1 else 'all threads'}"
+                                         for m in MODES for t in (1, 0)) + " |",
+             "|---|" + "--:|" * (2 * len(MODES))]
     for key, text in rows:
         cells = [ms(medians[(key, m, t)]) for m in MODES for t in (1, 0)]
         lines.append(f"| {text} | " + " | ".join(cells) + " |")
@@ -124,10 +127,10 @@ def table(title, rows, medians, label):
 
 def svg_plot(panels, path):
     """panels: [(title, xlabel, [(x, {series: seconds})])]; log-log axes, one panel per entry."""
-    colours = {("classic", 1): "#1f77b4", ("classic", 0): "#7fb2dc", ("robust", 1): "#d62728",
-               ("robust", 0): "#ee9a9b"}
-    names = {("classic", 1): "classic, 1 thread", ("classic", 0): "classic, all threads",
-             ("robust", 1): "robust, 1 thread", ("robust", 0): "robust, all threads"}
+    colours = {("classic", 1): "#1f77b4", ("classic", 0): "#7fb2dc", ("ink", 1): "#d62728",
+               ("ink", 0): "#ee9a9b", ("robust", 1): "#2ca02c", ("robust", 0): "#98df8a"}
+    names = {(m, t): f"{LABELS[m]}, {'1 thread' if t == 1 else 'all threads'}"
+             for m in LABELS for t in (1, 0)}
     pw, ph, ml, mt, mb = 420, 300, 60, 40, 50
     width = len(panels) * (pw + ml + 20) + 20
     height = ph + mt + mb + 60
