@@ -629,17 +629,21 @@ SceneResult bench_scene(const fs::path& path, const Options& opt) {
             renderer.render(scene, accel, camera, settings);
         },
         "includes the cel AOV copy");
-    // For scale: the default line mode, which this table does not break into stages yet.
-    RenderSettings robust = settings;
-    robust.edges = EdgeMode::Robust;
-    Renderer robust_renderer;
-    both(
-        "  (Renderer::render, robust lines: the default)",
-        [&](int t) {
-            robust.threads = t;
-            robust_renderer.render(scene, accel, camera, robust);
-        },
-        fmt::format("{} samples per pixel", robust.samples));
+    // For scale: the default line mode (ink) and robust lines, which this table does not break
+    // into stages (ink.md and sampling.md do).
+    for (const EdgeMode mode : {EdgeMode::Ink, EdgeMode::Robust}) {
+        RenderSettings other = settings;
+        other.edges = mode;
+        Renderer other_renderer;
+        both(
+            mode == EdgeMode::Ink ? "  (Renderer::render, ink lines: the default)"
+                                  : "  (Renderer::render, robust lines)",
+            [&](int t) {
+                other.threads = t;
+                other_renderer.render(scene, accel, camera, other);
+            },
+            fmt::format("{} samples per pixel, adaptive", other.samples));
+    }
 
     const ImageRgb8& image = renderer.render(scene, accel, camera, settings);
     const auto* pixels = image.data()->data();
@@ -681,9 +685,12 @@ SceneResult bench_scene(const fs::path& path, const Options& opt) {
             R, [&] { cli(1, "classic"); }, [&] { cli(0, "classic"); });
         rows.push_back({"frame, CLI end to end (`toonray render`)", c1, cN,
                         "process start to exit; --threads 1 / 0"});
+        auto [i1, iN] = time_pair(
+            R, [&] { cli(1, "ink"); }, [&] { cli(0, "ink"); });
+        rows.push_back({"  (frame, CLI, ink lines: the default)", i1, iN, "--edges ink"});
         auto [r1, rN] = time_pair(
             R, [&] { cli(1, "robust"); }, [&] { cli(0, "robust"); });
-        rows.push_back({"  (frame, CLI, robust lines: the default)", r1, rN, "--edges robust"});
+        rows.push_back({"  (frame, CLI, robust lines)", r1, rN, "--edges robust"});
         if (status != 0) fail(fmt::format("the CLI exited with status {}", status));
     } else {
         rep += fmt::format("- CLI row skipped: {} not found (build the toonray_cli target)\n",

@@ -168,11 +168,14 @@ def svg_plot(panels, path):
         out.append(f'<text x="{x0 - 45}" y="{mt + ph / 2}" text-anchor="middle" '
                    f'transform="rotate(-90 {x0 - 45} {mt + ph / 2})">ms per frame (log)</text>')
         for key, colour in colours.items():
+            if key not in points[0][1]:
+                continue  # a mode not timed
             pts = " ".join(f"{X(x):.1f},{Y(series[key]):.1f}" for x, series in points)
             out.append(f'<polyline points="{pts}" fill="none" stroke="{colour}" stroke-width="2"/>')
             for x, series in points:
                 out.append(f'<circle cx="{X(x):.1f}" cy="{Y(series[key]):.1f}" r="3" fill="{colour}"/>')
-    for i, (key, colour) in enumerate(colours.items()):
+    timed = [(key, colour) for key, colour in colours.items() if key in panels[0][2][0][1]]
+    for i, (key, colour) in enumerate(timed):
         lx = 20 + ml + i * 170
         out.append(f'<line x1="{lx}" y1="{height - 20}" x2="{lx + 25}" y2="{height - 20}" stroke="{colour}" '
                    f'stroke-width="3"/><text x="{lx + 30}" y="{height - 16}">{names[key]}</text>')
