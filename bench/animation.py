@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The piano animation end to end, through the real CLI: issue #6's "2,229 HD frames" figure.
+"""The piano animation end to end, through the real CLI: 2,229 frames at 720p on both cores.
 
     python3 bench/animation.py --toonray build/apps/toonray --work-dir build-bench/animation \
         [--frames 2229] [--repeats 1] [--markdown out.md]

@@ -144,7 +144,7 @@ def frame_part(args):
           f"Median of {args.repeats} interleaved rounds after a warm-up round; "
           + (f"every process pinned to CPU {pin}. " if pin is not None else "processes not pinned. ")
           + "ms: wall time from process start to exit; CPU: user + system time of the process. "
-          + f"Targets (issue figures): default <= {DEFAULT_TARGET}x the reference, classic <= {CLASSIC_TARGET}x, "
+          + f"Targets: default <= {DEFAULT_TARGET}x the reference, classic <= {CLASSIC_TARGET}x, "
           + "judged on the first scene."
           + ("" if has_option(args.toonray, "--adaptive") else
              " (No `--adaptive off` row: this CLI has no --adaptive option.)"),

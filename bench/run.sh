@@ -97,7 +97,7 @@ for part in "${parts[@]}"; do
             if [ $quick = 1 ]; then
                 "$build/bench/toonray_bench" --quick --work-dir "$build/bench/stages"
             else
-                # The teapot and the generated 35k scene, then the scenes of issue #6's frame and
+                # The teapot and the generated 35k scene, then the scenes of the frame and
                 # scale targets: a piano frame (34,476 triangles, exported by the CLI) and the
                 # 1M-triangle sphere of bench/scale.py.
                 scenes=("$root/tests/data/teapot.obj" "$(generated | grep scene35k)")
