@@ -1,8 +1,6 @@
 #include "toonray/render/renderer.h"
 
 #include <atomic>
-#include <cstdio>
-#include <cstdlib>
 #include <cmath>
 #include <limits>
 
@@ -410,8 +408,6 @@ void Renderer::render_buckets(const Scene& scene, const TriangleAccel& accel, co
         }
     });
     refined_pixels_ = refined;
-    if (std::getenv("TOONRAY_DEBUG_REFINED"))
-        std::fprintf(stderr, "refined %llu of %d\n", (unsigned long long)refined_pixels_, w * h);
     if (features) depth_feature_image(first_depth_, aovs_.depth);
 }
 
