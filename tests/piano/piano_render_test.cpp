@@ -16,6 +16,7 @@
 #include "toonray/render/renderer.h"
 #include "toonray/scene/obj_loader.h"
 #include "toonray/scene/obj_writer.h"
+#include "support/image_compare.h"
 
 namespace toonray {
 namespace {
@@ -32,14 +33,26 @@ Score forty_notes() {
     return score;
 }
 
-TEST(PianoRender, PosedPianoRoundTripsThroughObj) {
+// The piano playing forty_notes(), posed at `seconds` (with the roll's holes), and what the pose
+// showed.
+struct PosedPiano {
+    Scene scene;
+    PoseStats stats;
+};
+PosedPiano pose_forty_notes(double seconds) {
     const PianoPlayback play(forty_notes());
     PianoOptions options;
     options.hole_capacity = play.hole_capacity();
     const PianoModel model = build_piano(options);
-    Scene posed = model.scene;
-    const PoseStats stats = pose_piano(model, play.pose_at(2.0), &play.roll(), posed);
-    EXPECT_GT(stats.visible_holes, 0u);
+    PosedPiano posed{model.scene, {}};
+    posed.stats = pose_piano(model, play.pose_at(seconds), &play.roll(), posed.scene);
+    return posed;
+}
+
+TEST(PianoRender, PosedPianoRoundTripsThroughObj) {
+    const PosedPiano piano = pose_forty_notes(2.0);
+    const Scene& posed = piano.scene;
+    EXPECT_GT(piano.stats.visible_holes, 0u);
 
     const fs::path dir =
         fs::temp_directory_path() / ("toonray_piano_obj_" + std::to_string(::getpid()));
@@ -163,16 +176,10 @@ TEST(PianoRender, EverySurfaceSeenFromOutsideFacesTheViewer) {
     EXPECT_EQ(wrong, 0u);
 }
 
-}  // namespace
 // A piano frame adaptively sampled against full supersampling (--adaptive off): at most 0.5% of
 // pixels may differ by more than 2/255.
 TEST(PianoRender, AdaptiveSamplingStaysWithinFullSupersampling) {
-    const PianoPlayback play(forty_notes());
-    PianoOptions options;
-    options.hole_capacity = play.hole_capacity();
-    const PianoModel model = build_piano(options);
-    Scene scene = model.scene;
-    pose_piano(model, play.pose_at(1.25), &play.roll(), scene);
+    const Scene scene = pose_forty_notes(1.25).scene;
     TriangleAccel accel;
     accel.build(scene.positions, scene.tri_positions);
     // At 1280x720 the ink lines are wide enough to hide pixels, which take one sample.
@@ -191,13 +198,7 @@ TEST(PianoRender, AdaptiveSamplingStaysWithinFullSupersampling) {
         const ImageRgb8 a = adaptive.render(scene, accel, *scene.camera, settings);
         settings.adaptive = false;
         const ImageRgb8& b = full.render(scene, accel, *scene.camera, settings);
-        std::size_t differing = 0;
-        for (std::size_t i = 0; i < a.size(); ++i) {
-            bool differs = false;
-            for (int c = 0; c < 3; ++c) differs |= std::abs(a.data()[i][c] - b.data()[i][c]) > 2;
-            differing += differs;
-        }
-        const double share = static_cast<double>(differing) / static_cast<double>(a.size());
+        const double share = test_support::share_differing(a, b, 2);
         std::printf(
             "piano, %s, %dx%d: %.3f%% of pixels differ by more than 2/255; %.1f%% refined\n",
             mode == EdgeMode::Ink ? "ink" : "robust", c.width, c.height, 100 * share,
@@ -207,4 +208,5 @@ TEST(PianoRender, AdaptiveSamplingStaysWithinFullSupersampling) {
     }
 }
 
+}  // namespace
 }  // namespace toonray

@@ -12,6 +12,7 @@
 #include "toonray/render/renderer.h"
 #include "toonray/render/trace.h"
 #include "toonray/scene/obj_loader.h"
+#include "support/image_compare.h"
 #include "support/test_scenes.h"
 
 using namespace toonray;
@@ -57,18 +58,6 @@ struct SceneView {
 };
 
 Rgb8 bytes(const Vec3f& c) { return {to_byte(c.x), to_byte(c.y), to_byte(c.z)}; }
-
-// Share of pixels whose channels differ by more than `tolerance`.
-double share_differing(const ImageRgb8& a, const ImageRgb8& b, int tolerance) {
-    std::size_t n = 0;
-    for (std::size_t i = 0; i < a.size(); ++i)
-        for (int c = 0; c < 3; ++c)
-            if (std::abs(a.data()[i][c] - b.data()[i][c]) > tolerance) {
-                ++n;
-                break;
-            }
-    return static_cast<double>(n) / static_cast<double>(a.size());
-}
 
 }  // namespace
 
@@ -171,7 +160,7 @@ TEST(AdaptiveSampling, StaysWithinFullSupersampling) {
             const ImageRgb8 a = adaptive.render(s.scene, s.accel, s.camera, settings);
             settings.adaptive = false;
             const ImageRgb8& b = full.render(s.scene, s.accel, s.camera, settings);
-            const double differing = share_differing(a, b, 2);
+            const double differing = test_support::share_differing(a, b, 2);
             const double refined =
                 static_cast<double>(adaptive.refined_pixels()) / static_cast<double>(a.size());
             std::printf("%s %s: %.3f%% of pixels differ by more than 2/255; %.1f%% refined\n", name,
