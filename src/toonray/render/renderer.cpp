@@ -33,19 +33,6 @@ Rgb8 normal_colour(const Vec3f& n) {
     return {to_byte(n.x * 0.5f + 0.5f), to_byte(n.y * 0.5f + 0.5f), to_byte(n.z * 0.5f + 0.5f)};
 }
 
-// The depth feature image from each pixel's view depth: lighter is farther, scaled by the
-// farthest surface of the frame; 255 where nothing is seen.
-void depth_feature_image(const ImageF& depth, ImageGray8& out) {
-    const float z_max = largest_finite(depth);
-    out.reshape(depth.width(), depth.height());
-    for (std::size_t i = 0; i < depth.size(); ++i) {
-        const float z = depth.data()[i];
-        out.data()[i] = std::isfinite(z) && z_max > 0
-                            ? static_cast<std::uint8_t>(std::lround(z / z_max * 255.0f))
-                            : 255;
-    }
-}
-
 // Copies the pixels of `to_rect` from `from`, whose pixel (0, 0) is pixel (from_x0, from_y0) of
 // the frame, into the frame image `to`.
 template <typename T>
@@ -408,7 +395,9 @@ void Renderer::render_buckets(const Scene& scene, const TriangleAccel& accel, co
         }
     });
     refined_pixels_ = refined;
-    if (features) depth_feature_image(first_depth_, aovs_.depth);
+    // The depth feature image is classic's 8-bit depth map of the first samples' view depths:
+    // lighter is farther, scaled by the frame's farthest surface, 255 where nothing is seen.
+    if (features) classic_depth_map(first_depth_, aovs_.depth, settings.threads);
 }
 
 void Renderer::resolve_robust_bucket(const Bucket& bucket, BucketBuffers& b,
