@@ -34,6 +34,14 @@ struct DefaultInitAllocator : std::allocator<T> {
     }
 };
 
+/// v.resize(n), allocating exactly n when it grows (resize alone may take up to twice what is
+/// held), so that a buffer's size is what the frame memory estimates expect.
+template <typename Vector>
+void resize_exact(Vector& v, std::size_t n) {
+    if (n > v.capacity()) v.reserve(n);
+    v.resize(n);
+}
+
 template <typename T>
 class Image {
 public:
@@ -51,10 +59,7 @@ public:
     void reshape(int width, int height) {
         width_ = width;
         height_ = height;
-        const std::size_t n = static_cast<std::size_t>(width) * height;
-        // Exactly n when it grows (resize alone may take up to twice what is held).
-        if (n > pixels_.capacity()) pixels_.reserve(n);
-        pixels_.resize(n);
+        resize_exact(pixels_, static_cast<std::size_t>(width) * height);
     }
     [[nodiscard]] int width() const { return width_; }
     [[nodiscard]] int height() const { return height_; }

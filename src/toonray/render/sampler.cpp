@@ -47,18 +47,6 @@ PixelRect BucketGrid::bucket(int index) const {
             std::min(height, (cy + 1) * size)};
 }
 
-namespace {
-
-// v.resize(n), allocating exactly n when it grows (resize alone may take up to twice what is
-// held), so that the buffers' size is what frame_buffer_bytes expects.
-template <typename T>
-void resize_exact(std::vector<T>& v, std::size_t n) {
-    if (n > v.capacity()) v.reserve(n);
-    v.resize(n);
-}
-
-}  // namespace
-
 void SurfaceSamples::resize(std::size_t n) {
     resize_exact(colour, n);
     resize_exact(view_depth, n);
