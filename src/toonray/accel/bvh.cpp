@@ -134,7 +134,8 @@ struct Binner {
 
 
 // Adds one primitive to the bin of its centre on each axis; `off` holds the byte offsets of
-// those bins. The primitive's hi.w is 0, which the max leaves as it is; the count is added.
+// those bins. Lane 3 of a bin's hi is its count: the blend takes it from the integer add and
+// discards the max's lane 3.
 inline void bin_add(Bins& bins, const PrimRef& r, __m128i off) {
     char* boxes = reinterpret_cast<char*>(&bins.box[0][0]);
     const __m128i one = _mm_setr_epi32(0, 0, 0, 1);

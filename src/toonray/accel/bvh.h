@@ -43,8 +43,9 @@ struct Bvh {
     /// Builds with binned SAH on the boxes' centres: all three axes binned in one pass over the
     /// primitives, the large top levels binned and partitioned in parallel (TBB) and subtrees
     /// built as parallel tasks. Deterministic: the same input gives the same tree for any thread
-    /// count (work is cut at fixed sizes, merges are exact min/max and sums, and nodes are
-    /// numbered in a final depth-first pass).
+    /// count (work is cut at fixed sizes, merges are exact min/max and sums, and each subtree
+    /// task numbers its nodes in a chunk of its own; the chunks are joined in the order of their
+    /// first primitive, not of when they were made).
     [[nodiscard]] static Bvh build(std::span<const BBox> boxes, const Config& config) {
         return build(boxes, config, nullptr);
     }

@@ -123,8 +123,8 @@ void WideBvh::build(const Bvh& bvh, std::span<const float> leaf_areas,
     auto range = [&](std::uint32_t n) {
         return BvhNode{bvh.nodes[n].bounds, first_prim[n], prim_count[n]};
     };
-    // A triangle's box from its corners: only spread leaves need it, and their corners are read
-    // right after to pack them.
+    // A triangle's box from its corners: only spread leaves need it (one slot per triangle), so
+    // it is computed here rather than kept for every triangle.
     auto tri_box = [&](std::uint32_t p) {
         BBox box;
         for (std::uint32_t v : tris[p]) box.extend(positions[v]);
