@@ -311,16 +311,11 @@ int run(const Options& options) {
         const double ink1_s = time_frame(EdgeMode::Ink, inked1, 1);
 
         ink::InkLines lines;
-        std::vector<double> edges, visibility, chaining, drawing, total;
+        StageTimes stages;
         for (int i = 0; i <= repeats; ++i) {
             fresh_frame_lines(scene, accel, camera, options.width, options.height, lines);
             if (i == 0 && repeats > 0) continue;
-            edges.push_back(lines.timings.edges);
-            visibility.push_back(lines.timings.visibility);
-            chaining.push_back(lines.timings.chaining);
-            drawing.push_back(lines.timings.drawing);
-            total.push_back(lines.timings.edges + lines.timings.visibility +
-                            lines.timings.chaining + lines.timings.drawing);
+            stages.add(lines.timings);
         }
         if (options.quick) {
             ink::InkLines threaded;
@@ -337,10 +332,9 @@ int run(const Options& options) {
         ink::coverage_to_gray(lines.coverage, ink_gray);
         const int ink_specks = count_specks(ink_gray);
         const int robust_specks = count_specks(robust.aovs().edges);
-        fmt::print("| {} | {} | {} | {} | {} | {} | {:.2f} | {} | {} | {} | {} | {} / {} |\n",
+        fmt::print("| {} | {} | {} | {} | {} | {} | {:.2f} | {} | {} / {} |\n",
                    path.filename().string(), scene.triangle_count(), ms(classic_s), ms(robust_s),
-                   ms(ink_s), ms(ink1_s), ink1_s / classic_s, ms(median(edges)),
-                   ms(median(visibility)), ms(median(chaining)), ms(median(drawing)), robust_specks,
+                   ms(ink_s), ms(ink1_s), ink1_s / classic_s, stages.row(), robust_specks,
                    ink_specks);
         if (options.previous) {
             // As in an animation: the previous frame first, untimed, then this one with what
@@ -349,7 +343,8 @@ int run(const Options& options) {
             const Scene& before = previous.scene;
             const TriangleAccel& before_accel = previous.accel;
             const CameraSpec& before_camera = previous.camera;
-            std::vector<double> frame_t, edges_t, visibility_t, chaining_t, drawing_t;
+            std::vector<double> frame_t;
+            StageTimes stages_t;
             RenderSettings settings = file_options.settings;
             settings.edges = EdgeMode::Ink;
             settings.samples = 1;
@@ -366,16 +361,12 @@ int run(const Options& options) {
                 next_frame_lines(scene, accel, camera, options.width, options.height, animated);
                 if (i == 0 && repeats > 0) continue;
                 frame_t.push_back(frame_s);
-                edges_t.push_back(animated.timings.edges);
-                visibility_t.push_back(animated.timings.visibility);
-                chaining_t.push_back(animated.timings.chaining);
-                drawing_t.push_back(animated.timings.drawing);
+                stages_t.add(animated.timings);
             }
-            animation_rows.push_back(fmt::format(
-                "| {} after {} | {} | {:.2f} | {} | {} | {} | {} |", path.filename().string(),
-                options.previous->filename().string(), ms(median(frame_t)),
-                median(frame_t) / classic_s, ms(median(edges_t)), ms(median(visibility_t)),
-                ms(median(chaining_t)), ms(median(drawing_t))));
+            animation_rows.push_back(
+                fmt::format("| {} after {} | {} | {:.2f} | {} |", path.filename().string(),
+                            options.previous->filename().string(), ms(median(frame_t)),
+                            median(frame_t) / classic_s, stages_t.row()));
         }
         if (options.out) {
             fs::create_directories(*options.out);

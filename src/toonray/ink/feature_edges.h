@@ -103,13 +103,13 @@ struct PairCrossing {
     TriangleCrossing crossing;
 };
 
+/// The mesh edges of a welded mesh: which triangles' sides make each edge (feature_edges.cpp).
+struct MeshTopology;
+
 /// Intersection lines kept from one frame to the next: whether and where two triangles cross
 /// depends only on their corners, so a pair of triangles that both took part in the last frame
 /// and did not move (corners equal bit for bit) gives the same crossing; only pairs with another
 /// triangle are tested again. Between two frames of the piano most triangles do not move.
-/// The mesh edges of a welded mesh: which triangles' sides make each edge (feature_edges.cpp).
-struct MeshTopology;
-
 struct IntersectionCache {
     std::vector<std::array<Vec3f, 3>> corners;  ///< each triangle's corners in the last frame
     /// Per triangle: it took part in the last frame (without hidden lines, triangles turned
