@@ -121,9 +121,6 @@ inline DigitRun digit_run(std::uint64_t w) {
 /// ...), which the general path then reads; `end` (any bound past the line) only serves
 /// integer parts of 8 or more digits, which go to scan_short_decimal.
 inline bool read_number(const char*& pos, const char* end, float& out) {
-    static constexpr double kPow10[23] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,
-                                          1e8,  1e9,  1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
-                                          1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
     static constexpr double kPow10Negative[23] = {
         1e0,   1e-1,  1e-2,  1e-3,  1e-4,  1e-5,  1e-6,  1e-7,  1e-8,  1e-9,  1e-10, 1e-11,
         1e-12, 1e-13, 1e-14, 1e-15, 1e-16, 1e-17, 1e-18, 1e-19, 1e-20, 1e-21, 1e-22};
@@ -178,7 +175,7 @@ inline bool read_number(const char*& pos, const char* end, float& out) {
     const auto mantissa = static_cast<double>(static_cast<std::int64_t>(m));  // m < 10^15
     float v;
     if (power >= 0) {
-        if (!nearest_float(mantissa * kPow10[power], v)) return false;
+        if (!nearest_float(mantissa * kPowersOfTen[power], v)) return false;
     } else {
         // A division takes 3 to 4 times as long as a product, and its result is waited for:
         // multiplying by 10^-k, itself rounded, is within 2 units in the last place (ulp) of
@@ -187,7 +184,7 @@ inline bool read_number(const char*& pos, const char* end, float& out) {
         const double product = mantissa * kPow10Negative[-power];
         const auto low_bits = std::bit_cast<std::uint64_t>(product) & 0x1FFFFFFFu;
         if (low_bits - (0x10000000u - 8) <= 16) [[unlikely]] {
-            if (!nearest_float(mantissa / kPow10[-power], v)) return false;
+            if (!nearest_float(mantissa / kPowersOfTen[-power], v)) return false;
         } else {
             v = static_cast<float>(product);
         }

@@ -113,6 +113,11 @@ inline bool nearest_float(double d, float& out) {
     return true;
 }
 
+/// 10^0 to 10^22: every power of ten that is an exact double.
+inline constexpr double kPowersOfTen[23] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,
+                                            1e8,  1e9,  1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
+                                            1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
+
 /// The common case of OBJ numbers, "[-]ddd.ddd" with up to 15 significant digits and at most
 /// 15 decimals, parsed without from_chars. The mantissa m < 10^15 and 10^k are exact doubles,
 /// so m / 10^k rounds once to double, and nearest_float gives the float from_chars<float>
@@ -121,8 +126,6 @@ inline bool nearest_float(double d, float& out) {
 /// or the end of the token). Returns false, `p` unspecified, for anything else (exponents,
 /// longer numbers, the rare values nearest_float declines).
 inline bool scan_short_decimal(const char*& pos, const char* e, float& out) {
-    static constexpr double kPow10[16] = {1e0, 1e1, 1e2,  1e3,  1e4,  1e5,  1e6,  1e7,
-                                          1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15};
     const char* p = pos;  // a local cursor: the compiler keeps it in a register
     const bool negative = p < e && *p == '-';
     p += negative;
@@ -136,7 +139,7 @@ inline bool scan_short_decimal(const char*& pos, const char* e, float& out) {
     // Past 15 digits m may have wrapped, but then the result is not used.
     if (digits == 0 || digits > 15) return false;
     float v;
-    if (!nearest_float(static_cast<double>(m) / kPow10[decimals], v)) return false;
+    if (!nearest_float(static_cast<double>(m) / kPowersOfTen[decimals], v)) return false;
     out = negative ? -v : v;
     pos = p;
     return true;

@@ -2,7 +2,6 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_reduce.h>
-#include <tbb/task_arena.h>
 #include <tbb/task_group.h>
 
 #include <algorithm>
@@ -16,6 +15,7 @@
 #include <string>
 #include <unordered_map>
 
+#include "toonray/core/parallel.h"
 #include "toonray/core/simd_sse.h"
 #include "toonray/io/file.h"
 #include "toonray/scene/mtl_loader.h"
@@ -283,9 +283,10 @@ bool is_ignored_statement(std::string_view kw) {
 }
 
 /// A chunk of the padded zone read ahead by another thread (read_ahead), for ObjReader::merge:
-/// its plain v, vn, vt and f lines as elements in order, face indices as written (1-based,
-/// positive; checked at the merge), and marks where the other lines are, which the merge
-/// reads the general way in their place.
+/// its plain v, vn, vt and f lines as elements in order, face indices 0-based and not yet
+/// checked against what is defined (the need_* counts say what the merge must have; relative
+/// ones are not read ahead), and marks where the other lines are, which the merge reads the
+/// general way in their place.
 struct Chunk {
     /// Where a line is, and how many elements of each kind come before it in the chunk.
     struct Mark {
@@ -956,7 +957,7 @@ void parse_obj(std::string_view text, const std::filesystem::path& path, Scene& 
                Warnings& warnings, const ObjOptions& options) {
     // Chunks of a sixteenth of the text per thread, at least 64 KiB: enough for the threads to
     // meet near the middle, few enough that each is worth a thread's start.
-    const int threads = tbb::this_task_arena::max_concurrency();
+    const int threads = hardware_threads();
     const std::size_t chunk_bytes =
         std::max<std::size_t>(64 * 1024, text.size() / (16 * static_cast<std::size_t>(threads)));
     wavefront::parse_obj_in_chunks(text, path, scene, warnings, options, chunk_bytes, threads);
