@@ -21,6 +21,10 @@ bool is_comment(std::string_view s) {
 
 }  // namespace
 
+bool LineReader::continues(std::string_view physical) {
+    return ends_with_backslash(physical) && !is_comment(physical);
+}
+
 LineReader::LineReader(std::string_view text, std::string_view file, std::uint64_t max_line)
     : text_(text), file_(file), max_line_(max_line) {
     if (text_.size() >= 3 && std::memcmp(text_.data(), "\xEF\xBB\xBF", 3) == 0)
@@ -31,8 +35,7 @@ bool LineReader::next(std::string_view& line, std::size_t& line_number) {
     if (pos_ >= text_.size()) return false;
     line_number = ++physical_;
     std::string_view piece = take_physical();
-    // A comment is a whole line: "# C:\models\" must not swallow the next line.
-    if (!ends_with_backslash(piece) || is_comment(piece)) {
+    if (!continues(piece)) {
         line = piece;
         return true;
     }

@@ -34,6 +34,10 @@ public:
     /// Next logical line, or false at the end. `line_number` is the physical line it starts on.
     bool next(std::string_view& line, std::size_t& line_number);
 
+    /// Whether a physical line (without its line break) goes on into the next one: it ends in
+    /// a backslash and is not a comment ("# C:\models\" must not swallow the next line).
+    static bool continues(std::string_view physical);
+
     /// The unread text, for a caller that reads a line itself.
     [[nodiscard]] const char* cursor() const { return text_.data() + pos_; }
     [[nodiscard]] const char* end() const { return text_.data() + text_.size(); }

@@ -389,12 +389,10 @@ void read_ahead(Chunk& chunk, const char* padded_end, std::uint64_t max_line) {
         const char* last = p;
         while (*last != '\n' && *last != '\r') ++last;
         next = last + 1 + (*last == '\r' && last[1] == '\n');
-        const char* first = p;
-        while (first < last && is_blank(*first)) ++first;
-        if (last > p && last[-1] == '\\' && (first == last || *first != '#')) break;
-        if (p[0] == 'f' && std::memchr(p, '-', static_cast<std::size_t>(last - p))) break;
-        while (first < last && is_space(*first)) ++first;
-        if (static_cast<std::uint64_t>(last - p) <= max_line && (first == last || *first == '#')) {
+        const std::string_view line(p, static_cast<std::size_t>(last - p));
+        if (LineReader::continues(line)) break;
+        if (p[0] == 'f' && line.find('-') != std::string_view::npos) break;
+        if (line.size() <= max_line && Tokens(line).at_end()) {
             p = next;
             ++here.lines;
             continue;
