@@ -219,9 +219,6 @@ struct GoesLeft {
     [[nodiscard]] __m128i mask(__m128 centre) const {
         return _mm_cmplt_epi32(_mm_shuffle_epi32(bin(centre), A * 0x55), split);
     }
-    [[nodiscard]] bool operator()(__m128 centre) const {
-        return _mm_extract_epi32(bin(centre), A) < _mm_cvtsi128_si32(split);
-    }
     [[nodiscard]] __m128i bin(__m128 centre) const {
         return _mm_cvttps_epi32(_mm_mul_ps(_mm_sub_ps(centre, base), scale));
     }
@@ -300,7 +297,10 @@ struct Builder {
         return static_cast<float>((n + (1u << block_shift) - 1) >> block_shift);
     }
 
-    void bin(const Task& t, const Binner& binner, int bins, Bins& out) const {
+    // Bins t's primitives into `out`. A node of kParallelSplit primitives or more is binned in
+    // chunks of kChunk, whose bins are left in `chunk_bins` for its partition.
+    void bin(const Task& t, const Binner& binner, int bins, Bins& out,
+             std::vector<Bins>& chunk_bins) const {
         const std::size_t n = t.end - t.begin;
         const PrimRef* refs = buffers[t.buffer];
         out.clear(bins);
@@ -313,16 +313,16 @@ struct Builder {
             return;
         }
         const std::size_t chunks = (n + kChunk - 1) / kChunk;
-        std::vector<Bins> partial(chunks);
+        if (chunk_bins.size() < chunks) chunk_bins.resize(chunks);
         tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks, 1), [&](const auto& r) {
             for (std::size_t c = r.begin(); c != r.end(); ++c) {
-                partial[c].clear(bins);
+                chunk_bins[c].clear(bins);
                 const std::size_t b = t.begin + c * kChunk;
-                bin_range4(refs, b, std::min(b + kChunk, t.end), binner, bins, partial[c]);
+                bin_range4(refs, b, std::min(b + kChunk, t.end), binner, bins, chunk_bins[c]);
             }
         });
         // min/max and integer sums are exact: the merge order cannot change the result.
-        for (const Bins& p : partial) out.merge(p, bins);
+        for (std::size_t c = 0; c < chunks; ++c) out.merge(chunk_bins[c], bins);
     }
 
     [[nodiscard]] __m128 blocks4(__m128i n) const {
@@ -387,9 +387,11 @@ struct Builder {
     }
 
     // Moves t's range into the other buffer, the left side first (stable), several tasks when
-    // it is large; sets the children's buffer and centre bounds.
+    // it is large (chunk_bins: bin()'s bins of its chunks); sets the children's buffer and
+    // centre bounds.
     template <int A>
-    void partition_axis(const Task& t, const Binner& binner, const Split& s, Task& l, Task& r) {
+    void partition_axis(const Task& t, const Binner& binner, const Split& s,
+                        const std::vector<Bins>& chunk_bins, Task& l, Task& r) {
         const GoesLeft<A> left{binner.base, binner.scale, _mm_set1_epi32(s.bin)};
         const PrimRef* src = buffers[t.buffer];
         PrimRef* dst = buffers[1 - t.buffer];
@@ -400,24 +402,18 @@ struct Builder {
                             l.centres, r.centres);
             return;
         }
-        // In chunks: count each chunk's left side, then each chunk knows where its primitives go.
+        // In chunks: each chunk's left side is the count of its bins below the split, the
+        // primitives GoesLeft sends left, so each chunk knows where its primitives go.
         const std::size_t chunks = (n + kChunk - 1) / kChunk;
-        std::vector<std::size_t> left_count(chunks);
-        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks, 1), [&](const auto& range) {
-            for (std::size_t c = range.begin(); c != range.end(); ++c) {
-                const std::size_t b = t.begin + c * kChunk, e = std::min(b + kChunk, t.end);
-                std::size_t k = 0;
-                for (std::size_t i = b; i < e; ++i) k += left(_mm_add_ps(src[i].lo, src[i].hi));
-                left_count[c] = k;
-            }
-        });
         std::vector<std::size_t> left_at(chunks), right_at(chunks);
         std::size_t nl = 0, nr = 0;
         for (std::size_t c = 0; c < chunks; ++c) {
+            std::size_t left_count = 0;
+            for (int b = 0; b < s.bin; ++b) left_count += chunk_bins[c].count(A, b);
             left_at[c] = t.begin + nl;
             right_at[c] = t.begin + s.left_count + nr;
-            nl += left_count[c];
-            nr += std::min(kChunk, n - c * kChunk) - left_count[c];
+            nl += left_count;
+            nr += std::min(kChunk, n - c * kChunk) - left_count;
         }
         std::vector<Box4> lcs(chunks), rcs(chunks);
         tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks, 1), [&](const auto& range) {
@@ -432,11 +428,12 @@ struct Builder {
         }
     }
 
-    void partition(const Task& t, const Binner& binner, const Split& s, Task& l, Task& r) {
+    void partition(const Task& t, const Binner& binner, const Split& s,
+                   const std::vector<Bins>& chunk_bins, Task& l, Task& r) {
         switch (s.axis) {
-            case 0: partition_axis<0>(t, binner, s, l, r); break;
-            case 1: partition_axis<1>(t, binner, s, l, r); break;
-            default: partition_axis<2>(t, binner, s, l, r); break;
+            case 0: partition_axis<0>(t, binner, s, chunk_bins, l, r); break;
+            case 1: partition_axis<1>(t, binner, s, chunk_bins, l, r); break;
+            default: partition_axis<2>(t, binner, s, chunk_bins, l, r); break;
         }
     }
 
@@ -469,6 +466,7 @@ struct Builder {
     void build(Task root) {
         std::vector<Task> todo{root};
         Bins bins_storage;
+        std::vector<Bins> chunk_bins;  // of the large nodes, for their partitions
         while (!todo.empty()) {
             Task t = todo.back();
             todo.pop_back();
@@ -485,7 +483,7 @@ struct Builder {
             // there gave no better trees (measured on the test scenes).
             const int node_bins = n < 64 ? static_cast<int>(std::min<std::uint32_t>(n, 4)) : bins;
             Binner binner(t.centres, node_bins);
-            bin(t, binner, node_bins, bins_storage);
+            bin(t, binner, node_bins, bins_storage, chunk_bins);
             Split s = find_split(bins_storage, node_bins, n);
             const float leaf_cost = config.intersection_cost * blocks(n);
             std::size_t mid;
@@ -498,7 +496,7 @@ struct Builder {
                     make_leaf(t);
                     continue;
                 }
-                partition(t, binner, s, left, right);
+                partition(t, binner, s, chunk_bins, left, right);
                 mid = t.begin + s.left_count;
                 left.bounds = s.left;
                 right.bounds = s.right;
