@@ -17,13 +17,14 @@
 #include "toonray/scene/obj_loader.h"
 #include "toonray/scene/obj_writer.h"
 #include "support/image_compare.h"
+#include "support/same_bits.h"
 
 namespace toonray {
 namespace {
 
 namespace fs = std::filesystem;
 
-bool same_bits(const Vec3f& a, const Vec3f& b) { return std::memcmp(&a, &b, sizeof(Vec3f)) == 0; }
+using test_support::same_bits;
 
 // Forty overlapping notes over four seconds.
 Score forty_notes() {

@@ -12,12 +12,13 @@
 #include "toonray/render/renderer.h"
 #include "toonray/render/trace.h"
 #include "support/test_scenes.h"
+#include "support/same_bits.h"
 
 using namespace toonray;
 
 namespace {
 
-bool same_bits(const Vec3f& a, const Vec3f& b) { return std::memcmp(&a, &b, sizeof a) == 0; }
+using test_support::same_bits;
 
 // The teapot (no vertex normals) beside a fan with vertex normals, one of them zero (so
 // interpolation fails near it), and a degenerate triangle; two materials.

@@ -13,6 +13,7 @@
 #include "toonray/core/error.h"
 #include "toonray/scene/obj_fast_path.h"
 #include "toonray/scene/obj_loader.h"
+#include "support/same_bits.h"
 
 using namespace toonray;
 
@@ -36,12 +37,7 @@ Read read(const std::string& text, const ObjOptions& options, std::size_t chunk_
     return out;
 }
 
-template <typename T>
-bool same_bits(const std::vector<T>& a, const std::vector<T>& b) {
-    return a.size() == b.size() &&
-           (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
-}
-
+using test_support::same_bits;
 // Read on one thread, then in chunks of several sizes with several threads: all the same.
 // Returns the one-thread reading.
 Read expect_chunks_read_the_same(const std::string& text, const ObjOptions& options = {}) {

@@ -14,19 +14,14 @@
 #include "toonray/core/error.h"
 #include "toonray/scene/mtl_loader.h"
 #include "toonray/scene/obj_fast_path.h"
+#include "support/same_bits.h"
 
 using namespace toonray;
 namespace fs = std::filesystem;
 
 namespace {
 
-// Bit for bit: -0 and 0 differ.
-template <typename T>
-bool same_bits(const std::vector<T>& a, const std::vector<T>& b) {
-    return a.size() == b.size() &&
-           (a.empty() || std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0);
-}
-
+using test_support::same_bits;
 bool same_scene(const Scene& a, const Scene& b) {
     std::vector<std::string> names_a = a.objects, names_b = b.objects;
     for (const Material& m : a.materials) names_a.push_back(m.name + "/" + m.map_kd);
