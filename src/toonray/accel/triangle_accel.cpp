@@ -140,6 +140,16 @@ bool TriangleAccel::occluded(const Ray& ray) const {
 void TriangleAccel::intersect_tile(const Vec3f& origin, const Vec3f* dirs, int width, int height,
                                    Hit* hits, bool* found, float tmax) const {
     if (width <= 0 || height <= 0) return;
+    if (width <= kTileSize && height > kTileSize) {
+        // A narrow grid (a list of rays a few wide): its tiles are runs of whole rows, which
+        // lie next to each other in memory already.
+        for (int y0 = 0; y0 < height; y0 += kTileSize) {
+            const std::size_t at = static_cast<std::size_t>(y0) * width;
+            intersect_tile(origin, dirs + at, width, std::min(kTileSize, height - y0), hits + at,
+                           found + at, tmax);
+        }
+        return;
+    }
     if (width > kTileSize || height > kTileSize) {
         // Larger grids: tile them.
         for (int y0 = 0; y0 < height; y0 += kTileSize)

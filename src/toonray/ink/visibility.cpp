@@ -187,14 +187,9 @@ std::vector<EdgePiece> split_by_visibility(std::span<const FeatureSegment> segme
                         points[at] = seg.p0 + (seg.p1 - seg.p0) * c.t_of(sample_s(k));
                         dirs[at] = points[at] - view.eye();
                     }
-                    // The last sample repeats to the end of its row.
-                    for (std::size_t k = static_cast<std::size_t>(n); k < padded; ++k) {
-                        points[k] = points[k - 1];
-                        dirs[k] = dirs[k - 1];
-                    }
                     // A packet (one group of the tile) does not pay for itself on a short
-                    // segment: its rays one at a time, which find the same hits. Longer ones in
-                    // tiles of at most kTileSize rows, as the accelerator traces them.
+                    // segment: its rays one at a time, which find the same hits. Longer ones as
+                    // a grid kPacketWidth rays wide.
                     if (n <= kSingleRays) {
                         for (std::size_t k = 0; k < static_cast<std::size_t>(n); ++k) {
                             hits[k] = Hit{};
@@ -202,13 +197,14 @@ std::vector<EdgePiece> split_by_visibility(std::span<const FeatureSegment> segme
                                 Ray{view.eye(), dirs[k], 1.0f - settings.self_epsilon}, hits[k]);
                         }
                     } else {
-                        for (int row = 0; row < rows; row += TriangleAccel::kTileSize) {
-                            const std::size_t at = static_cast<std::size_t>(row) * kPacketWidth;
-                            context.accel.intersect_tile(
-                                view.eye(), dirs.data() + at, kPacketWidth,
-                                std::min(TriangleAccel::kTileSize, rows - row), hits.data() + at,
-                                found.get() + at, 1.0f - settings.self_epsilon);
+                        // The last sample repeats to the end of its row.
+                        for (std::size_t k = static_cast<std::size_t>(n); k < padded; ++k) {
+                            points[k] = points[k - 1];
+                            dirs[k] = dirs[k - 1];
                         }
+                        context.accel.intersect_tile(view.eye(), dirs.data(), kPacketWidth, rows,
+                                                     hits.data(), found.get(),
+                                                     1.0f - settings.self_epsilon);
                     }
                     for (int k = 0; k < n; ++k) {
                         const Hit& hit = hits[static_cast<std::size_t>(k)];
