@@ -132,6 +132,10 @@ TEST(Tile, MatchesSingleRaysAndBruteForceOnMeshes) {
             // Partial tiles, odd sizes.
             check_view(s, accel, view, 61, 37, 13, 5, 9);
             check_view(s, accel, view, 20, 20, 1, 1, 5);
+            // Grids narrower and taller than a tile (lists of rays a few wide), and wider and
+            // taller.
+            check_view(s, accel, view, 61, 37, 4, 37, 9);
+            check_view(s, accel, view, 61, 37, 61, 37, 9);
         }
     }
 }
