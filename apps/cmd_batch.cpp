@@ -19,7 +19,6 @@ struct BatchArgs {
     bool resume = false, fail_fast = false, quiet = false;
     RenderArgs render;
     GltfArgs gltf;
-    SceneArgs scene;
     SvgArgs svg;
 
     void add_to(CLI::App& app) {
@@ -64,7 +63,7 @@ int run_batch(const BatchArgs& args, const CLI::App& command) {
     if (!args.pattern.empty()) options.input_pattern = args.pattern;
     if (!args.output_pattern.empty()) options.output_pattern = args.output_pattern;
     options.render = args.render.resolve();
-    options.auto_smooth = args.scene.auto_smooth_angle();
+    options.scene = args.render.scene_setup();
     args.svg.apply(options.render, true);
     options.jobs = args.jobs;
     options.resume = args.resume;
@@ -96,7 +95,6 @@ Subcommand add_batch_command(CLI::App& app, LimitArgs& limit_args) {
     args->add_to(*batch);
     args->render.add_to(*batch);
     args->gltf.add_to(*batch, false);
-    args->scene.add_to(*batch);
     args->svg.add_to(*batch, true);
     limit_args.add_to(*batch);
     return {batch, [args, batch] { return run_batch(*args, *batch); }};

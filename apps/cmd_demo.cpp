@@ -51,6 +51,7 @@ int run_demo(const DemoArgs& args, const CLI::App& command) {
     options.seconds = args.full ? std::optional<double>() : std::optional<double>(piano.seconds);
     options.soundfont = piano.soundfont;
     options.movie.render = args.render.resolve();
+    options.movie.scene = args.render.scene_setup();
     args.svg.apply(options.movie.render, true);
     options.movie.start = piano.start;
     options.movie.fps = piano.fps;

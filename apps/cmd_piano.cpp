@@ -56,6 +56,7 @@ int run_piano(const PianoCommandArgs& args, const CLI::App& command) {
     if (!piano.export_obj.empty()) options.export_obj_dir = piano.export_obj;
     if (piano.seconds > 0) options.seconds = piano.seconds;
     options.render = args.render.resolve();
+    options.scene = args.render.scene_setup();
     args.svg.apply(options.render, true);
     std::optional<AudioOptions> audio_opts;  // checked before the frames are rendered
     if (!piano.audio.empty()) audio_opts = audio_options(score, piano, options.seconds);

@@ -5,7 +5,7 @@
 #include <optional>
 #include <string>
 
-#include "toonray/anim/gltf_animation.h"
+#include "toonray/scene/gltf_animation.h"
 
 namespace toonray::cli {
 

@@ -9,7 +9,7 @@
 #include "toonray/anim/piano_movie.h"
 #include "toonray/core/limits.h"
 #include "toonray/core/parse.h"
-#include "toonray/frame/lights.h"
+#include "toonray/scene/light.h"
 #include "toonray/ink/line_style.h"
 #include "toonray/io/file.h"
 #include "toonray/score/score_io.h"
@@ -40,6 +40,11 @@ void RenderArgs::add_to(CLI::App& app) {
         ->check(CLI::Range(0.0f, 0.99f))
         ->capture_default_str();
     app.add_flag("--no-textures", no_textures, "Ignore map_Kd textures");
+    app.add_option("--auto-smooth", auto_smooth,
+                   "Smooth normals for meshes without vertex normals: faces meeting at less than "
+                   "ANGLE degrees shade as one smooth surface, sharper edges stay creases "
+                   "(as Blender's auto-smooth; default off)")
+        ->check(CLI::Range(0.0f, 180.0f));
     app.add_option("--camera", camera,
                    "Camera ex,ey,ez,gx,gy,gz,ux,uy,uz: eye, gaze point, up; overrides the "
                    "file's camera block (default: the block, else a camera framing the scene)");
@@ -136,10 +141,11 @@ void RenderArgs::add_ink_style_options(CLI::App& app) {
 }
 
 void RenderArgs::resolve_ink_style(FrameOptions& options) const {
-    options.settings.line_taper = line_taper;
-    options.settings.line_width_by_depth = line_width_by_depth;
+    options.settings.lines.ink.taper = line_taper;
+    options.settings.lines.ink.width_by_depth = line_width_by_depth;
     if (!line_style.empty())
-        options.settings.line_styles = ink::parse_line_styles(read_file(line_style), line_style);
+        options.settings.lines.ink.styles =
+            ink::parse_line_styles(read_file(line_style), line_style);
 }
 
 FrameOptions RenderArgs::resolve() const {
@@ -147,53 +153,49 @@ FrameOptions RenderArgs::resolve() const {
     ImageSize s = parse_image_size(size, "--size");
     o.settings.width = s.width;
     o.settings.height = s.height;
-    for (const std::string& l : lights)
-        o.settings.shading.lights.push_back(with_flag("--light", [&] { return parse_light(l); }));
-    if (!lights_file.empty()) {
-        auto from_file = load_lights(lights_file);
-        o.settings.shading.lights.insert(o.settings.shading.lights.end(), from_file.begin(),
-                                         from_file.end());
-    }
     if (!ramp.empty())
         o.settings.shading.ramp = with_flag("--ramp", [&] { return parse_ramp(ramp); });
     o.settings.shading.shadows = shadows;
     o.settings.shading.specular = specular;
     o.settings.shading.rim = rim;
     o.settings.shading.textures = !no_textures;
-    if (!camera.empty())
-        o.camera = with_flag("--camera", [&] { return parse_camera_spec(camera); });
     o.settings.background = parse_colour(background, "--background");
-    o.settings.edges = edges == "classic" ? EdgeMode::Classic
-                                          : (edges == "ink" ? EdgeMode::Ink : EdgeMode::Robust);
+    o.settings.lines.mode = parse_line_mode(edges, "--edges");
     o.settings.lines.types = with_flag("--lines", [&] { return parse_line_types(lines); });
     o.settings.lines.crease_angle = crease_angle;
-    o.settings.lines.depth_threshold = depth_step;
+    o.settings.lines.robust.depth_step = depth_step;
     o.settings.lines.width = line_width;
     o.settings.lines.colour = parse_colour(line_colour, "--line-color");
-    o.settings.samples = samples;
-    o.settings.adaptive = adaptive == "on";
-    o.settings.tile_size = tile_size;
-    o.settings.depth_threshold = depth_threshold;
-    o.settings.normal_threshold = normal_threshold;
+    o.settings.sampling.samples = samples;
+    o.settings.sampling.adaptive = adaptive == "on";
+    o.settings.sampling.tile_size = tile_size;
+    o.settings.lines.classic.depth_threshold = depth_threshold;
+    o.settings.lines.classic.normal_threshold = normal_threshold;
     o.settings.threads = threads;
     o.bvh.max_leaf_size = leaf_size;
     o.png.level = png_level;
     if (!aov_dir.empty()) o.aov_dir = aov_dir;
     if (!aov_exr.empty()) o.aov_exr = aov_exr;
     resolve_ink_style(o);
+    with_flag("--lines", [&] { check_line_settings(o.settings.lines); });
     return o;
 }
 
-void SceneArgs::add_to(CLI::App& app) {
-    app.add_option("--auto-smooth", auto_smooth,
-                   "Smooth normals for meshes without vertex normals: faces meeting at less than "
-                   "ANGLE degrees shade as one smooth surface, sharper edges stay creases "
-                   "(as Blender's auto-smooth; default off)")
-        ->check(CLI::Range(0.0f, 180.0f));
-}
-
-std::optional<float> SceneArgs::auto_smooth_angle() const {
-    return auto_smooth >= 0.0f ? std::optional<float>(auto_smooth) : std::nullopt;
+SceneSetup RenderArgs::scene_setup() const {
+    SceneSetup setup;
+    const ImageSize s = parse_image_size(size, "--size");
+    setup.width = s.width;
+    setup.height = s.height;
+    if (auto_smooth >= 0.0f) setup.auto_smooth = auto_smooth;
+    for (const std::string& l : lights)
+        setup.lights.push_back(with_flag("--light", [&] { return parse_light(l); }));
+    if (!lights_file.empty()) {
+        auto from_file = load_lights(lights_file);
+        setup.lights.insert(setup.lights.end(), from_file.begin(), from_file.end());
+    }
+    if (!camera.empty())
+        setup.camera = with_flag("--camera", [&] { return parse_camera_spec(camera); });
+    return setup;
 }
 
 void SvgArgs::add_to(CLI::App& app, bool per_frame) {

@@ -29,13 +29,13 @@ struct RenderArgs {
     float depth_threshold = 8.0f;
     float normal_threshold = 4.0f;
     std::string lines = "all";
-    float crease_angle = RobustLineSettings{}.crease_angle;
-    float depth_step = RobustLineSettings{}.depth_threshold;
-    float line_width = RobustLineSettings{}.width;
+    float crease_angle = LineSettings{}.crease_angle;
+    float depth_step = RobustLineSettings{}.depth_step;
+    float line_width = LineSettings{}.width;
     std::string line_colour = "0,0,0";
-    int samples = RenderSettings{}.samples;
+    int samples = SamplingSettings{}.samples;
     std::string adaptive = "on";
-    int tile_size = RenderSettings{}.tile_size;
+    int tile_size = SamplingSettings{}.tile_size;
     int threads = 0;
     int leaf_size = Bvh::Config{}.max_leaf_size;
     int png_level = PngOptions{}.level;
@@ -46,8 +46,13 @@ struct RenderArgs {
     float line_taper = 0.0f;
     bool line_width_by_depth = false;
 
+    float auto_smooth = -1.0f;  ///< degrees; below 0: off
+
     void add_to(CLI::App& app);
     [[nodiscard]] FrameOptions resolve() const;
+    /// Auto-smooth, the lights given (--light, --lights) and the camera (--camera), for an
+    /// image of --size.
+    [[nodiscard]] SceneSetup scene_setup() const;
 
 private:
     void add_ink_style_options(CLI::App& app);
@@ -64,15 +69,6 @@ struct SvgArgs {
     /// Sets options.svg (or svg_dir), svg_hidden, svg_fill; Error for --hidden-lines or
     /// --svg-fill without --svg.
     void apply(FrameOptions& options, bool per_frame) const;
-};
-
-/// Options of render and batch that change the scene as loaded.
-struct SceneArgs {
-    float auto_smooth = -1.0f;  ///< degrees; below 0: off
-
-    void add_to(CLI::App& app);
-    /// The auto-smooth angle when asked for.
-    [[nodiscard]] std::optional<float> auto_smooth_angle() const;
 };
 
 /// Limits on what inputs may ask for (docs/robustness.md), as text until validated.

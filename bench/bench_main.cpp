@@ -44,7 +44,9 @@
 #include "toonray/io/png.h"
 #include "toonray/render/classic.h"
 #include "toonray/frame/frame_renderer.h"
+#include "toonray/render/look.h"
 #include "toonray/render/renderer.h"
+#include "toonray/render/shade_samples.h"
 #include "toonray/scene/obj_loader.h"
 
 extern char** environ;
@@ -144,42 +146,49 @@ void for_each_pixel(int w, int h, int threads, const Body& body) {
     });
 }
 
-// The renderer's per-sample shading stage (shade_tile: shading normal, light, cel band,
-// G-buffer writes) on stored rays and hits, so shading is timed apart from traversal. They are
-// handed over in the renderer's 16 x 16 tiles, as trace_primary does; the G-buffer must come out
-// bit-equal to Renderer's, which is checked before anything is timed.
+// The renderer's per-sample stage (shade_samples and the cel look: shading normal, light
+// terms, band, colour) on stored rays and hits, so shading is timed apart from traversal. They
+// are handed over row by row of the renderer's 16 x 16 tiles; the surface records must come out
+// bit-equal to the renderer's layers, which is checked before anything is timed.
 void shade(const Scene& scene, const TriangleAccel& accel, const ViewPlane& view,
-           const Vec3f& light, const RenderSettings& settings, const std::vector<Vec3f>& ray_dirs,
-           const std::vector<Hit>& hits, GBuffer& g, int threads) {
+           const std::vector<Light>& lights, const RenderSettings& settings,
+           const std::vector<Vec3f>& ray_dirs, const std::vector<Hit>& hits, SurfaceSamples& out,
+           int threads) {
     const int w = settings.width, h = settings.height;
-    const std::vector<Light> lights{Light{Light::Kind::Point, light, 1.0f}};  // as Renderer::render
     const ShadingContext ctx{scene, accel, settings.shading, lights, nullptr};
-    prepare_gbuffer(g, w, h, 1, settings.edges);
+    const LookFrame look{scene, settings.shading, settings.background, false};
+    out.resize(static_cast<std::size_t>(w) * h, SurfaceFields::Geometry, 1);
     const int tiles_x = (w + kTile - 1) / kTile, tiles_y = (h + kTile - 1) / kTile;
     parallel_for(tiles_x * tiles_y, 1, threads, [&](int begin, int end) {
-        std::array<Vec3f, kTile * kTile> dirs;
-        std::array<Hit, kTile * kTile> tile_hits;
-        std::array<bool, kTile * kTile> found;
+        std::array<bool, kTile> found;
         for (int tile = begin; tile < end; ++tile) {
-            SampleTile t{};
-            t.x0 = (tile % tiles_x) * kTile;
-            t.y0 = (tile / tiles_x) * kTile;
-            t.x1 = std::min(t.x0 + kTile, w);
-            t.y1 = std::min(t.y0 + kTile, h);
-            int i = 0;
-            for (int y = t.y0; y < t.y1; ++y)
-                for (int x = t.x0; x < t.x1; ++x, ++i) {
-                    dirs[i] = ray_dirs[static_cast<std::size_t>(y) * w + x];
-                    tile_hits[i] = hits[static_cast<std::size_t>(y) * w + x];
-                    found[i] = tile_hits[i].valid();
-                }
-            t.dirs = dirs.data();
-            t.hits = tile_hits.data();
-            t.found = found.data();
-            shade_tile(ctx, view, settings, t, g);
+            const int x0 = (tile % tiles_x) * kTile, y0 = (tile / tiles_x) * kTile;
+            const int x1 = std::min(x0 + kTile, w), y1 = std::min(y0 + kTile, h);
+            for (int y = y0; y < y1; ++y) {
+                const std::size_t row = static_cast<std::size_t>(y) * w + x0;
+                for (int x = x0; x < x1; ++x) found[x - x0] = hits[row + (x - x0)].valid();
+                shade_samples(ctx, view, x1 - x0, ray_dirs.data() + row, hits.data() + row,
+                              found.data(), out, row);
+                apply_look(look, out, row, row + static_cast<std::size_t>(x1 - x0));
+            }
         }
     });
 }
+
+// The per-pixel images the classic line stages read, from the shaded samples.
+struct ClassicInputs {
+    ImageF distance;
+    Image<Vec3f> normal, colour;
+
+    void fill(const SurfaceSamples& s, int w, int h) {
+        distance.reshape(w, h);
+        normal.reshape(w, h);
+        colour.reshape(w, h);
+        std::copy(s.distance.begin(), s.distance.end(), distance.data());
+        std::copy(s.normal.begin(), s.normal.end(), normal.data());
+        std::copy(s.colour.begin(), s.colour.end(), colour.data());
+    }
+};
 
 template <typename T>
 bool same_bytes(const Image<T>& a, const Image<T>& b) {
@@ -476,9 +485,13 @@ SceneResult bench_scene(const fs::path& path, const Options& opt) {
     fro.settings.height = h;
     // The classic line pipeline (Sobel on 8-bit maps, merge, blur): the stages this benchmark
     // times one by one. Explicit, so a change of the default line mode does not change it.
-    fro.settings.edges = EdgeMode::Classic;
-    const CameraSpec camera = choose_camera(scene, fro);
+    fro.settings.lines.mode = LineMode::Classic;
+    SceneSetup setup;
+    setup.width = w;
+    setup.height = h;
+    const CameraSpec camera = choose_camera(scene, setup);
     const ViewPlane view = make_view_plane(camera, w, h);
+    const std::vector<Light> lights{default_light(scene, camera)};
 
     // 2. Hits: against brute force on a sample, and against Embree on every pixel.
     const int stride = opt.quick ? 16 : 20;
@@ -512,25 +525,31 @@ SceneResult bench_scene(const fs::path& path, const Options& opt) {
         });
     };
     Renderer renderer;
-    GBuffer g;
-    const Vec3f light = default_light(scene, view);
+    SurfaceSamples g;
     bool shade_ok = true;
     for (int threads : {1, 0}) {
         settings.threads = threads;
-        renderer.render(scene, accel, camera, settings);
+        settings.layers = true;
+        renderer.render(scene, accel, camera, lights, settings);
+        settings.layers = false;
         trace(threads);
-        shade(scene, accel, view, light, settings, dirs, hits, g, threads);
-        const GBuffer& r = renderer.gbuffer();
-        shade_ok = shade_ok && same_bytes(g.distance, r.distance) &&
-                   same_bytes(g.normal, r.normal) && same_bytes(g.colour, r.colour) &&
-                   same_bytes(g.material, r.material) && same_bytes(g.object, r.object);
+        shade(scene, accel, view, lights, settings, dirs, hits, g, threads);
+        const FrameLayers& r = renderer.layers();
+        for (std::size_t i = 0; i < g.size(); ++i) {
+            const Rgb8 colour{to_byte(g.colour[i].x), to_byte(g.colour[i].y),
+                              to_byte(g.colour[i].z)};
+            shade_ok = shade_ok && g.distance[i] == r.distance.data()[i] &&
+                       std::memcmp(&g.normal[i], &r.normal.data()[i], sizeof(Vec3f)) == 0 &&
+                       g.object[i] == r.object.data()[i] && g.band[i] == r.band.data()[i] &&
+                       colour == r.cel.data()[i];
+        }
     }
     if (shade_ok)
-        rep += "- shade: shade_tile on stored hits is bit-equal to the renderer's G-buffer\n";
+        rep += "- shade: shade_samples on stored hits is bit-equal to the renderer's layers\n";
     else
         fail(
-            "shading stored hits through shade_tile differs from Renderer's G-buffer: the bench's "
-            "rays or tiles no longer match trace_primary's; update shade() in bench/bench_main.cpp");
+            "shading stored hits through shade_samples differs from Renderer's layers: the bench's "
+            "rays or tiles no longer match the sampler's; update shade() in bench/bench_main.cpp");
     if (opt.quick || !result.correct) return result;
 
     // 4. Timings.
@@ -587,25 +606,26 @@ SceneResult bench_scene(const fs::path& path, const Options& opt) {
     }
 
     auto [shade1, shadeN] = time_pair(
-        R, [&] { shade(scene, accel, view, light, settings, dirs, hits, g, 1); },
-        [&] { shade(scene, accel, view, light, settings, dirs, hits, g, 0); });
-    rows.push_back(
-        {"shade (normal, cel band, G-buffer)", shade1, shadeN, "per pixel, after trace"});
+        R, [&] { shade(scene, accel, view, lights, settings, dirs, hits, g, 1); },
+        [&] { shade(scene, accel, view, lights, settings, dirs, hits, g, 0); });
+    rows.push_back({"shade (surface record, cel look)", shade1, shadeN, "per pixel, after trace"});
 
-    Aovs a;
-    ImageRgb8 composed;
+    ClassicInputs in;
+    in.fill(g, w, h);
+    ImageGray8 depth_map, edges_depth, edges_normal, all_edges;
+    ImageRgb8 normal_map, composed, cel;
     auto maps = [&](int t) {
-        classic_depth_map(g.distance, a.depth, t);
-        classic_normal_map(g.normal, g.distance, a.normal, t);
+        classic_depth_map(in.distance, depth_map, t);
+        classic_normal_map(in.normal, in.distance, normal_map, t);
     };
     auto sobel = [&](int t) {
-        sobel_edges(a.depth, settings.depth_threshold, a.edges_depth, t);
-        sobel_edges(a.normal, settings.normal_threshold, a.edges_normal, t);
+        sobel_edges(depth_map, settings.lines.classic.depth_threshold, edges_depth, t);
+        sobel_edges(normal_map, settings.lines.classic.normal_threshold, edges_normal, t);
     };
     auto blur = [&](int t) {
-        merge_edges(a.edges_depth, a.edges_normal, a.edges);
-        compose_lines(g.colour, a.edges, composed, t,
-                      &a.cel);  // with the cel AOV, as the renderer does
+        merge_edges(edges_depth, edges_normal, all_edges);
+        compose_lines(in.colour, all_edges, composed, t,
+                      &cel);  // with the cel layer, as the renderer does
     };
     auto edges = [&](int t) {
         maps(t);
@@ -626,26 +646,26 @@ SceneResult bench_scene(const fs::path& path, const Options& opt) {
         "Renderer::render (trace to final image)",
         [&](int t) {
             settings.threads = t;
-            renderer.render(scene, accel, camera, settings);
+            renderer.render(scene, accel, camera, lights, settings);
         },
-        "includes the cel AOV copy");
+        "without layers");
     // For scale: the default line mode (ink) and robust lines, which this table does not break
     // into stages (ink.md and sampling.md do).
-    for (const EdgeMode mode : {EdgeMode::Ink, EdgeMode::Robust}) {
+    for (const LineMode mode : {LineMode::Ink, LineMode::Robust}) {
         RenderSettings other = settings;
-        other.edges = mode;
+        other.lines.mode = mode;
         Renderer other_renderer;
         both(
-            mode == EdgeMode::Ink ? "  (Renderer::render, ink lines: the default)"
+            mode == LineMode::Ink ? "  (Renderer::render, ink lines: the default)"
                                   : "  (Renderer::render, robust lines)",
             [&](int t) {
                 other.threads = t;
-                other_renderer.render(scene, accel, camera, other);
+                other_renderer.render(scene, accel, camera, lights, other);
             },
-            fmt::format("{} samples per pixel, adaptive", other.samples));
+            fmt::format("{} samples per pixel, adaptive", other.sampling.samples));
     }
 
-    const ImageRgb8& image = renderer.render(scene, accel, camera, settings);
+    const ImageRgb8& image = renderer.render(scene, accel, camera, lights, settings);
     const auto* pixels = image.data()->data();
     std::size_t ours_size = 0, libpng_size = 0;
     auto [png_ours, png_lib] = time_pair(
@@ -667,8 +687,11 @@ SceneResult bench_scene(const fs::path& path, const Options& opt) {
         Scene loaded;
         Warnings ws;
         load_obj(path, loaded, ws);
+        SceneFrame loaded_frame;
+        loaded_frame.scene = std::move(loaded);
+        finish_scene(loaded_frame, {}, setup);
         FrameRenderer fr;
-        fr.render(loaded, choose_camera(loaded, o), frame_png, o, ws);
+        fr.render(loaded_frame, frame_png, o, ws);
     };
     both("frame in-process (FrameRenderer, OBJ to PNG)", frame, "load, build, render, write");
 

@@ -205,6 +205,7 @@ struct BenchScene {
     Scene scene;
     TriangleAccel accel;
     CameraSpec camera;
+    std::vector<Light> lights;
 };
 
 BenchScene load_bench_scene(const fs::path& path, const FrameOptions& file_options) {
@@ -212,7 +213,11 @@ BenchScene load_bench_scene(const fs::path& path, const FrameOptions& file_optio
     Warnings warnings;
     load_obj(path, out.scene, warnings);
     out.accel.build(out.scene.positions, out.scene.tri_positions);
-    out.camera = choose_camera(out.scene, file_options);
+    SceneSetup setup;
+    setup.width = file_options.settings.width;
+    setup.height = file_options.settings.height;
+    out.camera = choose_camera(out.scene, setup);
+    out.lights = {default_light(out.scene, out.camera)};
     return out;
 }
 
@@ -270,6 +275,7 @@ int run(const Options& options) {
         const Scene& scene = loaded.scene;
         const TriangleAccel& accel = loaded.accel;
         const CameraSpec& camera = loaded.camera;
+        const std::vector<Light>& lights = loaded.lights;
         const int repeats = options.quick ? 1 : options.repeats;
 
         // Whole frames on one thread: trace, shade, lines, compose.
@@ -285,30 +291,31 @@ int run(const Options& options) {
         flush.add_triangle({0, 1, 2}, 0, 0);
         TriangleAccel flush_accel;
         flush_accel.build(flush.positions, flush.tri_positions);
-        auto time_frame = [&](EdgeMode mode, Renderer& renderer,
-                              int samples = RenderSettings{}.samples) {
+        auto time_frame = [&](LineMode mode, Renderer& renderer,
+                              int samples = SamplingSettings{}.samples) {
             RenderSettings settings = file_options.settings;
-            settings.edges = mode;
-            settings.samples = samples;
+            settings.lines.mode = mode;
+            settings.sampling.samples = samples;
             settings.threads = 1;
             std::vector<double> t;
             for (int i = 0; i <= repeats; ++i) {
-                if (mode == EdgeMode::Ink) renderer.render(flush, flush_accel, camera, settings);
+                if (mode == LineMode::Ink)
+                    renderer.render(flush, flush_accel, camera, lights, settings);
                 const auto start = Clock::now();
-                renderer.render(scene, accel, camera, settings);
+                renderer.render(scene, accel, camera, lights, settings);
                 if (i > 0 || repeats == 0)
                     t.push_back(std::chrono::duration<double>(Clock::now() - start).count());
             }
-            settings.feature_images = true;
-            renderer.render(scene, accel, camera, settings);
+            settings.layers = true;
+            renderer.render(scene, accel, camera, lights, settings);
             return median(t);
         };
         Renderer classic, robust, inked;
-        const double classic_s = time_frame(EdgeMode::Classic, classic);
-        const double robust_s = time_frame(EdgeMode::Robust, robust);
-        const double ink_s = time_frame(EdgeMode::Ink, inked);
+        const double classic_s = time_frame(LineMode::Classic, classic);
+        const double robust_s = time_frame(LineMode::Robust, robust);
+        const double ink_s = time_frame(LineMode::Ink, inked);
         Renderer inked1;
-        const double ink1_s = time_frame(EdgeMode::Ink, inked1, 1);
+        const double ink1_s = time_frame(LineMode::Ink, inked1, 1);
 
         ink::InkLines lines;
         StageTimes stages;
@@ -331,7 +338,9 @@ int run(const Options& options) {
         ImageGray8 ink_gray;
         ink::coverage_to_gray(lines.coverage, ink_gray);
         const int ink_specks = count_specks(ink_gray);
-        const int robust_specks = count_specks(robust.aovs().edges);
+        ImageGray8 robust_gray;
+        ink::coverage_to_gray(robust.layers().lines, robust_gray);
+        const int robust_specks = count_specks(robust_gray);
         fmt::print("| {} | {} | {} | {} | {} | {} | {:.2f} | {} | {} / {} |\n",
                    path.filename().string(), scene.triangle_count(), ms(classic_s), ms(robust_s),
                    ms(ink_s), ms(ink1_s), ink1_s / classic_s, stages.row(), robust_specks,
@@ -346,15 +355,15 @@ int run(const Options& options) {
             std::vector<double> frame_t;
             StageTimes stages_t;
             RenderSettings settings = file_options.settings;
-            settings.edges = EdgeMode::Ink;
-            settings.samples = 1;
+            settings.lines.mode = LineMode::Ink;
+            settings.sampling.samples = 1;
             settings.threads = 1;
             Renderer renderer;
             ink::InkLines animated;
             for (int i = 0; i <= repeats; ++i) {
-                renderer.render(before, before_accel, before_camera, settings);
+                renderer.render(before, before_accel, before_camera, previous.lights, settings);
                 auto start = Clock::now();
-                renderer.render(scene, accel, camera, settings);
+                renderer.render(scene, accel, camera, lights, settings);
                 const double frame_s = std::chrono::duration<double>(Clock::now() - start).count();
                 ink::draw_ink_lines(before, before_accel, before_camera, options.width,
                                     options.height, {}, 1, animated);
@@ -372,11 +381,11 @@ int run(const Options& options) {
             fs::create_directories(*options.out);
             const std::string stem = path.stem().string();
             RenderSettings settings = file_options.settings;
-            settings.edges = EdgeMode::Ink;
+            settings.lines.mode = LineMode::Ink;
             write_png(*options.out / (stem + "_ink.png"),
-                      inked.render(scene, accel, camera, settings));
+                      inked.render(scene, accel, camera, lights, settings));
             write_png(*options.out / (stem + "_ink_edges.png"), ink_gray);
-            write_png(*options.out / (stem + "_robust_edges.png"), robust.aovs().edges);
+            write_png(*options.out / (stem + "_robust_edges.png"), robust_gray);
             ink::SvgSettings svg;
             svg.width = options.width;
             svg.height = options.height;

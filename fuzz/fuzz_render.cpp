@@ -20,6 +20,7 @@
 #include "toonray/accel/triangle_accel.h"
 #include "toonray/core/error.h"
 #include "toonray/render/renderer.h"
+#include "toonray/scene/light.h"
 #include "toonray/scene/obj_loader.h"
 
 using namespace toonray;
@@ -125,6 +126,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     }
     TriangleAccel accel;
     accel.build(scene.positions, scene.tri_positions);
+    const std::vector<Light> lights{default_light(scene, camera)};
 
     IsaGuard restore_default_kernels;
     std::vector<Hit> reference_hits;
@@ -134,12 +136,12 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         FUZZ_CHECK(set_accel_isa(isa));
         check_hits(scene, accel, view, reference_hits);
         int m = 0;
-        for (EdgeMode mode : {EdgeMode::Classic, EdgeMode::Robust}) {
-            settings.edges = mode;
+        for (LineMode mode : {LineMode::Classic, LineMode::Robust}) {
+            settings.lines.mode = mode;
             // The first instruction set also computes the feature images: the others, without
             // them, must give the same final image.
-            settings.feature_images = reference_images[m].width() == 0;
-            const ImageRgb8& image = renderer.render(scene, accel, camera, settings);
+            settings.layers = reference_images[m].width() == 0;
+            const ImageRgb8& image = renderer.render(scene, accel, camera, lights, settings);
             FUZZ_CHECK(image.width() == settings.width && image.height() == settings.height);
             ImageRgb8& reference = reference_images[m++];
             if (reference.width() == 0) {

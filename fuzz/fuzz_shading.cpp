@@ -6,7 +6,7 @@
 
 #include "fuzz_util.h"
 #include "toonray/core/error.h"
-#include "toonray/frame/lights.h"
+#include "toonray/scene/light.h"
 #include "toonray/render/shading.h"
 
 using namespace toonray;
@@ -22,11 +22,13 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
                            ramp.thresholds.size() + 1 == ramp.levels.size());
                 for (float d : {-1.0f, 0.0f, 0.3f, 1.0f, 2.0f})
                     FUZZ_CHECK(std::isfinite(ramp.level(d)));
+                FUZZ_CHECK(parse_ramp(format_ramp(ramp)) == ramp);
                 break;
             }
             case 1: {
                 Light l = parse_light(text);
                 FUZZ_CHECK(is_finite(l.vector) && std::isfinite(l.intensity) && l.intensity >= 0);
+                FUZZ_CHECK(parse_light(format_light(l)) == l);
                 break;
             }
             case 2: {

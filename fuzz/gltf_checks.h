@@ -7,7 +7,7 @@
 #include <span>
 
 #include "fuzz_util.h"
-#include "toonray/anim/gltf_animation.h"
+#include "toonray/scene/gltf_animation.h"
 #include "toonray/core/error.h"
 #include "toonray/scene/camera.h"
 

@@ -1,14 +1,14 @@
-#include "toonray/anim/gltf_animation.h"
+#include "toonray/scene/gltf_animation.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <fstream>
 
-#include "toonray/anim/gltf_frames.h"
 #include "scene/gltf_test_files.h"
 #include "toonray/frame/frame_renderer.h"
 #include "toonray/io/png.h"
+#include "support/test_scenes.h"
 #include "support/test_support.h"
 
 namespace toonray {
@@ -222,11 +222,16 @@ TEST(GltfAnimation, LightsBecomeToonLights) {
     EXPECT_EQ(lights[1].kind, Light::Kind::Directional);
     expect_near(lights[1].vector, {0, 1, 0});  // -z turned a quarter about x
     EXPECT_FLOAT_EQ(lights[1].intensity, 0.5f);
-    // Given lights win over the file's.
-    FrameOptions options;
-    options.settings.shading.lights = {Light{}};
-    EXPECT_EQ(with_gltf_lights(options, lights).settings.shading.lights.size(), 1u);
-    EXPECT_EQ(with_gltf_lights(FrameOptions{}, lights).settings.shading.lights.size(), 2u);
+    // A scene source lights the frame with them, unless the settings give lights.
+    GltfDocument again = animator.document();
+    SceneFrame frame;
+    Warnings warnings;
+    GltfSource(again, {}, 24.0, SceneSetup{}).load(0, frame, warnings);
+    EXPECT_EQ(frame.lights, lights);
+    SceneSetup given;
+    given.lights = {Light{}};
+    GltfSource(again, {}, 24.0, given).load(0, frame, warnings);
+    EXPECT_EQ(frame.lights, given.lights);
 }
 
 TEST(GltfAnimation, MovingNodesRefitTheBvh) {
@@ -241,8 +246,9 @@ TEST(GltfAnimation, MovingNodesRefitTheBvh) {
     std::vector<Light> lights;
     for (int frame = 0; frame < 3; ++frame) {
         animator.pose(gltf_frame_time(frame, 24.0), 64, 48, scene, lights);
-        renderer.render(scene, choose_camera(scene, options),
-                        dir / ("f" + std::to_string(frame) + ".png"), options, warnings);
+        renderer.render(
+            test_support::scene_frame(scene, options.settings.width, options.settings.height),
+            dir / ("f" + std::to_string(frame) + ".png"), options, warnings);
         EXPECT_EQ(renderer.accel().refitted(), frame > 0) << frame;
     }
     EXPECT_DOUBLE_EQ(gltf_frame_time(1, 24.0), 1.0 / 24.0);
@@ -301,7 +307,9 @@ TEST(GltfAnimation, TexturesAreRightWayUp) {
         FrameOptions options;
         options.settings.width = options.settings.height = 64;
         FrameRenderer renderer;
-        renderer.render(scene, choose_camera(scene, options), dir / "quad.png", options, warnings);
+        renderer.render(
+            test_support::scene_frame(scene, options.settings.width, options.settings.height),
+            dir / "quad.png", options, warnings);
         const DecodedPng png = read_png(dir / "quad.png");
         const Rgb8 top = png.rgb(32, 24), bottom = png.rgb(32, 40);
         EXPECT_GT(top[0], top[2] + 60) << label;
@@ -340,7 +348,9 @@ TEST(GltfAnimation, VertexColoursMultiplyTheMaterial) {
     test_support::TempDir dir("gltf_colours");
     FrameRenderer renderer;
     Warnings warnings;
-    renderer.render(scene, choose_camera(scene, options), dir / "quad.png", options, warnings);
+    renderer.render(
+        test_support::scene_frame(scene, options.settings.width, options.settings.height),
+        dir / "quad.png", options, warnings);
     const DecodedPng png = read_png(dir / "quad.png");
     const Rgb8 top = png.rgb(32, 12), bottom = png.rgb(32, 52);
     EXPECT_GT(top[0], 60);  // 0.5 x red x the lit band

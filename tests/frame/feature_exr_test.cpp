@@ -11,7 +11,9 @@
 #include <map>
 #include <string>
 
+#include "toonray/frame/feature_images.h"
 #include "toonray/frame/frame_renderer.h"
+#include "toonray/ink/line_style.h"
 #include "toonray/io/exr.h"
 #include "toonray/io/png.h"
 #include "toonray/scene/obj_loader.h"
@@ -33,18 +35,17 @@ namespace {
 Scene load(const std::string& name) { return test_support::load_test_scene(name); }
 
 // Renders the spot model with both PNG feature images and the EXR; returns the EXR's path.
-fs::path render_both(const fs::path& dir, EdgeMode mode) {
+fs::path render_both(const fs::path& dir, LineMode mode) {
     const Scene scene = load("spot.obj");
     FrameOptions options;
     options.settings.width = 96;
     options.settings.height = 64;
-    options.settings.edges = mode;
-    options.settings.samples = 1;  // robust: one sample, at the pixel centre, as the EXR
+    options.settings.lines.mode = mode;
     options.aov_dir = dir / "aov";
     options.aov_exr = dir / "exr";
     FrameRenderer renderer;
     Warnings w;
-    renderer.render(scene, choose_camera(scene, options), dir / "frame.png", options, w);
+    renderer.render(test_support::scene_frame(scene, 96, 64), dir / "frame.png", options, w);
     return exr_path(*options.aov_exr, dir / "frame.png");
 }
 
@@ -80,16 +81,6 @@ ReadExr read_exr(const fs::path& path) {
     return out;
 }
 
-// The robust and ink modes' false colour of an id (render/renderer.cpp).
-Rgb8 id_colour(std::uint32_t id) {
-    if (id == kNoIndex) return {0, 0, 0};
-    std::uint32_t h = id * 2654435761u;
-    h ^= h >> 15;
-    return {static_cast<std::uint8_t>(64 + (h & 127)),
-            static_cast<std::uint8_t>(64 + ((h >> 8) & 127)),
-            static_cast<std::uint8_t>(64 + ((h >> 16) & 127))};
-}
-
 float linear(std::uint8_t byte) {
     const float c = static_cast<float>(byte) / 255.0f;
     return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
@@ -113,7 +104,7 @@ void expect_coverage(const ReadExr& exr, const std::string& channel, const fs::p
 
 TEST(FeatureExr, ClassicDistanceAgreesWithTheDepthPng) {
     test_support::TempDir dir("exr_classic");
-    const ReadExr exr = read_exr(render_both(dir.path, EdgeMode::Classic));
+    const ReadExr exr = read_exr(render_both(dir.path, LineMode::Classic));
     ASSERT_EQ(exr.width, 96);
     ASSERT_EQ(exr.height, 64);
     EXPECT_EQ(exr.types.at("Z"), Imf::FLOAT);
@@ -140,7 +131,7 @@ TEST(FeatureExr, ClassicDistanceAgreesWithTheDepthPng) {
 
 TEST(FeatureExr, RobustLayersAgreeWithThePngFeatureImages) {
     test_support::TempDir dir("exr_robust");
-    const ReadExr exr = read_exr(render_both(dir.path, EdgeMode::Robust));
+    const ReadExr exr = read_exr(render_both(dir.path, LineMode::Robust));
     const std::vector<float>& depth = exr.values.at("view_depth.Z");
     float z_max = 0.0f;
     for (float d : depth)
@@ -162,7 +153,8 @@ TEST(FeatureExr, RobustLayersAgreeWithThePngFeatureImages) {
         ASSERT_EQ(id_colour(hit ? static_cast<std::uint32_t>(material) : kNoIndex),
                   material_png.rgb.data()[i]);
         // Unit normals facing the eye; the PNG holds the geometric normal, the EXR the
-        // shading normal, so only their rough direction agrees.
+        // shading normal, so only their rough direction agrees. Both are of the pixel's first
+        // sample, as every layer.
         const float nx = exr.values.at("N.X")[i], ny = exr.values.at("N.Y")[i],
                     nz = exr.values.at("N.Z")[i];
         if (hit) {
@@ -183,7 +175,7 @@ TEST(FeatureExr, RobustLayersAgreeWithThePngFeatureImages) {
 
 TEST(FeatureExr, InkLinesAllIsTheCoverageAndTypesAddUp) {
     test_support::TempDir dir("exr_ink");
-    const ReadExr exr = read_exr(render_both(dir.path, EdgeMode::Ink));
+    const ReadExr exr = read_exr(render_both(dir.path, LineMode::Ink));
     expect_coverage(exr, "lines.all", dir.path / "aov/frame_edges.png");
     // Each type drawn alone covers no more than all lines together, and together as much.
     const std::vector<float>& all = exr.values.at("lines.all");
@@ -204,15 +196,16 @@ TEST(FeatureExr, PolylinesDrawnOverTheFrameHaveTheirChannel) {
         "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nf 1 2 3 4\n"
         "v -0.6 0.4 0.5\nv 0.6 0.4 0.5\nl -2 -1\n",
         "lines.obj", scene, w);
-    for (EdgeMode mode : {EdgeMode::Classic, EdgeMode::Robust, EdgeMode::Ink}) {
+    for (LineMode mode : {LineMode::Classic, LineMode::Robust, LineMode::Ink}) {
         FrameOptions options;
         options.settings.width = 80;
         options.settings.height = 60;
-        options.settings.edges = mode;
-        options.camera = CameraSpec{{0, 0, 4}, {0, 0, 0}, {0, 1, 0}};
+        options.settings.lines.mode = mode;
         options.aov_exr = dir.path / "f.exr";
         FrameRenderer renderer;
-        renderer.render(scene, *options.camera, dir.path / "f.png", options, w);
+        renderer.render(
+            test_support::scene_frame(scene, CameraSpec{{0, 0, 4}, {0, 0, 0}, {0, 1, 0}}, 80, 60),
+            dir.path / "f.png", options, w);
         const ReadExr exr = read_exr(dir.path / "f.exr");
         ASSERT_TRUE(exr.values.contains("lines.polyline")) << static_cast<int>(mode);
         const std::vector<float>& line = exr.values.at("lines.polyline");
@@ -226,9 +219,76 @@ TEST(FeatureExr, PolylinesDrawnOverTheFrameHaveTheirChannel) {
     }
 }
 
+TEST(FeatureExr, TheChannelsAreTheRenderersLayersOfEachPixelsFirstSample) {
+    // No second trace: with four samples a pixel, Z, N and the ids are those of the sample the
+    // renderer took first in each pixel, exactly.
+    test_support::TempDir dir("exr_layers");
+    const Scene scene = load("spot.obj");
+    FrameOptions options;
+    options.settings.width = 64;
+    options.settings.height = 48;
+    options.aov_exr = dir.path / "f.exr";
+    FrameRenderer renderer;
+    Warnings w;
+    renderer.render(test_support::scene_frame(scene, 64, 48), dir.path / "f.png", options, w);
+    const FrameLayers& layers = renderer.renderer().layers();
+    const ReadExr exr = read_exr(dir.path / "f.exr");
+    int seen = 0;
+    for (std::size_t i = 0; i < layers.distance.size(); ++i) {
+        const bool hit = layers.object.data()[i] != kNoIndex;
+        seen += hit;
+        ASSERT_EQ(exr.values.at("Z")[i], hit ? layers.distance.data()[i] : kExrBackgroundDepth);
+        ASSERT_EQ(exr.values.at("N.X")[i], layers.normal.data()[i].x);
+        ASSERT_EQ(exr.values.at("object_id.id")[i],
+                  hit ? static_cast<float>(layers.object.data()[i]) : kExrBackgroundId);
+        ASSERT_EQ(exr.values.at("band.index")[i],
+                  hit ? static_cast<float>(layers.band.data()[i]) : kExrBackgroundId);
+        ASSERT_EQ(exr.values.at("P.Y")[i], layers.position.data()[i].y);
+    }
+    EXPECT_GT(seen, 300);
+}
+
+TEST(FeatureExr, LineTypeChannelsAreDrawnWithTheirStyles) {
+    // A line style that widens the silhouettes widens their channel, as it does the picture.
+    test_support::TempDir dir("exr_styles");
+    const Scene scene = load("spot.obj");
+    auto silhouette_coverage = [&](const char* style) {
+        FrameOptions options;
+        options.settings.width = 96;
+        options.settings.height = 64;
+        options.settings.lines.ink.styles = ink::parse_line_styles(style, "test.style");
+        options.aov_exr = dir.path / "f.exr";
+        FrameRenderer renderer;
+        Warnings w;
+        renderer.render(test_support::scene_frame(scene, 96, 64), dir.path / "f.png", options, w);
+        const ReadExr exr = read_exr(dir.path / "f.exr");
+        double sum = 0.0;
+        for (float c : exr.values.at("lines.silhouette")) sum += c;
+        return sum;
+    };
+    const double plain = silhouette_coverage("");
+    const double wide = silhouette_coverage("match type=silhouette width=8\n");
+    EXPECT_GT(plain, 10.0);
+    EXPECT_GT(wide, 2.0 * plain);
+}
+
+TEST(FeatureExr, LayersOfAnotherSizeAreAnError) {
+    // A frame rendered without its layers has none to write: an error, not zero channels.
+    FrameLayers layers;
+    layers.image.reshape(8, 4);
+    FeatureLayers out;
+    try {
+        gather_feature_layers(layers, out);
+        FAIL() << "no error";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("layer is 0x0 in a 8x4 frame"), std::string::npos)
+            << e.what();
+    }
+}
+
 TEST(FeatureExr, OiiotoolListsTheChannels) {
     test_support::TempDir dir("exr_oiio");
-    const fs::path exr = render_both(dir.path, EdgeMode::Robust);
+    const fs::path exr = render_both(dir.path, LineMode::Robust);
     const std::string command = "oiiotool --info -v '" + exr.string() + "' 2>&1";
     FILE* pipe = ::popen(command.c_str(), "r");
     ASSERT_NE(pipe, nullptr);
@@ -257,7 +317,7 @@ TEST(FeatureExr, WithoutOpenExrTheErrorSaysSo) {
     test_support::TempDir dir("exr_none");
     EXPECT_FALSE(exr_available());
     try {
-        render_both(dir.path, EdgeMode::Robust);
+        render_both(dir.path, LineMode::Robust);
         FAIL() << "no error";
     } catch (const Error& e) {
         EXPECT_NE(std::string(e.what()).find("built without OpenEXR"), std::string::npos);

@@ -6,6 +6,7 @@
 #include <cstring>
 #include <filesystem>
 
+#include "toonray/frame/feature_images.h"
 #include "toonray/io/file.h"
 #include "toonray/io/png.h"
 #include "toonray/scene/obj_loader.h"
@@ -31,6 +32,11 @@ Scene twisted_teapot(const Scene& teapot, int frame) {
     return scene;
 }
 
+// The scene as a scene source finishes it for a frame of `o`'s size.
+SceneFrame frame_of(const Scene& scene, const FrameOptions& o) {
+    return test_support::scene_frame(scene, o.settings.width, o.settings.height);
+}
+
 bool same_pixels(const fs::path& a, const fs::path& b) {
     const DecodedPng pa = read_png(a), pb = read_png(b);
     return pa.rgb.size() == pb.rgb.size() &&
@@ -45,16 +51,16 @@ TEST(FrameRenderer, WritesTheImageAndAllFeatureImagesNamedAfterTheOutput) {
     FrameOptions o;
     o.settings.width = 64;
     o.settings.height = 48;
-    for (EdgeMode mode : {EdgeMode::Classic, EdgeMode::Robust, EdgeMode::Ink}) {
-        o.settings.edges = mode;
+    for (LineMode mode : {LineMode::Classic, LineMode::Robust, LineMode::Ink}) {
+        o.settings.lines.mode = mode;
         FrameRenderer fr;
         Warnings w;
         // Without a feature directory: the image alone, and no feature images computed.
         o.aov_dir.reset();
-        fr.render(teapot, choose_camera(teapot, o), dir.path / "plain.png", o, w);
-        EXPECT_EQ(fr.renderer().aovs().depth.size(), 0u);
+        fr.render(frame_of(teapot, o), dir.path / "plain.png", o, w);
+        EXPECT_EQ(fr.renderer().layers().distance.size(), 0u);
         o.aov_dir = dir.path / "aov";
-        fr.render(teapot, choose_camera(teapot, o), dir.path / "frame.png", o, w);
+        fr.render(frame_of(teapot, o), dir.path / "frame.png", o, w);
         EXPECT_TRUE(is_valid_png(dir.path / "frame.png"));
         EXPECT_TRUE(same_pixels(dir.path / "plain.png", dir.path / "frame.png"));
         std::size_t written = 0;
@@ -66,7 +72,7 @@ TEST(FrameRenderer, WritesTheImageAndAllFeatureImagesNamedAfterTheOutput) {
             EXPECT_EQ(read_png(p).width, 64);
             EXPECT_EQ(p, aov_path(dir.path / "aov", dir.path / "frame.png", f.name));
         }
-        EXPECT_EQ(written, mode == EdgeMode::Robust ? 12u : (mode == EdgeMode::Ink ? 13u : 6u));
+        EXPECT_EQ(written, mode == LineMode::Robust ? 12u : (mode == LineMode::Ink ? 13u : 6u));
         fs::remove_all(dir.path / "aov");
     }
 }
@@ -81,15 +87,15 @@ TEST(FrameRenderer, WritesTheInkStrokesAsSvg) {
     FrameRenderer fr;
     Warnings w;
     // Another line mode runs the ink stages for the SVG only: the same drawing as in ink mode.
-    fr.render(teapot, choose_camera(teapot, o), dir.path / "frame.png", o, w);
+    fr.render(frame_of(teapot, o), dir.path / "frame.png", o, w);
     const std::string robust = read_file(dir.path / "frame.svg");
-    o.settings.edges = EdgeMode::Ink;
-    fr.render(teapot, choose_camera(teapot, o), dir.path / "frame.png", o, w);
+    o.settings.lines.mode = LineMode::Ink;
+    fr.render(frame_of(teapot, o), dir.path / "frame.png", o, w);
     EXPECT_EQ(read_file(dir.path / "frame.svg"), robust);
-    o.settings.edges = EdgeMode::Ink;
+    o.settings.lines.mode = LineMode::Ink;
     for (bool hidden : {false, true}) {
         o.svg_hidden = hidden;
-        fr.render(teapot, choose_camera(teapot, o), dir.path / "frame.png", o, w);
+        fr.render(frame_of(teapot, o), dir.path / "frame.png", o, w);
         const std::string svg = read_file(dir.path / "frame.svg");
         EXPECT_NE(svg.find("viewBox=\"0 0 160 90\""), std::string::npos);
         EXPECT_NE(svg.find("<g id=\"visible-silhouette\">"), std::string::npos);
@@ -98,7 +104,7 @@ TEST(FrameRenderer, WritesTheInkStrokesAsSvg) {
     }
     // With the fill, the cel picture is embedded under the lines.
     o.svg_fill = true;
-    fr.render(teapot, choose_camera(teapot, o), dir.path / "frame.png", o, w);
+    fr.render(frame_of(teapot, o), dir.path / "frame.png", o, w);
     const std::string filled = read_file(dir.path / "frame.svg");
     const std::size_t image = filled.find("<image id=\"fill\"");
     ASSERT_NE(image, std::string::npos);
@@ -112,13 +118,13 @@ TEST(FrameRenderer, SvgDirectoryNamesFilesLikeThePngAndResumeNeedsBoth) {
     FrameOptions o;
     o.settings.width = 96;
     o.settings.height = 54;
-    o.settings.edges = EdgeMode::Classic;
+    o.settings.lines.mode = LineMode::Classic;
     o.svg_dir = dir.path / "svg";
     EXPECT_EQ(o.svg_path(dir.path / "keys_000030.png"), dir.path / "svg" / "keys_000030.svg");
     FrameRenderer fr;
     Warnings w;
     EXPECT_FALSE(frame_complete(dir.path / "keys_000030.png", o));
-    fr.render(teapot, choose_camera(teapot, o), dir.path / "keys_000030.png", o, w);
+    fr.render(frame_of(teapot, o), dir.path / "keys_000030.png", o, w);
     EXPECT_TRUE(frame_complete(dir.path / "keys_000030.png", o));
     fs::remove(dir.path / "svg" / "keys_000030.svg");
     EXPECT_FALSE(frame_complete(dir.path / "keys_000030.png", o));
@@ -135,22 +141,13 @@ TEST(FrameRenderer, ABadCameraWritesNothing) {
     o.aov_dir = dir.path / "aov";
     FrameRenderer fr;
     Warnings w;
-    const CameraSpec degenerate{{0, 0, 0}, {0, 0, 0}, {0, 1, 0}};  // gaze at the eye
-    EXPECT_THROW(fr.render(teapot, degenerate, dir.path / "frame.png", o, w), Error);
+    SceneFrame frame;
+    frame.scene = teapot;
+    frame.camera = CameraSpec{{0, 0, 0}, {0, 0, 0}, {0, 1, 0}};  // gaze at the eye
+    frame.lights = {Light{}};
+    EXPECT_THROW(fr.render(frame, dir.path / "frame.png", o, w), Error);
     EXPECT_FALSE(fs::exists(dir.path / "frame.png"));
     EXPECT_FALSE(fs::exists(dir.path / "aov"));
-}
-
-TEST(FrameRenderer, CameraIsTheOverrideElseTheScenesElseAutomatic) {
-    Scene teapot = load("teapot.obj");
-    FrameOptions o;
-    const CameraSpec automatic = choose_camera(teapot, o);
-    const CameraSpec block{{1, 2, 3}, {0, 0, 0}, {0, 1, 0}};
-    teapot.camera = block;
-    EXPECT_EQ(choose_camera(teapot, o).eye, block.eye);
-    o.camera = CameraSpec{{4, 5, 6}, {0, 0, 0}, {0, 1, 0}};
-    EXPECT_EQ(choose_camera(teapot, o).eye, Vec3f(4, 5, 6));
-    EXPECT_NE(automatic.eye, block.eye);
 }
 
 // Frames with the same triangles refit the previous frame's BVH (kMaxRefitsInARow in a row,
@@ -163,20 +160,21 @@ TEST(FrameRenderer, RefittedFramesEqualRebuiltFrames) {
     o.settings.width = 96;
     o.settings.height = 64;
     o.settings.threads = 1;
-    const CameraSpec camera = choose_camera(teapot, o);
+    const CameraSpec camera = frame_of(teapot, o).camera;
     FrameRenderer reused;
     const int frames = 2 * AnimationAccel::kMaxRefitsInARow + 3;  // refits, a rebuild, more refits
     for (int f = 0; f < frames; ++f) {
         const Scene scene = twisted_teapot(teapot, f);
-        for (EdgeMode mode : {EdgeMode::Classic, EdgeMode::Robust}) {
-            o.settings.edges = mode;
+        for (LineMode mode : {LineMode::Classic, LineMode::Robust}) {
+            o.settings.lines.mode = mode;
             Warnings w;
             FrameRenderer fresh;
-            fresh.render(scene, camera, dir.path / "fresh.png", o, w);
-            reused.render(scene, camera, dir.path / "reused.png", o, w);
+            const SceneFrame frame = test_support::scene_frame(scene, camera, 96, 64);
+            fresh.render(frame, dir.path / "fresh.png", o, w);
+            reused.render(frame, dir.path / "reused.png", o, w);
             EXPECT_FALSE(fresh.accel().refitted());
             ASSERT_TRUE(same_pixels(dir.path / "fresh.png", dir.path / "reused.png"))
-                << "frame " << f << (mode == EdgeMode::Classic ? " classic" : " robust");
+                << "frame " << f << (mode == LineMode::Classic ? " classic" : " robust");
         }
     }
 }
@@ -218,7 +216,7 @@ TEST(FrameBytes, CountTheRendererAndTheEncodingWithRoomToSpare) {
     EXPECT_GT(frame_bytes(o), renderer + pixels * 3);
     // Feature images count only when they are written.
     o.aov_dir = "aov";
-    EXPECT_TRUE(o.render_settings().feature_images);
+    EXPECT_TRUE(o.render_settings().layers);
     EXPECT_GT(frame_buffer_bytes(o.render_settings()), renderer);
     // Measured: `toonray render` with robust lines and feature images at 720p peaks at 48 MB,
     // 14 MB of which the program holds before any frame (`toonray --help`): 37 bytes a pixel.

@@ -9,6 +9,7 @@
 #include "toonray/ink/polylines.h"
 #include "toonray/io/png.h"
 #include "toonray/scene/obj_loader.h"
+#include "support/test_scenes.h"
 #include "support/test_support.h"
 
 using namespace toonray;
@@ -21,17 +22,17 @@ const char* kSquare = "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nf 1 2 3 4\n";
 const char* kFront = "v -0.6 0.4 0.5\nv 0 0.2 0.5\nv 0.6 0.4 0.5\nl -3 -2 -1\n";
 const char* kBehind = "v -0.6 -0.4 -0.5\nv 0.6 -0.4 -0.5\nl -2 -1\n";
 
-ImageRgb8 render(const std::string& obj, EdgeMode mode, const fs::path& dir) {
+ImageRgb8 render(const std::string& obj, LineMode mode, const fs::path& dir) {
     Scene scene;
     Warnings w;
     parse_obj(obj, "lines.obj", scene, w);
     FrameOptions options;
     options.settings.width = 80;
     options.settings.height = 60;
-    options.settings.edges = mode;
-    options.camera = CameraSpec{{0, 0, 4}, {0, 0, 0}, {0, 1, 0}};
+    options.settings.lines.mode = mode;
     FrameRenderer renderer;
-    renderer.render(scene, *options.camera, dir / "frame.png", options, w);
+    renderer.render(test_support::scene_frame(scene, CameraSpec{{0, 0, 4}, {0, 0, 0}, {0, 1, 0}}),
+                    dir / "frame.png", options, w);
     return read_png(dir / "frame.png").rgb;
 }
 
@@ -45,7 +46,7 @@ int differing_pixels(const ImageRgb8& a, const ImageRgb8& b) {
 
 TEST(Polylines, DrawnInEveryModeAndHiddenBehindSurfaces) {
     test_support::TempDir dir("polylines");
-    for (EdgeMode mode : {EdgeMode::Classic, EdgeMode::Robust, EdgeMode::Ink}) {
+    for (LineMode mode : {LineMode::Classic, LineMode::Robust, LineMode::Ink}) {
         const ImageRgb8 square = render(kSquare, mode, dir.path);
         const ImageRgb8 front = render(std::string(kSquare) + kFront, mode, dir.path);
         const ImageRgb8 behind = render(std::string(kSquare) + kBehind, mode, dir.path);

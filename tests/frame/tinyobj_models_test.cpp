@@ -13,6 +13,7 @@
 #include "toonray/frame/frame_renderer.h"
 #include "toonray/io/png.h"
 #include "toonray/scene/obj_loader.h"
+#include "support/test_scenes.h"
 #include "support/test_support.h"
 
 using namespace toonray;
@@ -51,7 +52,7 @@ TEST(TinyobjModels, EveryModelRendersUnlessTrulyBroken) {
             options.settings.width = 48;
             options.settings.height = 36;
             FrameRenderer renderer;
-            renderer.render(scene, choose_camera(scene, options), output, options, warnings);
+            renderer.render(test_support::scene_frame(scene, 48, 36), output, options, warnings);
             EXPECT_FALSE(kBroken.contains(name)) << "a broken file rendered";
             const DecodedPng png = read_png(output);
             EXPECT_EQ(png.width, 48);

@@ -16,6 +16,7 @@
 #include "toonray/render/renderer.h"
 #include "toonray/scene/obj_loader.h"
 #include "toonray/scene/obj_writer.h"
+#include "support/test_scenes.h"
 #include "support/image_compare.h"
 #include "support/same_bits.h"
 
@@ -93,15 +94,16 @@ TEST(PianoRender, KeysAreVisibleAndAPressShowsAfterRefit) {
     TriangleAccel accel;
     accel.build(scene.positions, scene.tri_positions);
     RenderSettings settings;
-    settings.edges = EdgeMode::Classic;  // reads the Euclidean distances of the G-buffer
+    settings.lines.mode = LineMode::Classic;  // one sample at each pixel's centre
+    settings.layers = true;                   // the distances and objects seen
     settings.width = 480;
     settings.height = 200;
     settings.threads = 1;
     // From the player's seat, looking down at the middle of the keyboard.
     const CameraSpec camera = look_at({0.0f, 1.15f, 0.95f}, model.keyboard_center, 75.0f);
     Renderer renderer;
-    renderer.render(scene, accel, camera, settings);
-    const GBuffer& g = renderer.gbuffer();
+    renderer.render(scene, accel, camera, test_support::default_lights(scene, camera), settings);
+    const FrameLayers& g = renderer.layers();
     std::set<std::uint32_t> keys_seen;
     std::set<std::uint32_t> key_objects;
     for (const PianoKey& k : model.keys) key_objects.insert(k.object);
@@ -112,7 +114,7 @@ TEST(PianoRender, KeysAreVisibleAndAPressShowsAfterRefit) {
     // Press middle C, refit, render again: the key's pixels change, and the refitted BVH gives
     // exactly what a fresh build gives.
     const PianoKey& c4 = model.keys[60 - kLowestKey];
-    auto key_pixels = [&](const GBuffer& gb) {
+    auto key_pixels = [&](const FrameLayers& gb) {
         std::vector<float> depth;
         for (std::size_t i = 0; i < gb.object.size(); ++i)
             if (gb.object.data()[i] == c4.object) depth.push_back(gb.distance.data()[i]);
@@ -124,17 +126,17 @@ TEST(PianoRender, KeysAreVisibleAndAPressShowsAfterRefit) {
     pose.key_angle[60 - kLowestKey] = kKeyDipAngle;
     pose_piano(model, pose, nullptr, scene);
     accel.refit(scene.positions, scene.tri_positions);
-    renderer.render(scene, accel, camera, settings);
-    const std::vector<float> after = key_pixels(renderer.gbuffer());
+    renderer.render(scene, accel, camera, test_support::default_lights(scene, camera), settings);
+    const std::vector<float> after = key_pixels(renderer.layers());
     EXPECT_NE(before, after);
-    const Image<float> refitted = renderer.gbuffer().distance;
+    const Image<float> refitted = renderer.layers().distance;
 
     TriangleAccel fresh;
     fresh.build(scene.positions, scene.tri_positions);
     Renderer other;
-    other.render(scene, fresh, camera, settings);
+    other.render(scene, fresh, camera, test_support::default_lights(scene, camera), settings);
     for (std::size_t i = 0; i < refitted.size(); ++i)
-        ASSERT_EQ(refitted.data()[i], other.gbuffer().distance.data()[i]) << "pixel " << i;
+        ASSERT_EQ(refitted.data()[i], other.layers().distance.data()[i]) << "pixel " << i;
 }
 
 TEST(PianoRender, EverySurfaceSeenFromOutsideFacesTheViewer) {
@@ -185,24 +187,28 @@ TEST(PianoRender, AdaptiveSamplingStaysWithinFullSupersampling) {
     accel.build(scene.positions, scene.tri_positions);
     // At 1280x720 the ink lines are wide enough to hide pixels, which take one sample.
     struct Case {
-        EdgeMode mode;
+        LineMode mode;
         int width, height;
     };
-    for (const Case& c : {Case{EdgeMode::Ink, 640, 360}, Case{EdgeMode::Robust, 640, 360},
-                          Case{EdgeMode::Ink, 1280, 720}}) {
-        const EdgeMode mode = c.mode;
+    for (const Case& c : {Case{LineMode::Ink, 640, 360}, Case{LineMode::Robust, 640, 360},
+                          Case{LineMode::Ink, 1280, 720}}) {
+        const LineMode mode = c.mode;
         RenderSettings settings;
-        settings.edges = mode;
+        settings.lines.mode = mode;
         settings.width = c.width;
         settings.height = c.height;
         Renderer adaptive, full;
-        const ImageRgb8 a = adaptive.render(scene, accel, *scene.camera, settings);
-        settings.adaptive = false;
-        const ImageRgb8& b = full.render(scene, accel, *scene.camera, settings);
+        const ImageRgb8 a =
+            adaptive.render(scene, accel, *scene.camera,
+                            test_support::default_lights(scene, *scene.camera), settings);
+        settings.sampling.adaptive = false;
+        const ImageRgb8& b =
+            full.render(scene, accel, *scene.camera,
+                        test_support::default_lights(scene, *scene.camera), settings);
         const double share = test_support::share_differing(a, b, 2);
         std::printf(
             "piano, %s, %dx%d: %.3f%% of pixels differ by more than 2/255; %.1f%% refined\n",
-            mode == EdgeMode::Ink ? "ink" : "robust", c.width, c.height, 100 * share,
+            mode == LineMode::Ink ? "ink" : "robust", c.width, c.height, 100 * share,
             100.0 * static_cast<double>(adaptive.refined_pixels()) / a.size());
         EXPECT_LE(share, 0.005);
         EXPECT_LT(adaptive.refined_pixels(), a.size() / 2);

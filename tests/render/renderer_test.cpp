@@ -5,13 +5,14 @@
 #include <cmath>
 #include <cstring>
 #include <string_view>
-#include <variant>
 #include <vector>
 
 #include "toonray/io/png.h"
 #include "toonray/render/classic.h"
+#include "toonray/render/robust.h"
 #include "toonray/scene/obj_loader.h"
 #include "support/test_scenes.h"
+#include "support/same_layers.h"
 #include "support/test_support.h"
 
 using namespace toonray;
@@ -43,12 +44,19 @@ std::uint64_t bytes_of(const Image<T>& image) {
     return image.size() * sizeof(T);
 }
 
-const Image<Vec3f>& render_scene(Renderer& r, const Scene& s, const CameraSpec& cam,
-                                 RenderSettings settings) {
+// Renders with the layers and returns them.
+const FrameLayers& render_scene(Renderer& r, const Scene& s, const CameraSpec& cam,
+                                RenderSettings settings, std::vector<Light> lights = {}) {
     static TriangleAccel accel;
     accel.build(s.positions, s.tri_positions);
-    r.render(s, accel, cam, settings);
-    return r.gbuffer().colour;
+    settings.layers = true;
+    if (lights.empty()) lights = test_support::default_lights(s, cam);
+    r.render(s, accel, cam, lights, settings);
+    return r.layers();
+}
+
+std::vector<Light> point_light(const Vec3f& position) {
+    return {Light{Light::Kind::Point, position, 1.0f}};
 }
 
 }  // namespace
@@ -58,16 +66,15 @@ TEST(Renderer, FlatSquareFacingTheLightIsItsKdWithoutLines) {
     // Looking straight down at a plane 5 units away; a narrow field of view keeps depth nearly
     // constant, and a light far along the normal gives l.n close to 1 everywhere.
     CameraSpec cam{{0, 0, 5}, {0, 0, 1}, {0, 1, 0}};
-    for (EdgeMode mode : {EdgeMode::Classic, EdgeMode::Robust}) {
+    for (LineMode mode : {LineMode::Classic, LineMode::Robust}) {
         RenderSettings settings;
-        settings.edges = mode;
+        settings.lines.mode = mode;
         settings.width = 128;
         settings.height = 96;
-        settings.light = Vec3f(0, 0, 1e4f);
         Renderer r;
         TriangleAccel accel;
         accel.build(s.positions, s.tri_positions);
-        const ImageRgb8& out = r.render(s, accel, cam, settings);
+        const ImageRgb8& out = r.render(s, accel, cam, point_light({0, 0, 1e4f}), settings);
         for (int y = 0; y < settings.height; ++y)
             for (int x = 0; x < settings.width; ++x)
                 ASSERT_EQ(out(x, y), (Rgb8{51, 102, 153})) << x << "," << y;
@@ -80,12 +87,11 @@ TEST(Renderer, CelBandsFollowThePointLight) {
     Scene s = square(10.0f, {1.0f, 1.0f, 1.0f});
     CameraSpec cam{{0, 0, 8}, {0, 0, 7}, {0, 1, 0}};  // 90 degrees: sees x in [-8, 8]
     RenderSettings settings;
-    settings.edges = EdgeMode::Classic;  // one sample per pixel: colours are the formula's
+    settings.lines.mode = LineMode::Classic;  // one sample per pixel: bands are the formula's
     settings.width = 160;
     settings.height = 120;
-    settings.light = Vec3f(0, 0, 2);
     Renderer r;
-    const Image<Vec3f>& colour = render_scene(r, s, cam, settings);
+    const FrameLayers& layers = render_scene(r, s, cam, settings, point_light({0, 0, 2}));
     ViewPlane view = make_view_plane(cam, settings.width, settings.height);
     int checked = 0, bands[3] = {0, 0, 0};
     for (int y = 0; y < settings.height; ++y)
@@ -96,9 +102,12 @@ TEST(Renderer, CelBandsFollowThePointLight) {
             float l_dot_n = 2.0f / std::sqrt(4.0f + hit.x * hit.x + hit.y * hit.y);
             float scaled = l_dot_n * 16.0f;
             if (std::abs(scaled - std::round(scaled)) < 1e-3f) continue;  // on a band boundary
-            float expect = l_dot_n < 0.25f ? 0.5f : (l_dot_n < 0.5f ? 0.75f : 1.0f);
-            ASSERT_EQ(colour(x, y).x, expect) << x << "," << y;
-            bands[expect == 0.5f ? 0 : (expect == 0.75f ? 1 : 2)]++;
+            const int band = l_dot_n < 0.25f ? 0 : (l_dot_n < 0.5f ? 1 : 2);
+            ASSERT_EQ(layers.band(x, y), band) << x << "," << y;
+            const float level = settings.shading.ramp.levels[band];
+            ASSERT_EQ(layers.cel(x, y)[0], to_byte(level)) << x << "," << y;
+            ASSERT_NEAR(layers.light(x, y), l_dot_n, 1e-4f) << x << "," << y;
+            bands[band]++;
             ++checked;
         }
     EXPECT_GT(checked, settings.width * settings.height * 9 / 10);
@@ -110,15 +119,14 @@ TEST(Renderer, SilhouetteOfASquareOnBackgroundIsOutlined) {
     CameraSpec cam{
         {0, 0, 4}, {0, 0, 3}, {0, 1, 0}};  // sees x in [-4, 4]: the square is the middle quarter
     RenderSettings settings;
-    settings.edges = EdgeMode::Classic;
+    settings.lines.mode = LineMode::Classic;
     settings.width = 200;
     settings.height = 200;
-    settings.light = Vec3f(0, 0, 100);
-    settings.feature_images = true;
+    settings.layers = true;
     Renderer r;
     TriangleAccel accel;
     accel.build(s.positions, s.tri_positions);
-    const ImageRgb8& out = r.render(s, accel, cam, settings);
+    const ImageRgb8& out = r.render(s, accel, cam, point_light({0, 0, 100}), settings);
     // Square covers pixels [75, 125). Its border pixels are lines; inside and far outside are not.
     EXPECT_EQ(out(100, 100), (Rgb8{128, 128, 128}));
     EXPECT_EQ(out(10, 10), (Rgb8{255, 255, 255}));
@@ -128,11 +136,15 @@ TEST(Renderer, SilhouetteOfASquareOnBackgroundIsOutlined) {
         EXPECT_LT(out(i, 75)[0], 60) << i;
         EXPECT_LT(out(i, 124)[0], 60) << i;
     }
-    EXPECT_EQ(r.aovs().edges(75, 100), 0);
-    EXPECT_EQ(r.aovs().edges(100, 100), 255);
-    EXPECT_EQ(r.aovs().depth(10, 10), 255);                       // miss: white
-    EXPECT_EQ(r.aovs().normal(10, 10), (Rgb8{0, 0, 0}));          // miss: black
-    EXPECT_EQ(r.aovs().normal(100, 100), (Rgb8{128, 128, 255}));  // facing +z
+    const FrameLayers& layers = r.layers();
+    EXPECT_EQ(layers.lines(75, 100), 1.0f);
+    EXPECT_EQ(layers.lines(100, 100), 0.0f);
+    EXPECT_TRUE(std::isinf(layers.distance(10, 10)));  // miss
+    EXPECT_EQ(layers.object(10, 10), kNoIndex);
+    EXPECT_EQ(layers.band(10, 10), kNoBand);
+    EXPECT_EQ(layers.normal(10, 10), Vec3f(0, 0, 0));
+    EXPECT_EQ(layers.normal(100, 100), Vec3f(0, 0, 1));  // facing +z
+    EXPECT_EQ(layers.position(100, 100).z, 0.0f);
 }
 
 TEST(Renderer, NormalsFaceTheViewer) {
@@ -140,12 +152,11 @@ TEST(Renderer, NormalsFaceTheViewer) {
     Scene s = square(1.0f, {1, 1, 1});
     CameraSpec cam{{0, 0, -4}, {0, 0, -3}, {0, 1, 0}};
     RenderSettings settings;
-    settings.edges = EdgeMode::Classic;
+    settings.lines.mode = LineMode::Classic;
     settings.width = 32;
     settings.height = 32;
     Renderer r;
-    render_scene(r, s, cam, settings);
-    EXPECT_EQ(r.gbuffer().normal(16, 16), Vec3f(0, 0, -1));
+    EXPECT_EQ(render_scene(r, s, cam, settings).normal(16, 16), Vec3f(0, 0, -1));
 }
 
 TEST(Renderer, InterpolatesVertexNormalsOnlyWhenAllCornersHaveThem) {
@@ -155,30 +166,17 @@ TEST(Renderer, InterpolatesVertexNormalsOnlyWhenAllCornersHaveThem) {
     s.tri_normals[1] = {0, kNoIndex, 1};  // one missing: geometric
     CameraSpec cam{{0, 0, 4}, {0, 0, 3}, {0, 1, 0}};
     RenderSettings settings;
-    settings.edges = EdgeMode::Classic;
+    settings.lines.mode = LineMode::Classic;
     settings.width = 64;
     settings.height = 64;
     Renderer r;
-    render_scene(r, s, cam, settings);
+    const FrameLayers& layers = render_scene(r, s, cam, settings);
     // Pixel (34, 33) lies in triangle 0 (below the diagonal y = x), (30, 29) in triangle 1.
-    Vec3f n0 = r.gbuffer().normal(36, 33);
+    Vec3f n0 = layers.normal(36, 33);
     EXPECT_GT(std::abs(n0.x), 0.01f);
     EXPECT_NEAR(length(n0), 1.0f, 1e-5f);
-    EXPECT_EQ(r.gbuffer().normal(28, 29), Vec3f(0, 0, 1));
-}
-
-TEST(Renderer, DefaultLightIsTheEyeMovedAlongUpAndRight) {
-    Scene s = square(3.0f, {1, 1, 1});  // radius = half the diagonal of a 6 x 6 x 0 box
-    CameraSpec cam{{0, 0, 4}, {0, 0, 3}, {0, 1, 0}};
-    RenderSettings settings;
-    settings.width = 16;
-    settings.height = 16;
-    Renderer r;
-    render_scene(r, s, cam, settings);
-    float half_radius = 0.5f * std::sqrt(72.0f) * 0.5f;
-    EXPECT_NEAR(r.light().x, half_radius, 1e-5f);
-    EXPECT_NEAR(r.light().y, half_radius, 1e-5f);
-    EXPECT_NEAR(r.light().z, 4.0f, 1e-5f);
+    EXPECT_EQ(layers.normal(28, 29), Vec3f(0, 0, 1));
+    EXPECT_EQ(layers.geometric_normal(36, 33), Vec3f(0, 0, 1));
 }
 
 TEST(Renderer, OutputIsIdenticalForEveryThreadCount) {
@@ -186,23 +184,24 @@ TEST(Renderer, OutputIsIdenticalForEveryThreadCount) {
     RenderSettings settings;
     settings.width = 320;
     settings.height = 180;
-    settings.feature_images = true;
+    settings.layers = true;
     CameraSpec cam = framing_camera(s, settings);
     TriangleAccel accel;
     accel.build(s.positions, s.tri_positions);
     Renderer one, two, many;
     settings.threads = 1;
-    for (EdgeMode mode : {EdgeMode::Classic, EdgeMode::Robust}) {
-        settings.edges = mode;
+    for (LineMode mode : {LineMode::Classic, LineMode::Robust, LineMode::Ink}) {
+        settings.lines.mode = mode;
         settings.threads = 1;
-        ImageRgb8 a = one.render(s, accel, cam, settings);
+        ImageRgb8 a = one.render(s, accel, cam, test_support::default_lights(s, cam), settings);
         settings.threads = 2;
-        ImageRgb8 b = two.render(s, accel, cam, settings);
+        ImageRgb8 b = two.render(s, accel, cam, test_support::default_lights(s, cam), settings);
         settings.threads = 7;
-        ImageRgb8 c = many.render(s, accel, cam, settings);
+        ImageRgb8 c = many.render(s, accel, cam, test_support::default_lights(s, cam), settings);
         ASSERT_EQ(0, std::memcmp(a.data(), b.data(), a.size() * 3));
         ASSERT_EQ(0, std::memcmp(a.data(), c.data(), a.size() * 3));
-        ASSERT_EQ(0, std::memcmp(one.aovs().depth.data(), two.aovs().depth.data(), a.size()));
+        ASSERT_TRUE(test_support::same_layers(one.layers(), two.layers()));
+        ASSERT_TRUE(test_support::same_layers(one.layers(), many.layers()));
     }
 }
 
@@ -210,14 +209,15 @@ TEST(Renderer, MatchesABruteForceReference) {
     // The same pixels traced by testing every triangle: the BVH must find the same surfaces.
     Scene s = load("spot.obj");
     RenderSettings settings;
-    settings.edges = EdgeMode::Classic;  // its G-buffer holds the Euclidean distance
+    settings.lines.mode = LineMode::Classic;  // one sample at each pixel's centre
     settings.width = 160;
     settings.height = 90;
+    settings.layers = true;  // the Euclidean distance of each pixel's sample
     CameraSpec cam = framing_camera(s, settings);
     TriangleAccel accel;
     accel.build(s.positions, s.tri_positions);
     Renderer r;
-    r.render(s, accel, cam, settings);
+    r.render(s, accel, cam, test_support::default_lights(s, cam), settings);
     ViewPlane view = make_view_plane(cam, settings.width, settings.height);
     int mismatches = 0, hits = 0;
     for (int y = 0; y < settings.height; ++y)
@@ -233,7 +233,7 @@ TEST(Renderer, MatchesABruteForceReference) {
                                        s.positions[tri[2]], t, u, v))
                     best = t;
             }
-            float got = r.gbuffer().distance(x, y);
+            float got = r.layers().distance(x, y);
             if (std::isfinite(best)) ++hits;
             if (!(got == best)) ++mismatches;
         }
@@ -246,12 +246,12 @@ TEST(Renderer, TeapotMatchesTheGoldenImage) {
     // figures; tiny differences (a ray through a shared edge) are tolerated.
     Scene s = load("teapot.obj");
     RenderSettings settings;
-    settings.edges = EdgeMode::Classic;
+    settings.lines.mode = LineMode::Classic;
     CameraSpec cam = framing_camera(s, settings);
     TriangleAccel accel;
     accel.build(s.positions, s.tri_positions);
     Renderer r;
-    const ImageRgb8& out = r.render(s, accel, cam, settings);
+    const ImageRgb8& out = r.render(s, accel, cam, test_support::default_lights(s, cam), settings);
     DecodedPng golden =
         read_png(std::string(TOONRAY_TEST_DATA_DIR) + "/golden/teapot_classic_1280x720.png");
     ASSERT_EQ(golden.width, out.width());
@@ -262,134 +262,86 @@ TEST(Renderer, TeapotMatchesTheGoldenImage) {
     EXPECT_LE(differ, out.size() / 1000) << differ << " pixels differ";
 }
 
-TEST(Renderer, FeatureImagesAreComputedOnlyWhenAskedAndChangeNothingElse) {
+TEST(Renderer, LayersAreFilledOnlyWhenAskedAndChangeNothingElse) {
     Scene s = load("teapot.obj");
     TriangleAccel accel;
     accel.build(s.positions, s.tri_positions);
-    for (EdgeMode mode : {EdgeMode::Classic, EdgeMode::Robust, EdgeMode::Ink}) {
+    for (LineMode mode : {LineMode::Classic, LineMode::Robust, LineMode::Ink}) {
         RenderSettings settings;
-        settings.edges = mode;
+        settings.lines.mode = mode;
         settings.width = 160;
         settings.height = 90;
         const CameraSpec cam = framing_camera(s, settings);
+        const std::vector<Light> lights = test_support::default_lights(s, cam);
         Renderer with, without;
-        settings.feature_images = true;
-        const ImageRgb8 a = with.render(s, accel, cam, settings);
-        settings.feature_images = false;
-        const ImageRgb8 b = without.render(s, accel, cam, settings);
+        settings.layers = true;
+        const ImageRgb8 a = with.render(s, accel, cam, lights, settings);
+        settings.layers = false;
+        const ImageRgb8 b = without.render(s, accel, cam, lights, settings);
         ASSERT_EQ(a.size(), b.size());
         EXPECT_EQ(0, std::memcmp(a.data(), b.data(), a.size() * sizeof(Rgb8)));
-        for (const FeatureImage& f : feature_images()) {
-            const std::size_t asked =
-                std::visit([&](auto m) { return (with.aovs().*m).size(); }, f.image);
-            const std::size_t not_asked =
-                std::visit([&](auto m) { return (without.aovs().*m).size(); }, f.image);
-            EXPECT_EQ(asked, f.in(mode) ? a.size() : 0u) << f.name;
-            EXPECT_EQ(not_asked, 0u) << f.name;
-        }
-        // The same renderer, asked and then not: nothing of the earlier frame's features shows.
-        with.render(s, accel, cam, settings);
-        EXPECT_EQ(with.aovs().depth.size(), 0u);
-        EXPECT_EQ(with.aovs().cel.size(), 0u);
+        const FrameLayers& l = with.layers();
+        for (std::size_t size : {l.cel.size(), l.distance.size(), l.view_depth.size(),
+                                 l.normal.size(), l.object.size(), l.band.size(), l.light.size(),
+                                 l.position.size(), l.uv.size(), l.refined.size(), l.lines.size()})
+            EXPECT_EQ(size, a.size());
+        const std::size_t types =
+            mode == LineMode::Classic ? 2 : (mode == LineMode::Robust ? 5 : 6);
+        ASSERT_EQ(l.line_types.size(), types);
+        for (const LineLayer& type : l.line_types) EXPECT_EQ(type.coverage.size(), a.size());
+        const FrameLayers& none = without.layers();
+        EXPECT_EQ(none.distance.size() + none.object.size() + none.band.size(), 0u);
+        EXPECT_TRUE(none.line_types.empty());
+        // The same renderer, asked and then not: nothing of the earlier frame's layers shows.
+        with.render(s, accel, cam, lights, settings);
+        EXPECT_EQ(with.layers().distance.size(), 0u);
+        EXPECT_TRUE(with.layers().line_types.empty());
     }
 }
 
-TEST(Renderer, FeatureImageTableListsEachModesImages) {
-    std::vector<std::string_view> classic, robust, ink;
-    for (const FeatureImage& f : feature_images()) {
-        if (f.in(EdgeMode::Classic)) classic.push_back(f.name);
-        if (f.in(EdgeMode::Robust)) robust.push_back(f.name);
-        if (f.in(EdgeMode::Ink)) ink.push_back(f.name);
-    }
-    EXPECT_EQ(ink, (std::vector<std::string_view>{
-                       "depth", "normal", "edges", "cel", "lines_silhouette", "lines_crease",
-                       "lines_material", "lines_border", "lines_intersection", "lines_polyline",
-                       "object_id", "material_id", "samples"}));
-    EXPECT_EQ(classic, (std::vector<std::string_view>{"depth", "normal", "edges_depth",
-                                                      "edges_normal", "edges", "cel"}));
-    EXPECT_EQ(robust, (std::vector<std::string_view>{
-                          "depth", "normal", "edges", "cel", "lines_silhouette", "lines_crease",
-                          "lines_depth", "lines_object", "lines_material", "object_id",
-                          "material_id", "samples"}));
-}
-
-// frame_buffer_bytes counts the buffers a renderer holds after a frame: exactly the frame-sized
-// ones, and per thread at most bucket_buffer_bytes (which every sample of a bucket reaches).
-TEST(Renderer, FrameBufferBytesCountTheBuffersRendererHolds) {
+// frame_buffer_bytes bounds what a renderer holds after a frame, not loosely: every sample of
+// every bucket traced (adaptive off), with and without the layers.
+TEST(Renderer, FrameBufferBytesBoundTheBuffersRendererHolds) {
     Scene s = load("spot.obj");
     TriangleAccel accel;
     accel.build(s.positions, s.tri_positions);
     struct Case {
-        EdgeMode mode;
+        LineMode mode;
         int samples;
         float line_width;
     };
     // The last robust case draws lines so wide that each bucket uses the full distance image.
-    for (const Case& c : {Case{EdgeMode::Classic, 1, 2.0f}, Case{EdgeMode::Robust, 1, 2.0f},
-                          Case{EdgeMode::Robust, 4, 2.0f}, Case{EdgeMode::Robust, 9, 2.0f},
-                          Case{EdgeMode::Robust, 4, 100.0f}, Case{EdgeMode::Ink, 1, 2.0f},
-                          Case{EdgeMode::Ink, 4, 2.0f}}) {
-        RenderSettings settings;
-        settings.edges = c.mode;
-        settings.samples = c.samples;
-        settings.lines.width = c.line_width;
-        settings.width = 96;
-        settings.height = 720;  // tall enough that 100-pixel lines need the full distance image
-        settings.feature_images = true;
-        settings.adaptive = false;  // every sample traced: the buckets' largest buffers
-        settings.threads = 1;
-        const CameraSpec cam = framing_camera(s, settings);
-        Renderer r;
-        const ImageRgb8& out = r.render(s, accel, cam, settings);
-        const GBuffer& g = r.gbuffer();
-        std::uint64_t held = bytes_of(out) + bytes_of(g.distance) + bytes_of(g.normal) +
-                             bytes_of(g.view_depth) + bytes_of(g.geometric_normal) +
-                             bytes_of(g.colour) + bytes_of(g.material) + bytes_of(g.object);
-        std::uint64_t features = 0;
-        for (const FeatureImage& f : feature_images())
-            features += std::visit([&](auto m) { return bytes_of(r.aovs().*m); }, f.image);
-        held += features;
-        if (c.mode != EdgeMode::Classic) {
-            // The first samples' depths the depth feature image is scaled by.
-            features += static_cast<std::uint64_t>(settings.width) * settings.height * 4;
-            held += static_cast<std::uint64_t>(settings.width) * settings.height * 4;
+    for (const Case& c : {Case{LineMode::Classic, 1, 2.0f}, Case{LineMode::Robust, 1, 2.0f},
+                          Case{LineMode::Robust, 4, 2.0f}, Case{LineMode::Robust, 9, 2.0f},
+                          Case{LineMode::Robust, 4, 100.0f}, Case{LineMode::Ink, 1, 2.0f},
+                          Case{LineMode::Ink, 4, 2.0f}})
+        for (bool layers : {true, false}) {
+            RenderSettings settings;
+            settings.lines.mode = c.mode;
+            settings.sampling.samples = c.samples;
+            settings.lines.width = c.line_width;
+            settings.width = 96;
+            settings.height = 720;  // tall enough that 100-pixel lines need the distance image
+            settings.layers = layers;
+            settings.sampling.adaptive = false;  // every sample traced: the largest buffers
+            settings.threads = 1;
+            const CameraSpec cam = framing_camera(s, settings);
+            Renderer r;
+            r.render(s, accel, cam, test_support::default_lights(s, cam), settings);
+            if (c.line_width > 50.0f) {
+                EXPECT_GT(line_distance_band(line_thickness(c.line_width, settings.height, 2)),
+                          kMaxDistanceBand);
+            }
+            const std::uint64_t estimate = frame_buffer_bytes(settings);
+            const std::uint64_t held = r.held_bytes();
+            EXPECT_LE(held, estimate) << c.samples << " layers " << layers;
+            EXPECT_GT(static_cast<double>(held), 0.75 * static_cast<double>(estimate))
+                << c.samples << " layers " << layers;
         }
-        if (c.mode == EdgeMode::Ink) {
-            const ink::InkLines& ink = r.ink_lines();
-            // The line layer, and the same again while each line type's feature image is drawn.
-            held += 2 * (bytes_of(ink.coverage) + bytes_of(ink.style));
-        }
-        if (c.line_width > 50.0f) {
-            EXPECT_GT(line_distance_band(line_thickness(c.line_width, settings.height, 2)),
-                      kMaxDistanceBand);
-        }
-        const std::uint64_t buckets =
-            c.mode == EdgeMode::Classic ? 0 : bucket_buffer_bytes(settings);
-        if (c.mode != EdgeMode::Classic) {
-            EXPECT_GT(r.bucket_bytes(), 0u);
-            EXPECT_LE(r.bucket_bytes(), buckets) << c.samples;
-            EXPECT_GT(r.bucket_bytes(), buckets / 2) << c.samples;  // not a loose bound
-        }
-        EXPECT_EQ(frame_buffer_bytes(settings), held + buckets) << c.samples;
-        // Without feature images: classic keeps the maps its lines come from, less cel.
-        settings.feature_images = false;
-        const std::uint64_t kept =
-            c.mode == EdgeMode::Classic ? features - bytes_of(r.aovs().cel) : 0;
-        // Ink without feature images: the layer each line type is drawn into is not needed,
-        // and the mask of pixels the lines hide (a byte each) is.
-        const std::uint64_t type_layer =
-            c.mode == EdgeMode::Ink
-                ? bytes_of(r.ink_lines().coverage) + bytes_of(r.ink_lines().style)
-                : 0;
-        const std::uint64_t hidden = c.mode == EdgeMode::Ink ? bytes_of(out) / sizeof(Rgb8) : 0;
-        EXPECT_EQ(frame_buffer_bytes(settings),
-                  held + buckets - features + kept - type_layer + hidden)
-            << c.samples;
-    }
     RenderSettings huge;
     huge.width = huge.height = 2147483647;
-    huge.edges = EdgeMode::Ink;
-    huge.feature_images = true;
+    huge.lines.mode = LineMode::Ink;
+    huge.layers = true;
     EXPECT_EQ(frame_buffer_bytes(huge), UINT64_MAX);
 }
 
@@ -411,54 +363,61 @@ TEST(Renderer, InkLinesAreTheCoverageOverTheCelColours) {
     TriangleAccel accel;
     accel.build(s.positions, s.tri_positions);
     RenderSettings settings;
-    settings.edges = EdgeMode::Ink;
+    settings.lines.mode = LineMode::Ink;
     settings.width = 320;
     settings.height = 180;
-    settings.feature_images = true;
+    settings.layers = true;
     settings.lines.colour = Vec3f(0.2f, 0.0f, 0.0f);
     const CameraSpec cam = framing_camera(s, settings);
     Renderer r;
-    const ImageRgb8 image = r.render(s, accel, cam, settings);
+    const ImageRgb8 image = r.render(s, accel, cam, test_support::default_lights(s, cam), settings);
     const ink::InkLines& lines = r.ink_lines();
     ASSERT_EQ(lines.coverage.width(), 320);
-    ImageRgb8 expected = r.aovs().cel;
+    ImageRgb8 expected = r.layers().cel;
     ink::composite_lines(lines.coverage, settings.lines.colour, expected);
     ASSERT_EQ(0, std::memcmp(image.data(), expected.data(), image.size() * sizeof(Rgb8)));
+    ASSERT_TRUE(test_support::same_image(lines.coverage, r.layers().lines, "lines"));
     ImageGray8 gray;
     ink::coverage_to_gray(lines.coverage, gray);
-    ASSERT_EQ(0, std::memcmp(gray.data(), r.aovs().edges.data(), gray.size()));
     long line_pixels = 0;
     for (std::size_t i = 0; i < gray.size(); ++i) line_pixels += gray.data()[i] < 128;
     EXPECT_GT(line_pixels, 300);
-    // One image per line type: together (the darkest per pixel) they are the edges image, and
+    // One layer per line type: together (the most per pixel) they are the lines layer, and
     // the teapot (a mesh without normals, open at the spout's and lid's rims) has silhouettes,
     // creases and borders.
-    const ImageGray8* types[] = {&r.aovs().lines_silhouette,   &r.aovs().lines_crease,
-                                 &r.aovs().lines_material,     &r.aovs().lines_border,
-                                 &r.aovs().lines_intersection, &r.aovs().lines_polyline};
-    std::vector<long> type_pixels(std::size(types), 0);
+    const std::vector<LineLayer>& types = r.layers().line_types;
+    ASSERT_EQ(types.size(), 6u);
+    const char* names[] = {"silhouette", "border",       "crease",
+                           "material",   "intersection", "polyline"};
+    for (std::size_t t = 0; t < types.size(); ++t) EXPECT_EQ(types[t].name, names[t]);
+    std::vector<long> type_pixels(types.size(), 0);
     for (std::size_t i = 0; i < gray.size(); ++i) {
-        std::uint8_t darkest = 255;
-        for (std::size_t t = 0; t < std::size(types); ++t) {
-            ASSERT_EQ(types[t]->size(), gray.size());
-            darkest = std::min(darkest, types[t]->data()[i]);
-            type_pixels[t] += types[t]->data()[i] < 128;
+        float most = 0.0f;
+        for (std::size_t t = 0; t < types.size(); ++t) {
+            ASSERT_EQ(types[t].coverage.size(), gray.size());
+            most = std::max(most, types[t].coverage.data()[i]);
+            type_pixels[t] += types[t].coverage.data()[i] > 0.5f;
         }
-        ASSERT_EQ(darkest, gray.data()[i]) << i;
+        ASSERT_EQ(most, lines.coverage.data()[i]) << i;
     }
     EXPECT_GT(type_pixels[0], 100);  // silhouettes
+    EXPECT_GT(type_pixels[1], 10);   // borders
     EXPECT_EQ(type_pixels[5], 0);    // no polylines in the scene
-    // Hidden lines are found for SVG but not drawn; any thread count gives the same pixels.
+    // Hidden lines are kept with the strokes (for SVG) but not drawn; any thread count gives the
+    // same pixels.
+    settings.strokes = true;
     settings.hidden_lines = true;
     settings.threads = 1;
     Renderer one;
-    const ImageRgb8 again = one.render(s, accel, cam, settings);
+    const ImageRgb8 again =
+        one.render(s, accel, cam, test_support::default_lights(s, cam), settings);
     EXPECT_EQ(0, std::memcmp(image.data(), again.data(), image.size() * sizeof(Rgb8)));
     bool hidden = false;
     for (const auto& stroke : one.ink_lines().strokes) hidden = hidden || !stroke.visible;
     EXPECT_TRUE(hidden);
     // Line types map onto the ink's: none draws nothing.
     settings.lines.types = 0;
-    const ImageRgb8 bare = one.render(s, accel, cam, settings);
-    EXPECT_EQ(0, std::memcmp(bare.data(), one.aovs().cel.data(), bare.size() * sizeof(Rgb8)));
+    const ImageRgb8 bare =
+        one.render(s, accel, cam, test_support::default_lights(s, cam), settings);
+    EXPECT_EQ(0, std::memcmp(bare.data(), one.layers().cel.data(), bare.size() * sizeof(Rgb8)));
 }

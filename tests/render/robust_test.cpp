@@ -16,6 +16,7 @@
 #include "toonray/render/classic.h"
 #include "toonray/render/renderer.h"
 #include "toonray/render/trace.h"
+#include "support/test_scenes.h"
 
 using namespace toonray;
 
@@ -26,20 +27,27 @@ constexpr float kPi = 3.14159265f;
 struct Frame {
     Renderer renderer;
     RenderSettings settings;
+    std::vector<Light> lights;  ///< none: the default light
     CameraSpec camera;
     ViewPlane view;
     int sub = 1;                     ///< samples per pixel side
     Image<std::uint8_t> sample_hit;  ///< whether each sample's ray hits, traced here one by one
 };
 
+std::vector<Light> lights_or_default(const Frame& f, const Scene& scene) {
+    return f.lights.empty() ? test_support::default_lights(scene, f.camera) : f.lights;
+}
+
 void render(Frame& f, const Scene& scene) {
     TriangleAccel accel;
     accel.build(scene.positions, scene.tri_positions);
     f.view = make_view_plane(f.camera, f.settings.width, f.settings.height);
-    f.settings.feature_images = true;  // coverage() reads the line coverage image
-    f.renderer.render(scene, accel, f.camera, f.settings);
+    f.settings.layers = true;  // coverage() reads the line coverage image
+    f.renderer.render(scene, accel, f.camera, lights_or_default(f, scene), f.settings);
     // The renderer keeps no per-sample buffers: which samples see the scene, ray by ray.
-    f.sub = f.settings.edges == EdgeMode::Classic ? 1 : samples_per_side(f.settings.samples);
+    f.sub = f.settings.lines.mode == LineMode::Classic
+                ? 1
+                : samples_per_side(f.settings.sampling.samples);
     f.sample_hit.resize(f.settings.width * f.sub, f.settings.height * f.sub);
     for (int y = 0; y < f.sample_hit.height(); ++y)
         for (int x = 0; x < f.sample_hit.width(); ++x) {
@@ -49,11 +57,9 @@ void render(Frame& f, const Scene& scene) {
         }
 }
 
-// Line coverage of pixel (x, y) in [0, 1]: robust from the coverage image, classic from the
-// merged edge image (1 on an edge).
-float coverage(const Frame& f, int x, int y) {
-    return 1.0f - f.renderer.aovs().edges(x, y) / 255.0f;
-}
+// Line coverage of pixel (x, y) in [0, 1]: robust's coverage, classic's merged edges (1 on an
+// edge).
+float coverage(const Frame& f, int x, int y) { return f.renderer.layers().lines(x, y); }
 
 // Pixel coordinates (continuous, pixel centres at +0.5) of a world point.
 Vec2f project(const ViewPlane& v, const Vec3f& p) {
@@ -228,12 +234,12 @@ TEST(RobustLines, GrazingPlaneHasNoLinesInside) {
         Vec3f dir(0.0f, -std::cos(a), -std::sin(a));
         Vec3f eye(0.0f, 2.0f, 0.0f);
         int false_lines[2] = {0, 0};
-        for (EdgeMode mode : {EdgeMode::Classic, EdgeMode::Robust}) {
+        for (LineMode mode : {LineMode::Classic, LineMode::Robust}) {
             Frame f;
             f.settings.width = 320;
             f.settings.height = 180;
-            f.settings.edges = mode;
-            f.settings.light = Vec3f(0, 1000, 0);
+            f.settings.lines.mode = mode;
+            f.lights = {Light{Light::Kind::Point, Vec3f(0, 1000, 0), 1.0f}};
             f.camera = look_at(eye, eye + dir, 60.0f, {0, 1, 0});
             render(f, floor);
             auto inside = interior_pixels(f, 3);
@@ -241,7 +247,7 @@ TEST(RobustLines, GrazingPlaneHasNoLinesInside) {
             int lines = 0;
             for (auto [x, y] : inside)
                 if (coverage(f, x, y) > 0.0f) ++lines;
-            false_lines[mode == EdgeMode::Robust] = lines;
+            false_lines[mode == LineMode::Robust] = lines;
         }
         std::printf("grazing plane at %.0f deg: false line pixels classic %d, robust %d\n", angle,
                     false_lines[0], false_lines[1]);
@@ -254,11 +260,11 @@ TEST(RobustLines, TessellatedSphereHasLinesOnlyAtItsSilhouette) {
     Scene ball = sphere(200, 101, 1.0f);
     ASSERT_GT(ball.triangle_count(), 39000u);
     int false_lines[2] = {0, 0};
-    for (EdgeMode mode : {EdgeMode::Classic, EdgeMode::Robust}) {
+    for (LineMode mode : {LineMode::Classic, LineMode::Robust}) {
         Frame f;
         f.settings.width = 640;
         f.settings.height = 360;
-        f.settings.edges = mode;
+        f.settings.lines.mode = mode;
         f.camera = look_at({0.3f, 0.8f, 4.0f}, {0, 0, 0}, 45.0f);
         render(f, ball);
         const int sub = f.sub;
@@ -276,7 +282,7 @@ TEST(RobustLines, TessellatedSphereHasLinesOnlyAtItsSilhouette) {
                     for (int dx = -near; dx <= near; ++dx)
                         (hit(x + dx, y + dy) ? near_hit : near_miss) = true;
                 float c = coverage(f, x, y);
-                if (hit(x, y) && !near_miss && c > 0.0f) ++false_lines[mode == EdgeMode::Robust];
+                if (hit(x, y) && !near_miss && c > 0.0f) ++false_lines[mode == LineMode::Robust];
                 // Silhouette pixels: a hit with a miss as a 4-neighbour.
                 if (hit(x, y) &&
                     (!hit(x - 1, y) || !hit(x + 1, y) || !hit(x, y - 1) || !hit(x, y + 1))) {
@@ -284,7 +290,7 @@ TEST(RobustLines, TessellatedSphereHasLinesOnlyAtItsSilhouette) {
                     if (coverage_near(f, {x + 0.5f, y + 0.5f}) > 0.5f) ++silhouette_drawn;
                 }
             }
-        if (mode == EdgeMode::Robust) {
+        if (mode == LineMode::Robust) {
             EXPECT_GT(silhouette, 500);
             EXPECT_EQ(silhouette_drawn, silhouette) << "silhouette incomplete";
         }
@@ -309,33 +315,33 @@ TEST(RobustLines, AdaptiveSamplingKeepsTheGrazingFloorAndTheSphere) {
         {"grazing floor", floor_plane(500.0f, 60), look_at(eye, eye + dir, 60.0f, {0, 1, 0})},
         {"sphere", sphere(200, 101, 1.0f), look_at({0.3f, 0.8f, 4.0f}, {0, 0, 0}, 45.0f)}};
     for (const Case& c : cases)
-        for (EdgeMode mode : {EdgeMode::Robust, EdgeMode::Ink}) {
+        for (LineMode mode : {LineMode::Robust, LineMode::Ink}) {
             Frame adaptive, full;
             for (Frame* f : {&adaptive, &full}) {
                 f->settings.width = 640;
                 f->settings.height = 360;
-                f->settings.edges = mode;
-                f->settings.light = Vec3f(0, 1000, 0);
-                f->settings.adaptive = f == &adaptive;
+                f->settings.lines.mode = mode;
+                f->lights = {Light{Light::Kind::Point, Vec3f(0, 1000, 0), 1.0f}};
+                f->settings.sampling.adaptive = f == &adaptive;
                 f->camera = c.camera;
                 render(*f, c.scene);
             }
-            const ImageRgb8& x = adaptive.renderer.aovs().cel;
-            const ImageRgb8& y = full.renderer.aovs().cel;
+            const ImageRgb8& x = adaptive.renderer.layers().cel;
+            const ImageRgb8& y = full.renderer.layers().cel;
             ASSERT_EQ(x.size(), y.size());
             // The final image: colours and lines.
             std::size_t differing = 0;
-            const ImageGray8& ex = adaptive.renderer.aovs().edges;
-            const ImageGray8& ey = full.renderer.aovs().edges;
+            const ImageF& ex = adaptive.renderer.layers().lines;
+            const ImageF& ey = full.renderer.layers().lines;
             for (std::size_t i = 0; i < x.size(); ++i) {
-                bool differs = std::abs(ex.data()[i] - ey.data()[i]) > 2;
+                bool differs = std::abs(ex.data()[i] - ey.data()[i]) * 255.0f > 2.0f;
                 for (int ch = 0; ch < 3; ++ch)
                     differs |= std::abs(x.data()[i][ch] - y.data()[i][ch]) > 2;
                 differing += differs;
             }
             const double share = static_cast<double>(differing) / static_cast<double>(x.size());
             std::printf("%s, %s: %.3f%% of pixels differ by more than 2/255 (%llu refined)\n",
-                        c.name, mode == EdgeMode::Ink ? "ink" : "robust", 100 * share,
+                        c.name, mode == LineMode::Ink ? "ink" : "robust", 100 * share,
                         static_cast<unsigned long long>(adaptive.renderer.refined_pixels()));
             EXPECT_LE(share, 0.005) << c.name;
             EXPECT_LT(adaptive.renderer.refined_pixels(), x.size() / 4) << c.name;
@@ -438,7 +444,7 @@ TEST(RobustLines, WidthScalesWithResolution) {
         Frame f;
         f.settings.width = height * 16 / 9;
         f.settings.height = height;
-        f.settings.samples = 1;  // keeps the 4K G-buffer small; widths do not depend on it
+        f.settings.sampling.samples = 1;  // keeps the 4K G-buffer small; widths do not depend on it
         f.camera = look_at({2.6f, 2.1f, 3.0f}, {0.5f, 0.5f, 0.5f}, 40.0f);
         render(f, cube);
         for (int y = 0; y < height; ++y)
@@ -495,7 +501,9 @@ TEST(RobustLines, ParsesLineTypes) {
     EXPECT_EQ(parse_line_types("none"), 0u);
     EXPECT_EQ(parse_line_types("silhouette,crease"),
               static_cast<unsigned>(kLineSilhouette | kLineCrease));
-    EXPECT_THROW(parse_line_types("silhouette,outline"), Error);
+    EXPECT_THROW((void)parse_line_types("silhouette,outline"), Error);
+    for (unsigned types : {0u, 1u, 5u, 30u, unsigned(kLineAll)})
+        EXPECT_EQ(parse_line_types(format_line_types(types)), types) << format_line_types(types);
     try {
         (void)parse_line_types("silhouette,outline");
     } catch (const Error& e) {
@@ -528,7 +536,7 @@ namespace {
 
 // find_line_seeds as it was first written, pixel by pixel: the reference the row-wise,
 // vectorised version must match bit for bit.
-Image<std::uint8_t> reference_seeds(const FineBuffers& fine, const RobustLineSettings& s) {
+Image<std::uint8_t> reference_seeds(const FineBuffers& fine, const LineSettings& s) {
     const float inf = std::numeric_limits<float>::infinity();
     const int w = fine.depth.width(), h = fine.depth.height();
     Image<std::uint8_t> seeds(w, h, 0);
@@ -557,7 +565,7 @@ Image<std::uint8_t> reference_seeds(const FineBuffers& fine, const RobustLineSet
             float z0 = fine.depth(x0, y0), z1 = fine.depth(x1, y1);
             if (z0 == inf || z1 == inf) return;
             float i0 = 1.0f / z0, i1 = 1.0f / z1;
-            if (!(std::abs(i0 - 2.0f * inv + i1) > s.depth_threshold * inv)) return;
+            if (!(std::abs(i0 - 2.0f * inv + i1) > s.robust.depth_step * inv)) return;
             bool first = std::abs(i0 - inv) > std::abs(i1 - inv);
             float z_across = first ? z0 : z1;
             if (z_across > z) farthest_step = std::max(farthest_step, (z_across - z) / z);
@@ -565,7 +573,7 @@ Image<std::uint8_t> reference_seeds(const FineBuffers& fine, const RobustLineSet
         if (x > 0 && x + 1 < w) along(x - 1, y, x + 1, y);
         if (y > 0 && y + 1 < h) along(x, y - 1, x, y + 1);
         if (farthest_step < 0.0f) return 0;
-        return s.types & (farthest_step > s.silhouette_ratio ? kLineSilhouette : kLineDepth);
+        return s.types & (farthest_step > s.robust.silhouette_ratio ? kLineSilhouette : kLineDepth);
     };
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x) {
@@ -683,7 +691,7 @@ TEST(RobustLines, SeedsMatchThePerPixelReference) {
                                unsigned(kLineCrease), 0u})
             for (int threads : {1, 2, 3}) {
                 RandomGBuffer g(size[0], size[1], ++seed);
-                RobustLineSettings settings;
+                LineSettings settings;
                 settings.types = types;
                 Image<std::uint8_t> expected = reference_seeds(g.fine(), settings), seeds;
                 find_line_seeds(g.fine(), settings, seeds, threads);

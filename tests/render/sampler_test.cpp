@@ -6,13 +6,13 @@
 
 #include <cstdio>
 #include <cstring>
-#include <variant>
 
 #include "toonray/render/classic.h"
 #include "toonray/render/renderer.h"
 #include "toonray/render/trace.h"
 #include "toonray/scene/obj_loader.h"
 #include "support/image_compare.h"
+#include "support/same_layers.h"
 #include "support/test_scenes.h"
 
 using namespace toonray;
@@ -36,7 +36,7 @@ struct SceneView {
         settings.height = height;
         camera = test_support::framing_camera(scene, width, height);
         view = make_view_plane(camera, width, height);
-        lights = {Light{Light::Kind::Point, default_light(scene, view), 1.0f}};
+        lights = test_support::default_lights(scene, camera);
     }
 
     // The colour of fine-grid sample (x, y), traced and shaded one ray at a time.
@@ -78,9 +78,9 @@ TEST(BucketSampler, RefinedPixelsAreFullSupersamplingAndTheRestTheirFirstSample)
     SceneView s("spot.obj", 160, 90);
     const int sub = 2;
     const ShadingContext ctx{s.scene, s.accel, s.settings.shading, s.lights, nullptr};
+    const LookFrame look{s.scene, s.settings.shading, s.settings.background, false};
     for (bool adaptive : {true, false}) {
-        const SamplerFrame frame{s.accel, ctx, s.view,   s.settings.background, 160,
-                                 90,      sub, adaptive, RefineRule{}};
+        const SamplerFrame frame{s.accel, ctx, look, s.view, 160, 90, sub, adaptive, RefineRule{}};
         BucketSampler sampler;
         const PixelRect decided{40, 20, 104, 70};
         sampler.sample(frame, decided.grown(1, 160, 90), decided);
@@ -114,35 +114,27 @@ TEST(BucketSampler, RefinedPixelsAreFullSupersamplingAndTheRestTheirFirstSample)
 TEST(AdaptiveSampling, FramesAreTheSameForAnyBucketSizeAndThreadCount) {
     for (const char* name : {"teapot.obj", "spot.obj"}) {
         SceneView s(name, 200, 120);
-        for (EdgeMode mode : {EdgeMode::Ink, EdgeMode::Robust}) {
+        for (LineMode mode : {LineMode::Ink, LineMode::Robust}) {
             RenderSettings settings = s.settings;
-            settings.edges = mode;
-            settings.feature_images = true;
+            settings.lines.mode = mode;
+            settings.layers = true;
             Renderer reference_renderer;
-            const ImageRgb8 reference =
-                reference_renderer.render(s.scene, s.accel, s.camera, settings);
+            const ImageRgb8 reference = reference_renderer.render(
+                s.scene, s.accel, s.camera, test_support::default_lights(s.scene, s.camera),
+                settings);
             for (int tile : {1, 7, 64, 1000})
                 for (int threads : {1, 2, 3}) {
-                    settings.tile_size = tile;
+                    settings.sampling.tile_size = tile;
                     settings.threads = threads;
                     Renderer r;
-                    const ImageRgb8& image = r.render(s.scene, s.accel, s.camera, settings);
+                    const ImageRgb8& image =
+                        r.render(s.scene, s.accel, s.camera,
+                                 test_support::default_lights(s.scene, s.camera), settings);
                     ASSERT_EQ(0, std::memcmp(image.data(), reference.data(), image.size() * 3))
                         << name << " tile " << tile << " threads " << threads;
                     EXPECT_EQ(r.refined_pixels(), reference_renderer.refined_pixels());
-                    for (const FeatureImage& f : feature_images()) {
-                        if (!f.in(mode)) continue;
-                        std::visit(
-                            [&](auto m) {
-                                const auto& a = r.aovs().*m;
-                                const auto& b = reference_renderer.aovs().*m;
-                                ASSERT_EQ(a.size(), b.size()) << f.name;
-                                ASSERT_EQ(0, std::memcmp(a.data(), b.data(),
-                                                         a.size() * sizeof(*a.data())))
-                                    << f.name << " tile " << tile;
-                            },
-                            f.image);
-                    }
+                    ASSERT_TRUE(test_support::same_layers(r.layers(), reference_renderer.layers()))
+                        << name << " tile " << tile << " threads " << threads;
                 }
         }
     }
@@ -153,18 +145,22 @@ TEST(AdaptiveSampling, FramesAreTheSameForAnyBucketSizeAndThreadCount) {
 TEST(AdaptiveSampling, StaysWithinFullSupersampling) {
     for (const char* name : {"teapot.obj", "spot.obj"}) {
         SceneView s(name, 640, 360);
-        for (EdgeMode mode : {EdgeMode::Ink, EdgeMode::Robust}) {
+        for (LineMode mode : {LineMode::Ink, LineMode::Robust}) {
             RenderSettings settings = s.settings;
-            settings.edges = mode;
+            settings.lines.mode = mode;
             Renderer adaptive, full;
-            const ImageRgb8 a = adaptive.render(s.scene, s.accel, s.camera, settings);
-            settings.adaptive = false;
-            const ImageRgb8& b = full.render(s.scene, s.accel, s.camera, settings);
+            const ImageRgb8 a =
+                adaptive.render(s.scene, s.accel, s.camera,
+                                test_support::default_lights(s.scene, s.camera), settings);
+            settings.sampling.adaptive = false;
+            const ImageRgb8& b =
+                full.render(s.scene, s.accel, s.camera,
+                            test_support::default_lights(s.scene, s.camera), settings);
             const double differing = test_support::share_differing(a, b, 2);
             const double refined =
                 static_cast<double>(adaptive.refined_pixels()) / static_cast<double>(a.size());
             std::printf("%s %s: %.3f%% of pixels differ by more than 2/255; %.1f%% refined\n", name,
-                        mode == EdgeMode::Ink ? "ink" : "robust", 100 * differing, 100 * refined);
+                        mode == LineMode::Ink ? "ink" : "robust", 100 * differing, 100 * refined);
             EXPECT_LE(differing, 0.005) << name;
             EXPECT_EQ(full.refined_pixels(), a.size());
             EXPECT_LT(refined, 0.25) << name;

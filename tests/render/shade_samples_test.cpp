@@ -9,7 +9,7 @@
 #include <random>
 #include <vector>
 
-#include "toonray/render/renderer.h"
+#include "toonray/render/look.h"
 #include "toonray/render/trace.h"
 #include "support/test_scenes.h"
 #include "support/same_bits.h"
@@ -73,50 +73,91 @@ TEST(ShadeSamples, EqualsTheScalarShadingOfEverySample) {
     }
     ASSERT_GT(hit_count, n / 8);
 
-    std::vector<Vec3f> colour(n), geometric(n), shading(n);
-    std::vector<float> view_depth(n), distance(n);
-    std::vector<std::uint32_t> material(n), object(n);
-    std::vector<std::uint8_t> hit_flags(n);
-    for (int kind = 0; kind < 3; ++kind) {
-        ShadedSamples out;
-        out.colour = colour.data();
-        if (kind != 2) out.found = hit_flags.data();
-        if (kind == 1) {
-            out.view_depth = view_depth.data();
-            out.geometric_normal = geometric.data();
-        }
-        if (kind == 2) {
-            out.distance = distance.data();
-            out.shading_normal = shading.data();
-        }
-        if (kind != 0) {
-            out.material = material.data();
-            out.object = object.data();
-        }
-        shade_samples(ctx, view, background, n, dirs.data(), hits.data(), found.get(), out);
-        for (int i = 0; i < n; ++i) {
-            if (kind != 2) {
-                ASSERT_EQ(hit_flags[i], found[i] ? 1 : 0);
-            }
-            if (!found[i]) {
-                ASSERT_TRUE(same_bits(colour[i], background));
+    const LookFrame look{scene, settings, background, false};
+    for (SurfaceFields level : {SurfaceFields::Look, SurfaceFields::Geometry, SurfaceFields::All}) {
+        SurfaceSamples out;
+        out.resize(static_cast<std::size_t>(n) + 3, level, 1);
+        shade_samples(ctx, view, n, dirs.data(), hits.data(), found.get(), out, 3);
+        apply_look(look, out, 3, out.size());
+        for (int k = 0; k < n; ++k) {
+            const std::size_t i = static_cast<std::size_t>(k) + 3;
+            ASSERT_EQ(out.found[i], found[k] ? 1 : 0);
+            if (!found[k]) {
+                ASSERT_TRUE(same_bits(out.colour[i], background));
+                ASSERT_EQ(out.object[i], kNoIndex);
+                ASSERT_EQ(out.band[i], kNoBand);
                 continue;
             }
-            const Vec3f normal = shading_normal(scene, hits[i], dirs[i]);
-            ASSERT_TRUE(same_bits(colour[i], shade_hit(ctx, hits[i], view.eye, dirs[i], normal)))
-                << "sample " << i;
-            if (kind == 1) {
-                ASSERT_TRUE(same_bits(geometric[i], geometric_normal(scene, hits[i], dirs[i])));
-                ASSERT_EQ(view_depth[i], hits[i].t * dot(dirs[i], view.forward));
+            const Hit& hit = hits[k];
+            const Vec3f normal = shading_normal(scene, hit, dirs[k]);
+            ASSERT_TRUE(same_bits(out.colour[i], shade_hit(ctx, hit, view.eye, dirs[k], normal)))
+                << "sample " << k;
+            float n_dot_l = 0.0f;
+            const LightTerms terms = light_terms(ctx, hit, view.eye, dirs[k], normal, &n_dot_l);
+            ASSERT_EQ(out.band[i], terms.band);
+            ASSERT_EQ(out.accents[i], terms.accents);
+            ASSERT_TRUE(same_bits(out.albedo[i], terms.albedo));
+            ASSERT_EQ(out.material[i], scene.tri_material[hit.prim]);
+            ASSERT_EQ(out.object[i], scene.tri_object[hit.prim]);
+            if (level >= SurfaceFields::Geometry) {
+                ASSERT_TRUE(
+                    same_bits(out.geometric_normal[i], geometric_normal(scene, hit, dirs[k])));
+                ASSERT_TRUE(same_bits(out.normal[i], normal)) << "sample " << k;
+                ASSERT_EQ(out.view_depth[i], hit.t * dot(dirs[k], view.forward));
+                ASSERT_EQ(out.distance[i], hit.t);
             }
-            if (kind == 2) {
-                ASSERT_TRUE(same_bits(shading[i], normal)) << "sample " << i;
-                ASSERT_EQ(distance[i], hits[i].t);
-            }
-            if (kind != 0) {
-                ASSERT_EQ(material[i], scene.tri_material[hits[i].prim]);
-                ASSERT_EQ(object[i], scene.tri_object[hits[i].prim]);
+            if (level >= SurfaceFields::All) {
+                ASSERT_EQ(out.prim[i], hit.prim);
+                ASSERT_TRUE(same_bits(out.position[i], view.eye + dirs[k] * hit.t));
+                ASSERT_EQ(out.diffuse[i], terms.diffuse);
+                ASSERT_EQ(out.n_dot_l[i], n_dot_l);
+                ASSERT_EQ(out.shadowed[i], 0u);
             }
         }
+        // Only the level's arrays are kept.
+        EXPECT_EQ(out.distance.size(), level >= SurfaceFields::Geometry ? out.size() : 0u);
+        EXPECT_EQ(out.position.size(), level >= SurfaceFields::All ? out.size() : 0u);
     }
+}
+
+TEST(ShadeSamples, LightTermsRecordEachLightAndItsShadow) {
+    // A floor and a square hovering over its middle; two directional lights from above, the
+    // second dimmer and slanted. Below the square the first light is blocked.
+    Scene s;
+    s.positions = {{-10, -10, 0}, {10, -10, 0}, {10, 10, 0}, {-10, 10, 0},
+                   {-2, -2, 3},   {2, -2, 3},   {2, 2, 3},   {-2, 2, 3}};
+    s.add_triangle({0, 1, 2}, 0, 0);
+    s.add_triangle({0, 2, 3}, 0, 0);
+    s.add_triangle({4, 5, 6}, 0, 0);
+    s.add_triangle({4, 6, 7}, 0, 0);
+    TriangleAccel accel;
+    accel.build(s.positions, s.tri_positions);
+    ShadingSettings settings;
+    settings.shadows = true;
+    const std::vector<Light> lights{{Light::Kind::Directional, {0, 0, -1}, 1.0f},
+                                    {Light::Kind::Directional, {0.6f, 0, -0.8f}, 0.25f}};
+    const ShadingContext ctx{s, accel, settings, lights, nullptr};
+    // Straight down onto the floor: under the square (blocked) and beside it (lit).
+    const Vec3f eye(0, 0, 20);
+    std::vector<Vec3f> dirs{normalize(Vec3f(0, 0, -20)), normalize(Vec3f(8, 0, -20))};
+    std::vector<Hit> hits(2);
+    bool found[2];
+    // The first ray hits the square's top, so aim the first one under it from the side.
+    const Vec3f side(-6, 0, 0.5f);
+    dirs[0] = normalize(Vec3f(0, 0, 0) - side);
+    found[0] = accel.intersect(Ray{side, dirs[0]}, hits[0]);
+    found[1] = accel.intersect(Ray{eye, dirs[1]}, hits[1]);
+    ASSERT_TRUE(found[0] && found[1]);
+    const ViewPlane view0{side, {}, {}, {}, {1, 0, 0}, {0, 0, 1}, dirs[0]};
+    SurfaceSamples out;
+    out.resize(1, SurfaceFields::All, 2);
+    shade_samples(ctx, view0, 1, dirs.data(), hits.data(), found, out, 0);
+    EXPECT_EQ(out.shadowed[0], 1u);  // the first light is blocked, the slanted one is not
+    EXPECT_FLOAT_EQ(out.n_dot_l[0], 1.0f);
+    EXPECT_FLOAT_EQ(out.n_dot_l[1], 0.8f);
+    EXPECT_FLOAT_EQ(out.diffuse[0], 0.25f * 0.8f);
+    const ViewPlane view1{eye, {}, {}, {}, {1, 0, 0}, {0, 1, 0}, {0, 0, -1}};
+    shade_samples(ctx, view1, 1, dirs.data() + 1, hits.data() + 1, found + 1, out, 0);
+    EXPECT_EQ(out.shadowed[0], 0u);
+    EXPECT_FLOAT_EQ(out.diffuse[0], 1.0f + 0.25f * 0.8f);
 }

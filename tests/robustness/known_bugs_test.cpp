@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include "support/test_scenes.h"
+
 #include "robustness_util.h"
 #include "toonray/accel/triangle_accel.h"
 #include "toonray/render/renderer.h"
@@ -33,7 +35,8 @@ TEST(KnownBugs, BvhBinningWithExtremeCoordinates) {
         Renderer renderer;
         const CameraSpec camera =
             scene.camera ? *scene.camera : auto_camera(scene.positions, 32, 24);
-        const ImageRgb8& image = renderer.render(scene, accel, camera, settings);
+        const ImageRgb8& image = renderer.render(
+            scene, accel, camera, test_support::default_lights(scene, camera), settings);
         EXPECT_EQ(image.width(), 32) << name;
     }
 }

@@ -111,8 +111,8 @@ TEST(LimitValues, DefaultsAreDocumented) {
 TEST(LimitValues, MemoryEstimatesSaturateInsteadOfOverflowing) {
     RenderSettings huge;
     huge.width = huge.height = 2147483647;
-    huge.edges = EdgeMode::Ink;
-    huge.feature_images = true;
+    huge.lines.mode = LineMode::Ink;
+    huge.layers = true;
     EXPECT_EQ(frame_buffer_bytes(huge), UINT64_MAX);
     EXPECT_EQ(scene_bytes(UINT64_MAX, UINT64_MAX), UINT64_MAX);
     // Measured with feature images: 37 bytes a pixel above the program's own 14 MB.

@@ -10,12 +10,10 @@
 #include <memory>
 
 #include "toonray/core/error.h"
-#include "toonray/anim/gltf_frames.h"
+#include "toonray/anim/scene_frames.h"
 #include "toonray/core/limits.h"
 #include "toonray/core/saturating.h"
 #include "toonray/scene/gltf_loader.h"
-#include "toonray/frame/lights.h"
-#include "toonray/scene/auto_smooth.h"
 #include "toonray/scene/obj_loader.h"
 
 namespace toonray {
@@ -46,13 +44,14 @@ FramePattern output_pattern(const BatchOptions& options) {
     return FramePattern(escaped + "_%06d.png");
 }
 
-// The frames of a batch: frame N's scene is read from its OBJ file.
-class ObjFrames : public FrameSource {
+// The frames of a batch: frame N's scene is read from the OBJ file its number names.
+class ObjSequenceSource : public SceneSource {
 public:
-    ObjFrames(const BatchOptions& options, const FramePlan& plan)
-        : options_(options), output_pattern_(output_pattern(options)) {
+    ObjSequenceSource(const BatchOptions& options, SceneSetup setup, const FramePlan& plan)
+        : input_dir_(options.input_dir), setup_(std::move(setup)) {
         // Each job keeps two scenes (one rendering, the next loading) and its frame buffers.
-        obj_.limits.reserved_memory = static_cast<std::uint64_t>(plan.jobs) * plan.frame_bytes;
+        obj_.limits.reserved_memory =
+            mul_saturated(static_cast<std::uint64_t>(plan.jobs), plan.frame_bytes);
         obj_.limits.scenes_in_flight = static_cast<std::uint32_t>(2 * plan.jobs);
         if (options.input_pattern) {
             input_patterns_.emplace_back(*options.input_pattern);
@@ -61,105 +60,31 @@ public:
         }
     }
 
-    [[nodiscard]] std::filesystem::path output(int frame) const override {
-        return options_.output_dir / output_pattern_.format(frame);
-    }
-    [[nodiscard]] bool done(int frame) const override {
-        return frame_complete(output(frame), options_.render);
-    }
-
-    std::unique_ptr<FrameJob> make_job(int jobs) override;
-
-    // Loads frame's scene and returns its lights (frame_lights). Runs on a job's loading
-    // thread; throws Error.
-    std::vector<Light> load(int frame, Scene& scene, Warnings& warnings) const {
-        auto input = find_frame_file(options_.input_dir, input_patterns_, frame);
+    void load(int frame, SceneFrame& out, Warnings& warnings) const override {
+        auto input = find_frame_file(input_dir_, input_patterns_, frame);
         if (!input) {
             std::string tried;
             for (const auto& p : input_patterns_)
                 tried += (tried.empty() ? "" : ", ") + p.format(frame);
             throw Error(fmt::format("{}: no input file for frame {} (tried {})",
-                                    options_.input_dir.string(), frame, tried));
+                                    input_dir_.string(), frame, tried));
         }
         try {
-            load_obj(*input, scene, warnings, obj_);
-            if (options_.auto_smooth) auto_smooth(scene, *options_.auto_smooth);
-            return frame_lights(*input, options_.render.settings.shading.lights);
+            ObjFileSource::load_file(*input, setup_, obj_, out, warnings);
         } catch (const Error&) {
             throw;
         } catch (const std::exception& e) {
             throw Error(fmt::format("frame {}: {}", frame, e.what()));
         }
     }
-
-    [[nodiscard]] const BatchOptions& options() const { return options_; }
+    [[nodiscard]] bool reads_files() const override { return true; }
 
 private:
-    const BatchOptions& options_;
-    FramePattern output_pattern_;
+    std::filesystem::path input_dir_;
+    SceneSetup setup_;
     std::vector<FramePattern> input_patterns_;
     ObjOptions obj_;
 };
-
-// A batch job: two scenes, so that the next frame's OBJ loads while this one renders.
-class ObjFrameJob : public FrameJob {
-public:
-    ObjFrameJob(const ObjFrames& source, int jobs)
-        : source_(source), render_(source.options().render) {
-        render_.settings.threads = threads_per_frame(render_.settings.threads, jobs);
-    }
-
-    void produce(int frame, std::optional<int> next, Warnings& warnings) override {
-        Loaded current;
-        if (pending_.valid()) current = pending_.get();  // loaded into scenes_[slot_]
-        if (pending_frame_ != frame) current = load(frame, slot_);
-        if (next) {
-            Scene& target = scenes_[1 - slot_];
-            const int n = *next;
-            pending_frame_ = n;
-            pending_ =
-                std::async(std::launch::async, [this, n, &target] { return load_into(n, target); });
-        }
-        const Scene& scene = scenes_[slot_];
-        slot_ = 1 - slot_;
-        warnings.insert(warnings.end(), current.warnings.begin(), current.warnings.end());
-        if (current.error) std::rethrow_exception(current.error);
-        render_.settings.shading.lights = std::move(current.lights);
-        renderer_.render(scene, choose_camera(scene, render_), source_.output(frame), render_,
-                         warnings);
-    }
-
-private:
-    // A frame's scene as loaded, and what went wrong; nothing escapes the loading thread.
-    struct Loaded {
-        Warnings warnings;
-        std::exception_ptr error;
-        std::vector<Light> lights;  ///< the frame's lights (empty: the default light)
-    };
-
-    Loaded load_into(int frame, Scene& scene) const {
-        Loaded loaded;
-        try {
-            loaded.lights = source_.load(frame, scene, loaded.warnings);
-        } catch (...) {
-            loaded.error = std::current_exception();
-        }
-        return loaded;
-    }
-    Loaded load(int frame, int slot) { return load_into(frame, scenes_[slot]); }
-
-    const ObjFrames& source_;
-    FrameOptions render_;
-    FrameRenderer renderer_;
-    Scene scenes_[2];
-    int slot_ = 0;  ///< the scene of the frame produced next
-    std::future<Loaded> pending_;
-    int pending_frame_ = -1;
-};
-
-std::unique_ptr<FrameJob> ObjFrames::make_job(int jobs) {
-    return std::make_unique<ObjFrameJob>(*this, jobs);
-}
 
 }  // namespace
 
@@ -242,8 +167,12 @@ BatchReport run_batch(const BatchOptions& options, BatchObserver* observer) {
             throw Error(fmt::format("{}: SVG directory cannot be created or is not writable",
                                     options.render.svg_dir->string()));
     }
-    std::vector<int> frames = shard_frames(options.first, options.last, options.shard);
-    const FramePlan plan = plan_frame_jobs(options.render, options.jobs, frames.size());
+    std::vector<int> frames_list = shard_frames(options.first, options.last, options.shard);
+    const FramePlan plan = plan_frame_jobs(options.render, options.jobs, frames_list.size());
+    // The automatic camera frames the image the frames are rendered at.
+    SceneSetup setup = options.scene;
+    setup.width = options.render.settings.width;
+    setup.height = options.render.settings.height;
     ScheduleOptions schedule;
     schedule.jobs = plan.jobs;
     schedule.resume = options.resume;
@@ -256,7 +185,8 @@ BatchReport run_batch(const BatchOptions& options, BatchObserver* observer) {
         if (!std::filesystem::exists(file) && std::filesystem::exists(options.input_dir / file))
             file = options.input_dir / file;
         GltfOptions gltf;
-        gltf.limits.reserved_memory = static_cast<std::uint64_t>(plan.jobs) * plan.frame_bytes;
+        gltf.limits.reserved_memory =
+            mul_saturated(static_cast<std::uint64_t>(plan.jobs), plan.frame_bytes);
         Warnings warnings;
         GltfDocument document = load_gltf(file, warnings, gltf);
         // Each job poses its own scene.
@@ -264,28 +194,20 @@ BatchReport run_batch(const BatchOptions& options, BatchObserver* observer) {
                                    mul_saturated(scene_bytes(document.vertices, document.triangles),
                                                  static_cast<std::uint64_t>(plan.jobs))),
                      fmt::format("{} frames of {} at once", plan.jobs, file.string()));
-        const GltfAnimator animator(std::move(document), options.gltf);
-        if (auto w = animator.aspect_warning(options.render.settings.width,
-                                             options.render.settings.height))
+        GltfSource scenes(std::move(document), options.gltf, options.gltf_fps, setup);
+        if (auto w = scenes.animator().aspect_warning(setup.width, setup.height))
             warnings.push_back(*w);
         if (observer)
             for (const auto& w : warnings) observer->warning(options.first, w);
-        // Without a camera in the file, one automatic camera for the whole run, framing the
-        // range's first frame (whatever the shard), so that the animation moves in a still frame.
-        FrameOptions render = options.render;
-        if (!render.camera && !animator.has_camera()) {
-            Scene first;
-            std::vector<Light> lights;
-            animator.pose(gltf_frame_time(options.first, options.gltf_fps), render.settings.width,
-                          render.settings.height, first, lights);
-            render.camera = choose_camera(first, render);
-        }
-        GltfFrames source(animator, options.gltf_fps, render, options.output_dir,
-                          output_pattern(options));
-        return run_frames(source, frames, schedule, observer);
+        // Without a camera, one automatic camera for the whole run, framing the range's first
+        // frame (whatever the shard), so that the animation moves in a still frame.
+        scenes.hold_automatic_camera(gltf_frame_time(options.first, options.gltf_fps));
+        RenderedFrames frames(scenes, options.render, options.output_dir, output_pattern(options));
+        return run_frames(frames, frames_list, schedule, observer);
     }
-    ObjFrames source(options, plan);
-    return run_frames(source, frames, schedule, observer);
+    ObjSequenceSource scenes(options, setup, plan);
+    RenderedFrames frames(scenes, options.render, options.output_dir, output_pattern(options));
+    return run_frames(frames, frames_list, schedule, observer);
 }
 
 }  // namespace toonray

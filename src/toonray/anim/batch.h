@@ -9,8 +9,9 @@
 
 #include "toonray/anim/frame_pattern.h"
 #include "toonray/anim/frame_scheduler.h"
-#include "toonray/anim/gltf_animation.h"
 #include "toonray/frame/frame_renderer.h"
+#include "toonray/scene/gltf_animation.h"
+#include "toonray/scene/scene_source.h"
 
 namespace toonray {
 
@@ -44,10 +45,10 @@ struct BatchOptions {
     std::optional<std::string> input_pattern;   ///< default: see default_input_patterns()
     std::optional<std::string> output_pattern;  ///< default: NAME_%06d.png
     FrameOptions render;
-    /// Auto-smooth angle in degrees for triangles without normals (scene/auto_smooth.h); off
-    /// when unset. Frames are lit by render.settings.shading.lights when given, else by each
-    /// frame's lights file (frame/lights.h, frame_lights), else by the default light.
-    std::optional<float> auto_smooth;
+    /// Auto-smooth, camera and lights (scene/scene_source.h): frames are lit by scene.lights
+    /// when given, else by each frame's lights file or the glTF file's lights, else by the
+    /// default light.
+    SceneSetup scene;
     int jobs = 0;            ///< frames rendered at once; 0 = one per hardware thread
     bool resume = false;     ///< skip frames whose PNG exists and is valid
     bool fail_fast = false;  ///< stop at the first failed frame

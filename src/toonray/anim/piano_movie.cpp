@@ -10,6 +10,8 @@
 #include "toonray/core/error.h"
 #include "toonray/core/limits.h"
 #include "toonray/core/parallel.h"
+#include "toonray/core/saturating.h"
+#include "toonray/anim/scene_frames.h"
 #include "toonray/piano/piano_animation.h"
 #include "toonray/piano/piano_model.h"
 #include "toonray/piano/piano_pose.h"
@@ -61,15 +63,13 @@ void check_directory(const std::filesystem::path& dir, const char* what) {
                                 dir.string(), what));
 }
 
-// The piano's frames: each job poses its own copy of the piano at the frame's time and renders
-// it along the camera path, or writes it as OBJ + MTL with the camera block.
-class PianoFrames : public FrameSource {
+// The piano's frames: frame N is the piano posed at its score time, seen from the camera path
+// (unless the settings give a camera). Each job poses its own copy of the piano.
+class PianoSource : public SceneSource {
 public:
-    PianoFrames(const Score& score, const CameraPath& path, const PianoMovieOptions& options)
-        : playback_(score),
-          path_(path),
-          options_(options),
-          output_pattern_(options.name + "_%06d" + (options.export_obj_dir ? ".obj" : ".png")) {
+    PianoSource(const Score& score, const CameraPath& path, const PianoMovieOptions& options,
+                SceneSetup setup)
+        : playback_(score), path_(path), options_(options), setup_(std::move(setup)) {
         // The roll's hole pool holds the most slots visible at once; a score can ask for
         // millions (two triangles each). Check before building.
         const std::uint64_t holes = playback_.hole_capacity();
@@ -84,66 +84,62 @@ public:
         model_ = build_piano(piano);
     }
 
-    [[nodiscard]] std::filesystem::path output(int frame) const override {
-        return (options_.export_obj_dir ? *options_.export_obj_dir : options_.output_dir) /
-               output_pattern_.format(frame);
+    void load(int frame, SceneFrame& out, Warnings&) const override {
+        const double t = options_.start + (frame - 1) / options_.fps;
+        // A job poses its own copy in place; auto-smooth adds normals that posing would not
+        // move, so then every frame starts from the model.
+        if (out.scene.triangle_count() != model_.scene.triangle_count() || setup_.auto_smooth)
+            out.scene = model_.scene;
+        const PoseStats stats =
+            pose_piano(model_, playback_.pose_at(t), &playback_.roll(), out.scene);
+        dropped_holes_ += stats.dropped_holes;
+        out.scene.camera = path_.camera(t);
+        finish_scene(out, {}, setup_);
     }
-    [[nodiscard]] bool done(int frame) const override {
-        return frame_complete(output(frame), options_.render);
-    }
-
-    std::unique_ptr<FrameJob> make_job(int jobs) override;
 
     [[nodiscard]] const Scene& scene() const { return model_.scene; }
     [[nodiscard]] std::uint32_t dropped_holes() const { return dropped_holes_.load(); }
-
-    // Poses `scene` (a copy of the piano's) for frame and returns the frame's camera.
-    CameraSpec pose(int frame, Scene& scene) {
-        const double t = options_.start + (frame - 1) / options_.fps;
-        const PoseStats stats = pose_piano(model_, playback_.pose_at(t), &playback_.roll(), scene);
-        dropped_holes_ += stats.dropped_holes;
-        return path_.camera(t);
-    }
-
-    [[nodiscard]] const PianoMovieOptions& options() const { return options_; }
 
 private:
     PianoPlayback playback_;
     PianoModel model_;
     const CameraPath& path_;
     const PianoMovieOptions& options_;
-    FramePattern output_pattern_;
-    std::atomic<std::uint32_t> dropped_holes_{0};
+    SceneSetup setup_;
+    mutable std::atomic<std::uint32_t> dropped_holes_{0};
 };
 
-class PianoFrameJob : public FrameJob {
+// Exporting instead of rendering: each frame's posed piano as OBJ + MTL with its camera block.
+class ExportedFrames : public FrameSource {
 public:
-    PianoFrameJob(PianoFrames& source, int jobs)
-        : source_(source), scene_(source.scene()), render_(source.options().render) {
-        render_.settings.threads = threads_per_frame(render_.settings.threads, jobs);
-    }
+    ExportedFrames(const PianoSource& scenes, std::filesystem::path dir, FramePattern pattern)
+        : scenes_(scenes), dir_(std::move(dir)), pattern_(std::move(pattern)) {}
 
-    void produce(int frame, std::optional<int>, Warnings& warnings) override {
-        const CameraSpec camera = source_.pose(frame, scene_);
-        if (source_.options().export_obj_dir) {
-            scene_.camera = camera;
-            writer_.write(source_.output(frame), scene_);
-        } else {
-            renderer_.render(scene_, camera, source_.output(frame), render_, warnings);
-        }
+    [[nodiscard]] std::filesystem::path output(int frame) const override {
+        return dir_ / pattern_.format(frame);
     }
+    std::unique_ptr<FrameJob> make_job(int) override { return std::make_unique<Job>(*this); }
 
 private:
-    PianoFrames& source_;
-    Scene scene_;  ///< this job's copy to pose
-    FrameOptions render_;
-    FrameRenderer renderer_;
-    ObjWriter writer_;
-};
+    class Job : public FrameJob {
+    public:
+        explicit Job(const ExportedFrames& frames) : frames_(frames) {}
+        void produce(int frame, std::optional<int>, Warnings& warnings) override {
+            frames_.scenes_.load(frame, scene_, warnings);
+            scene_.scene.camera = scene_.camera;
+            writer_.write(frames_.output(frame), scene_.scene);
+        }
 
-std::unique_ptr<FrameJob> PianoFrames::make_job(int jobs) {
-    return std::make_unique<PianoFrameJob>(*this, jobs);
-}
+    private:
+        const ExportedFrames& frames_;
+        SceneFrame scene_;
+        ObjWriter writer_;
+    };
+
+    const PianoSource& scenes_;
+    std::filesystem::path dir_;
+    FramePattern pattern_;
+};
 
 }  // namespace
 
@@ -171,7 +167,10 @@ PianoMovieReport render_piano_movie(const Score& score, const CameraPath& camera
     if (options.render.aov_dir) check_directory(*options.render.aov_dir, "AOV");
     if (options.render.aov_exr) check_exr_sequence(*options.render.aov_exr);
     if (options.render.svg_dir) check_directory(*options.render.svg_dir, "SVG");
-    PianoFrames source(score, camera_path, options);
+    SceneSetup setup = options.scene;
+    setup.width = options.render.settings.width;
+    setup.height = options.render.settings.height;
+    PianoSource source(score, camera_path, options, setup);
     const Scene& piano = source.scene();
     // Each job poses its own copy of the scene with its own BVH, and (unless exporting)
     // renders into its own frame buffers.
@@ -184,10 +183,13 @@ PianoMovieReport render_piano_movie(const Score& score, const CameraPath& camera
         plan = plan_frame_jobs(options.render, options.jobs, static_cast<std::size_t>(frames));
     }
     const std::uint64_t scene = scene_bytes(piano.positions.size(), piano.triangle_count());
+    auto in_flight = [&] {
+        return mul_saturated(static_cast<std::uint64_t>(plan.jobs),
+                             add_saturated(plan.frame_bytes, scene));
+    };
     if (options.jobs <= 0)  // one per core, as many as fit
-        while (plan.jobs > 1 && plan.jobs * (plan.frame_bytes + scene) > limits().max_memory)
-            --plan.jobs;
-    check_memory(plan.jobs * (plan.frame_bytes + scene),
+        while (plan.jobs > 1 && in_flight() > limits().max_memory) --plan.jobs;
+    check_memory(in_flight(),
                  fmt::format("{} frame{} at once of the piano ({} triangles)", plan.jobs,
                              plan.jobs == 1 ? "" : "s", piano.triangle_count()));
     std::vector<int> numbers(static_cast<std::size_t>(frames));
@@ -196,10 +198,17 @@ PianoMovieReport render_piano_movie(const Score& score, const CameraPath& camera
     schedule.jobs = plan.jobs;
     schedule.resume = options.resume && !exporting;
     schedule.cancel = options.cancel;
+    const FramePattern pattern(options.name + "_%06d" + (exporting ? ".obj" : ".png"));
     PianoMovieReport report;
     report.frame_count = frames;
     report.triangles = piano.triangle_count();
-    report.batch = run_frames(source, numbers, schedule, observer);
+    if (exporting) {
+        ExportedFrames exported(source, *options.export_obj_dir, pattern);
+        report.batch = run_frames(exported, numbers, schedule, observer);
+    } else {
+        RenderedFrames rendered(source, options.render, options.output_dir, pattern);
+        report.batch = run_frames(rendered, numbers, schedule, observer);
+    }
     report.dropped_holes = source.dropped_holes();
     return report;
 }

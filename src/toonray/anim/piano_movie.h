@@ -35,7 +35,8 @@ struct PianoMovieOptions {
     std::filesystem::path output_dir;  ///< PNG frames go here
     /// Write OBJ + MTL frames here instead of rendering PNGs.
     std::optional<std::filesystem::path> export_obj_dir;
-    FrameOptions render;  ///< size, lines, AOVs, PNG level; camera comes from the path
+    FrameOptions render;  ///< size, lines, AOVs, PNG level
+    SceneSetup scene;     ///< auto-smooth, lights; a camera here replaces the camera path
     int jobs = 0;         ///< frames at once; 0 = one per core
     bool resume = false;  ///< skip frames whose PNG is already valid
     const std::atomic<bool>* cancel = nullptr;

@@ -70,4 +70,39 @@ Vec3f parse_colour(std::string_view text, std::string_view option) {
     return c;
 }
 
+std::vector<float> parse_number_list(std::string_view text, std::string_view what) {
+    std::vector<float> out;
+    if (text.empty()) return out;
+    for (;;) {
+        const std::size_t comma = text.find(',');
+        const std::string_view item = text.substr(0, comma);
+        float v = 0.0f;
+        const char* b = item.data();
+        auto [p, ec] = std::from_chars(b, b + item.size(), v);
+        if (item.empty() || ec != std::errc() || p != b + item.size() || !std::isfinite(v))
+            throw Error(fmt::format("{}: malformed number '{}'", what, item));
+        out.push_back(v);
+        if (comma == std::string_view::npos) return out;
+        text.remove_prefix(comma + 1);
+    }
+}
+
+std::string format_number(float value) { return fmt::format("{}", value); }
+
+std::string format_vec3(const Vec3f& v) {
+    return fmt::format("{},{},{}", format_number(v.x), format_number(v.y), format_number(v.z));
+}
+
+std::string format_colour(const Vec3f& colour) {
+    std::string hex = "#";
+    for (int i = 0; i < 3; ++i) {
+        const float scaled = colour[i] * 255.0f;
+        const int byte = static_cast<int>(std::lround(scaled));
+        if (byte < 0 || byte > 255 || static_cast<float>(byte) / 255.0f != colour[i])
+            return format_vec3(colour);
+        hex += fmt::format("{:02x}", byte);
+    }
+    return hex;
+}
+
 }  // namespace toonray

@@ -1,18 +1,15 @@
 #pragma once
-/// The feature images of a frame as one multi-layer OpenEXR file (docs/exr.md): distance and
-/// view depth, normals, object and material ids at each pixel's centre, traced once more for
-/// the purpose (the renderer's own buffers are 8-bit images or sub-pixel samples); the cel
-/// colour and each line type's coverage from the renderer's finished feature images.
+/// The layers of a frame as one multi-layer OpenEXR file (docs/exr.md), from the renderer's
+/// layers (render/frame_layers.h): the cel colour, distance and view depth, normal, object and
+/// material ids, band, light term, position and texture coordinates of each pixel's first
+/// sample, and every line type's coverage.
 
 #include <cstdint>
 #include <filesystem>
 #include <string>
 #include <vector>
 
-#include "toonray/accel/triangle_accel.h"
-#include "toonray/render/renderer.h"
-#include "toonray/scene/camera.h"
-#include "toonray/scene/scene.h"
+#include "toonray/render/frame_layers.h"
 
 namespace toonray {
 
@@ -36,16 +33,14 @@ struct FeatureLayers {
     [[nodiscard]] const Layer* find(std::string_view name) const;
 };
 
-/// Gathers the layers of the frame `renderer` last rendered (with settings.feature_images) of
-/// `scene` through `accel`, seen by `camera`. Channels: R, G, B (cel colour, linear), A
-/// (1 where a surface is seen), Z (distance along the ray), view_depth.Z (along the view
-/// axis), N.X, N.Y, N.Z (world-space shading normal facing the eye), object_id.id,
-/// material_id.id, lines.all and one lines.<type> per line type the mode draws.
-/// `polylines`: in the classic and robust modes, the coverage of the polylines drawn over the
-/// frame (ink/polylines.h), as lines.polyline and in lines.all; nullptr when none were drawn.
-void gather_feature_layers(const Scene& scene, const TriangleAccel& accel, const CameraSpec& camera,
-                           const RenderSettings& settings, const Renderer& renderer,
-                           FeatureLayers& out, const ImageF* polylines = nullptr);
+/// Gathers the EXR channels of a frame's layers (rendered with RenderSettings::layers).
+/// Channels: R, G, B (cel colour, linear), A (1 where a surface is seen), Z (distance along the
+/// ray), view_depth.Z (along the view axis), N.X, N.Y, N.Z (world-space shading normal facing
+/// the eye), object_id.id, material_id.id, band.index (the ramp band; -1 where nothing is
+/// seen), light.L (the summed light term), P.X, P.Y, P.Z (world position), uv.U, uv.V, lines.all
+/// and one lines.<type> per line type of the mode. Throws Error when a layer the channels come
+/// from is missing or not the size of the picture.
+void gather_feature_layers(const FrameLayers& layers, FeatureLayers& out);
 
 /// Writes the layers as one EXR file, atomically. Throws Error when the build has no OpenEXR.
 void write_feature_exr(const std::filesystem::path& path, const FeatureLayers& layers);

@@ -17,19 +17,20 @@
 #include "toonray/render/renderer.h"
 #include "toonray/scene/camera.h"
 #include "toonray/scene/scene.h"
+#include "toonray/scene/scene_source.h"
 
 namespace toonray {
 
 struct FrameOptions {
-    RenderSettings
-        settings;  ///< feature_images is set from aov_dir (and svg_fill), hidden_lines from svg
+    /// layers is set from aov_dir, aov_exr and svg_fill; strokes and hidden_lines from svg.
+    RenderSettings settings;
     std::optional<CameraSpec> camera;              ///< overrides the scene's camera block
     std::optional<std::filesystem::path> aov_dir;  ///< write the feature images here
     /// Also write the feature images as one multi-layer EXR (frame/feature_exr.h): this file
     /// when it ends in ".exr", else `<aov_exr>/<stem>.exr` for each output (exr_path).
     std::optional<std::filesystem::path> aov_exr;
-    /// Also write the ink strokes as SVG here (ink/svg.h), with hidden lines in a layer of
-    /// their own when svg_hidden. In modes other than ink the ink stages run for the SVG only.
+    /// Also write the strokes as SVG here (ink/svg.h), with hidden lines in a layer of their own
+    /// when svg_hidden. In modes other than ink the ink lines are found for the SVG only.
     std::optional<std::filesystem::path> svg;
     bool svg_hidden = false;
     /// Animations: one SVG per frame in this directory, named like its PNG (`NAME.svg` for
@@ -52,9 +53,6 @@ struct FrameOptions {
 /// written atomically, so a complete file is a whole one).
 [[nodiscard]] bool frame_complete(const std::filesystem::path& output, const FrameOptions& options);
 
-/// The camera a frame uses: the override, else the scene's camera block, else an automatic one.
-CameraSpec choose_camera(const Scene& scene, const FrameOptions& options);
-
 /// The feature image file for an output and a feature name: `<dir>/<stem>_<name>.png`.
 std::filesystem::path aov_path(const std::filesystem::path& dir,
                                const std::filesystem::path& output, std::string_view name);
@@ -76,11 +74,11 @@ void check_exr_sequence(const std::filesystem::path& aov_exr);
 
 class FrameRenderer {
 public:
-    /// Renders `scene` seen by `camera` to `output` (and, with options.aov_dir, its feature
-    /// images, created if missing; with options.svg, the ink strokes). Throws Error for a bad
-    /// camera (before anything is written) or a failed write; texture problems are appended
-    /// to `warnings`.
-    void render(const Scene& scene, const CameraSpec& camera, const std::filesystem::path& output,
+    /// Renders a scene source's frame (scene/scene_source.h) to `output` (and, with
+    /// options.aov_dir, its feature images, created if missing; with options.svg, the ink
+    /// strokes). Throws Error for a bad camera (before anything is written) or a failed write;
+    /// texture problems are appended to `warnings`.
+    void render(const SceneFrame& frame, const std::filesystem::path& output,
                 const FrameOptions& options, Warnings& warnings);
 
     [[nodiscard]] const Renderer& renderer() const { return renderer_; }
@@ -90,10 +88,7 @@ private:
     AnimationAccel accel_;
     TextureCache textures_;
     Renderer renderer_;
-    FeatureLayers layers_;
-    ImageRgb8 with_polylines_;  ///< classic and robust frames with the polylines drawn over
-    ImageF polyline_coverage_;  ///< and the polylines' coverage, for the EXR
-    ink::InkLines svg_lines_;   ///< the ink lines of an SVG asked of another line mode
+    FeatureLayers exr_layers_;
 };
 
 }  // namespace toonray

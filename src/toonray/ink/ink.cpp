@@ -122,7 +122,15 @@ void draw_ink_lines(const Scene& scene, const TriangleAccel& accel, const Camera
         }
         out.pens.push_back(std::move(pen));
     }
-    draw_styled_strokes(out.strokes, out.pens, width, height, out.coverage, out.style, threads);
+    if (settings.drawn_types == (1u << kEdgeTypeCount) - 1) {
+        draw_styled_strokes(out.strokes, out.pens, width, height, out.coverage, out.style, threads);
+    } else {
+        std::vector<Stroke> drawn;
+        for (const Stroke& stroke : out.strokes)
+            if (settings.drawn_types & (1u << static_cast<unsigned>(stroke.type)))
+                drawn.push_back(stroke);
+        draw_styled_strokes(drawn, out.pens, width, height, out.coverage, out.style, threads);
+    }
     out.timings.drawing = seconds_since(start);
 }
 

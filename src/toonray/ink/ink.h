@@ -30,6 +30,9 @@ struct InkSettings {
     /// Line sets: which strokes are drawn and how (line_style.h). Without rules visible lines
     /// are drawn with width and colour, hidden ones are not drawn.
     LineStyleSet styles;
+    /// The line types drawn into the line layer (InkLines::coverage), as bits 1 << EdgeType;
+    /// the strokes of the others are kept (for SVG) but not drawn.
+    unsigned drawn_types = (1u << kEdgeTypeCount) - 1;
 };
 
 /// Seconds spent in each stage of the last draw_ink_lines.

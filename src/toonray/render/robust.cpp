@@ -4,7 +4,6 @@
 #include <cmath>
 #include <fmt/format.h>
 #include <limits>
-#include <sstream>
 #include <vector>
 
 #include "toonray/core/error.h"
@@ -482,34 +481,13 @@ void size_resolved_outputs(int w, int h, ImageRgb8& final_image, ImageRgb8* cel,
 
 }  // namespace
 
-unsigned parse_line_types(const std::string& text) {
-    if (text == "all") return kLineAll;
-    if (text == "none") return 0;
-    unsigned types = 0;
-    std::stringstream in(text);
-    std::string item;
-    while (std::getline(in, item, ',')) {
-        if (item == "silhouette") types |= kLineSilhouette;
-        else if (item == "crease") types |= kLineCrease;
-        else if (item == "depth") types |= kLineDepth;
-        else if (item == "object") types |= kLineObject;
-        else if (item == "material") types |= kLineMaterial;
-        else
-            throw Error(
-                fmt::format("unknown line type '{}' (choose from silhouette, crease, depth, "
-                            "object, material, all, none)",
-                            item));
-    }
-    return types;
-}
-
-void find_line_seeds(const FineBuffers& fine, const RobustLineSettings& s,
-                     Image<std::uint8_t>& seeds, int threads) {
+void find_line_seeds(const FineBuffers& fine, const LineSettings& s, Image<std::uint8_t>& seeds,
+                     int threads) {
     const int w = fine.depth.width(), h = fine.depth.height();
     size_for_overwrite(seeds, w, h);
     if (w == 0 || h == 0) return;
     const SeedTests tests{s.types, portable::cos(s.crease_angle * 3.14159265f / 180.0f),
-                          s.depth_threshold, s.silhouette_ratio};
+                          s.robust.depth_step, s.robust.silhouette_ratio};
     parallel_for(h, kRowGrain, threads, [&](int y0, int y1) {
         SeedRowScratch r(w);
         // Row y0's share of the pairs with the row above (computed again here, once per task).
@@ -615,6 +593,12 @@ void resolve_lines(const Image<Vec3f>& fine_colour, const ImageF& squared_distan
             sums.write(y, sub, line_colour, final_image, cel, lines);
         }
     });
+}
+
+int robust_halo(float thickness, int sub) {
+    const float reach = thickness > 0.0f ? thickness * 0.5f + 0.5f : 0.0f;
+    const int fine = static_cast<int>(std::ceil(reach)) + 1;
+    return (fine + sub - 1) / sub;
 }
 
 int line_distance_band(float thickness) {

@@ -1,5 +1,5 @@
 #pragma once
-/// The robust line mode (`--edges robust`, the default): lines found on a supersampled G-buffer
+/// The robust line mode (`--edges robust`): lines found on a supersampled G-buffer
 /// by tests that do not misfire on planes at grazing angles or on finely tessellated meshes,
 /// drawn with a width that scales with the image height, and anti-aliased by filtering the
 /// fine grid down. Everything is on a fixed sub-pixel grid, so animations do not flicker.
@@ -9,37 +9,9 @@
 
 #include "toonray/core/image.h"
 #include "toonray/core/math.h"
+#include "toonray/render/line_settings.h"
 
 namespace toonray {
-
-/// Line types, combinable as bits (`--lines silhouette,crease,depth,object,material`).
-enum LineType : unsigned {
-    kLineSilhouette =
-        1u << 0,  ///< surface next to background, or in front of something much farther
-    kLineCrease =
-        1u << 1,           ///< geometric normals of neighbours differ by more than the crease angle
-    kLineDepth = 1u << 2,  ///< a step in depth where the surface is not a continuous plane or slope
-    kLineObject = 1u << 3,    ///< neighbours belong to different objects
-    kLineMaterial = 1u << 4,  ///< neighbours have different materials
-    kLineAll = 31u,
-};
-
-/// Parses "silhouette,crease,depth,object,material" (any subset, or "all" / "none"). Throws
-/// Error ("unknown line type '...' ...").
-unsigned parse_line_types(const std::string& text);
-
-struct RobustLineSettings {
-    unsigned types = kLineAll;
-    float crease_angle = 40.0f;  ///< degrees between neighbouring geometric normals
-    /// Depth lines where |second difference of 1/z| / (1/z) exceeds this. 1/z is linear in
-    /// screen space across any plane, so planes never cross it however steep the view.
-    float depth_threshold = 0.02f;
-    /// A depth discontinuity larger than this fraction of the nearer depth is a silhouette
-    /// (one thing in front of another) rather than a depth line (a fold of one surface).
-    float silhouette_ratio = 0.1f;
-    float width = 2.0f;  ///< line width in pixels at 720 lines; scales with image height
-    Vec3f colour{0.0f};
-};
 
 /// The fine-grid inputs of the line tests; misses have depth +inf.
 struct FineBuffers {
@@ -51,7 +23,7 @@ struct FineBuffers {
 
 /// Marks line seeds: each fine pixel gets the bits of the line types found between it and a
 /// 4-neighbour, on the nearer of the two (the foreground owns the line). 0 = no line.
-void find_line_seeds(const FineBuffers& fine, const RobustLineSettings& settings,
+void find_line_seeds(const FineBuffers& fine, const LineSettings& settings,
                      Image<std::uint8_t>& seeds, int threads);
 
 /// Squared Euclidean distance (in fine pixels) from every pixel to the nearest non-zero seed
@@ -82,6 +54,11 @@ float line_thickness(float width, int height, int sub);
 void resolve_lines(const Image<Vec3f>& fine_colour, const ImageF& squared_distance, float thickness,
                    int sub, const Vec3f& line_colour, ImageRgb8& final_image, ImageRgb8* cel,
                    ImageGray8* lines, int threads);
+
+/// Pixels around a bucket whose samples its lines depend on. A line covers fine samples
+/// nearer than thickness / 2 + 0.5 to its seeds, and a seed depends on the samples next to it,
+/// so the bucket's fine grid is grown by that reach plus one sample, in whole pixels.
+[[nodiscard]] int robust_halo(float thickness, int sub);
 
 /// The band of distance_to_seeds_banded that covers every fine pixel a line of `thickness`
 /// reaches. Above kMaxDistanceBand, resolve_lines_from_seeds uses the full distance image.

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstring>
 
+#include "toonray/core/saturating.h"
 #include "toonray/render/classic.h"
 #include "toonray/render/shade_samples.h"
 #include "toonray/render/trace.h"
@@ -18,20 +19,17 @@ constexpr int kListWidth = 4;
 // Refined pixels are listed in blocks of this many pixels a side.
 constexpr int kBlock = 16;
 
-// Shades n traced samples into out[offset, offset + n): the colour always, and the view depth,
-// geometric normal and ids when `surface`.
+// The surface records of n traced samples into out[offset, offset + n), then their look.
 void shade_into(const SamplerFrame& f, int n, const Vec3f* dirs, const Hit* hits, const bool* found,
-                SurfaceSamples& out, std::size_t offset, bool surface) {
-    ShadedSamples to;
-    to.colour = out.colour.data() + offset;
-    to.found = out.found.data() + offset;
-    if (surface) {
-        to.view_depth = out.view_depth.data() + offset;
-        to.geometric_normal = out.normal.data() + offset;
-        to.material = out.material.data() + offset;
-        to.object = out.object.data() + offset;
-    }
-    shade_samples(f.shading, f.view, f.background, n, dirs, hits, found, to);
+                SurfaceSamples& out, std::size_t offset) {
+    shade_samples(f.shading, f.view, n, dirs, hits, found, out, offset);
+    apply_look(f.look, out, offset, offset + static_cast<std::size_t>(n));
+}
+
+// Where fine-grid sample (x, y) lies on the image, in pixels.
+Vec2f image_position(int x, int y, int sub) {
+    return {(static_cast<float>(x) + 0.5f) / static_cast<float>(sub),
+            (static_cast<float>(y) + 0.5f) / static_cast<float>(sub)};
 }
 
 }  // namespace
@@ -47,29 +45,37 @@ PixelRect BucketGrid::bucket(int index) const {
             std::min(height, (cy + 1) * size)};
 }
 
-void SurfaceSamples::resize(std::size_t n) {
-    resize_exact(colour, n);
-    resize_exact(view_depth, n);
-    resize_exact(normal, n);
-    resize_exact(material, n);
-    resize_exact(object, n);
-    resize_exact(found, n);
-}
-
-std::uint64_t SurfaceSamples::bytes() const {
-    return colour.capacity() * sizeof(Vec3f) + view_depth.capacity() * sizeof(float) +
-           normal.capacity() * sizeof(Vec3f) + material.capacity() * sizeof(std::uint32_t) +
-           object.capacity() * sizeof(std::uint32_t) + found.capacity();
-}
-
 std::uint64_t BucketSampler::bytes() const {
     return first_.bytes() + rest_.bytes() + refine_.capacity() + first_bytes_.capacity() +
-           key_.capacity() * sizeof(std::uint32_t) + differs_right_.capacity() +
-           differs_below_.capacity() + no_differences_.capacity() + hidden_.capacity() +
+           key_.capacity() * sizeof(RefineKey) + differs_right_.capacity() +
+           differs_below_.capacity() + no_differences_.capacity() + covered_.capacity() +
            (refined_pixels_.capacity() + refined_slot_.capacity()) * sizeof(std::uint32_t) +
            (dirs_.capacity() + rest_dirs_.capacity()) * sizeof(Vec3f) +
            hits_.capacity() * sizeof(Hit) + hit_found_size_ +
            (columns_.capacity() + rows_.capacity()) * sizeof(int);
+}
+
+std::uint64_t BucketSampler::max_bytes(std::uint64_t traced, std::uint64_t decided, int sub,
+                                       SurfaceFields first_fields, SurfaceFields rest_fields,
+                                       int lights) {
+    const std::uint64_t tile_rays = static_cast<std::uint64_t>(kTile) * kTile;
+    const std::uint64_t ray = sizeof(Vec3f) + sizeof(Hit) + 1;  // direction, hit, found flag
+    const std::uint64_t others = static_cast<std::uint64_t>(sub) * sub - 1;
+    // The rays of one traced tile and their sample columns and rows.
+    std::uint64_t bytes = tile_rays * ray + 2 * kTile * sizeof(int);
+    // The first samples, with their colours as bytes and refine keys, the differences to their
+    // neighbours, whether lines cover them, and a row of no differences.
+    const std::uint64_t first = SurfaceSamples::bytes_per_sample(first_fields, lights) +
+                                sizeof(Rgb8) + sizeof(RefineKey) + 3;
+    bytes = add_saturated(bytes, mul_saturated(traced, first));
+    bytes = add_saturated(bytes, traced);
+    // Every other sample of every decided pixel (its record and its ray, four rays a row at
+    // most), with the pixel's slot, list entry and flag.
+    const std::uint64_t rest = SurfaceSamples::bytes_per_sample(rest_fields, lights) + ray;
+    bytes =
+        add_saturated(bytes, mul_saturated(decided, add_saturated(mul_saturated(others, rest),
+                                                                  1 + 2 * sizeof(std::uint32_t))));
+    return add_saturated(bytes, kListWidth * ray);
 }
 
 void BucketSampler::sample(const SamplerFrame& frame, const PixelRect& traced,
@@ -85,7 +91,8 @@ void BucketSampler::sample(const SamplerFrame& frame, const PixelRect& traced,
 
 void BucketSampler::trace_first(const SamplerFrame& frame) {
     const int tw = traced_.width(), th = traced_.height();
-    first_.resize(static_cast<std::size_t>(tw) * th);
+    first_.resize(static_cast<std::size_t>(tw) * th, frame.first_fields,
+                  static_cast<int>(frame.shading.lights.size()));
     resize_exact(key_, static_cast<std::size_t>(tw) * th);
     resize_exact(first_bytes_, 3 * static_cast<std::size_t>(tw) * th);
     resize_exact(dirs_, kTile * kTile);
@@ -96,7 +103,6 @@ void BucketSampler::trace_first(const SamplerFrame& frame) {
     }
     resize_exact(columns_, kTile);
     resize_exact(rows_, kTile);
-    const bool surface = frame.rule.surface || frame.surface_of_all || frame.surface_of_first;
     for (int ty = traced_.y0; ty < traced_.y1; ty += kTile) {
         const int rows = std::min(kTile, traced_.y1 - ty);
         for (int j = 0; j < rows; ++j) rows_[j] = (ty + j) * sub_;
@@ -110,15 +116,12 @@ void BucketSampler::trace_first(const SamplerFrame& frame) {
             for (int j = 0; j < rows; ++j) {
                 const std::size_t at = static_cast<std::size_t>(j) * cols;
                 const std::size_t to = first_index(tx, ty + j);
+                for (int i = 0; i < cols; ++i)
+                    first_.image[to + i] = image_position(columns_[i], rows_[j], sub_);
                 shade_into(frame, cols, dirs_.data() + at, hits_.data() + at, hit_found_.get() + at,
-                           first_, to, surface);
-                std::uint8_t* bytes = first_bytes_.data() + 3 * to;
-                to_bytes(&first_.colour[to].x, 3 * cols, bytes);
-                for (int i = 0; i < cols; ++i) {
-                    const std::uint8_t* b = bytes + 3 * i;
-                    key_[to + i] =
-                        b[0] | (b[1] << 8) | (b[2] << 16) | (first_.found[to + i] ? 0u : 1u << 24);
-                }
+                           first_, to);
+                to_bytes(&first_.colour[to].x, 3 * cols, first_bytes_.data() + 3 * to);
+                for (int i = 0; i < cols; ++i) key_[to + i] = refine_key(first_, to + i);
             }
         }
     }
@@ -126,14 +129,14 @@ void BucketSampler::trace_first(const SamplerFrame& frame) {
 
 namespace {
 
-// Whether the surfaces seen by first samples a and b differ (for robust lines): both hit, and
-// their ids or normals differ. Whether they hit at all is in their colour keys.
-inline bool surfaces_differ(const SurfaceSamples& s, std::size_t a, std::size_t b,
-                            const RefineRule& rule) {
-    // Bitwise on 0/1 integers rather than && and ||: no branches in the caller's row loops.
-    const int ids = int{s.object[a] != s.object[b]} | int{s.material[a] != s.material[b]};
-    const int normals = int{dot(s.normal[a], s.normal[b]) < rule.cos_normal};
-    return (s.found[a] & s.found[b] & (ids | normals)) != 0;
+// Whether the surfaces seen by first samples a and b differ in geometry (for robust lines):
+// both hit, and their geometric normals differ. Whether they hit at all, and their ids, are in
+// their refine keys.
+inline bool normals_differ(const SurfaceSamples& s, std::size_t a, std::size_t b,
+                           const RefineRule& rule) {
+    // Bitwise on 0/1 integers rather than &&: no branches in the caller's row loops.
+    const int normals = int{dot(s.geometric_normal[a], s.geometric_normal[b]) < rule.cos_normal};
+    return (s.found[a] & s.found[b] & normals) != 0;
 }
 
 }  // namespace
@@ -166,20 +169,21 @@ void neighbours_differ(const std::uint8_t* __restrict right, std::uint8_t left_o
     for (int x = 1; x < n; ++x) out[x] = right[x] | right[x - 1] | below[x] | above[x];
 }
 
-// pair[x] = 0 where pixel x or its partner x + offset is hidden, for x in [0, n).
-void clear_hidden_pairs(const std::uint8_t* __restrict hidden, int offset, int n,
-                        std::uint8_t* __restrict pair) {
-    for (int x = 0; x < n; ++x) pair[x] = pair[x] & ((hidden[x] | hidden[x + offset]) ^ 1);
+// pair[x] = 0 where pixel x or its partner x + offset is covered, for x in [0, n).
+void clear_covered_pairs(const std::uint8_t* __restrict covered, int offset, int n,
+                         std::uint8_t* __restrict pair) {
+    for (int x = 0; x < n; ++x) pair[x] = pair[x] & ((covered[x] | covered[x + offset]) ^ 1);
 }
 
-// Pixels the lines hide take no more samples.
-void keep_visible(const std::uint8_t* __restrict hidden, int n, std::uint8_t* __restrict refine) {
-    for (int x = 0; x < n; ++x) refine[x] = refine[x] & (hidden[x] ^ 1);
+// Pixels the lines cover take no more samples.
+void keep_uncovered(const std::uint8_t* __restrict covered, int n,
+                    std::uint8_t* __restrict refine) {
+    for (int x = 0; x < n; ++x) refine[x] = refine[x] & (covered[x] ^ 1);
 }
 
 }  // namespace
 
-void BucketSampler::mark_differences(const RefineRule& rule, const std::uint8_t* hidden,
+void BucketSampler::mark_differences(const RefineRule& rule, const std::uint8_t* covered,
                                      int width) {
     // Each pair of 4-neighbours of the traced pixels once: with the pixel to the right, and
     // with the one below. Pixels at the traced rectangle's edge have no pair beyond it.
@@ -187,7 +191,7 @@ void BucketSampler::mark_differences(const RefineRule& rule, const std::uint8_t*
     const std::size_t n = static_cast<std::size_t>(tw) * th;
     differs_right_.assign(n, 0);
     differs_below_.assign(n, 0);
-    const std::uint32_t* key = key_.data();
+    const RefineKey* key = key_.data();
     for (int y = 0; y < th; ++y) {
         const std::size_t row = static_cast<std::size_t>(y) * tw;
         std::uint8_t* right = differs_right_.data() + row;
@@ -197,24 +201,24 @@ void BucketSampler::mark_differences(const RefineRule& rule, const std::uint8_t*
         for (int x = 0; x < tw; ++x) below[x] = key[row + x] != key[row + x + tw];
         if (!rule.surface) continue;
         for (int x = 0; x + 1 < tw; ++x)
-            right[x] |= surfaces_differ(first_, row + x, row + x + 1, rule);
+            right[x] |= normals_differ(first_, row + x, row + x + 1, rule);
         for (int x = 0; x < tw; ++x)
-            below[x] |= surfaces_differ(first_, row + x, row + x + tw, rule);
+            below[x] |= normals_differ(first_, row + x, row + x + tw, rule);
     }
-    if (!hidden) return;
-    // A pixel that lines hide completely is not compared with its neighbours: lines are
-    // centred on the edges they draw and hide a pixel only within half a pixel of their
-    // centreline, so the edge between it and a visible neighbour lies under the line, beyond
+    if (!covered) return;
+    // A pixel that lines cover completely is not compared with its neighbours: lines are
+    // centred on the edges they draw and cover a pixel only within half a pixel of their
+    // centreline, so the edge between it and an uncovered neighbour lies under the line, beyond
     // that neighbour's own samples (at most 0.36 pixel from its centre).
-    hidden_.resize(n);
+    covered_.resize(n);
     for (int y = 0; y < th; ++y)
-        std::memcpy(hidden_.data() + static_cast<std::size_t>(y) * tw,
-                    hidden + static_cast<std::size_t>(traced_.y0 + y) * width + traced_.x0, tw);
+        std::memcpy(covered_.data() + static_cast<std::size_t>(y) * tw,
+                    covered + static_cast<std::size_t>(traced_.y0 + y) * width + traced_.x0, tw);
     for (int y = 0; y < th; ++y) {
         const std::size_t row = static_cast<std::size_t>(y) * tw;
-        clear_hidden_pairs(hidden_.data() + row, 1, tw - 1, differs_right_.data() + row);
+        clear_covered_pairs(covered_.data() + row, 1, tw - 1, differs_right_.data() + row);
         if (y + 1 < th)
-            clear_hidden_pairs(hidden_.data() + row, tw, tw, differs_below_.data() + row);
+            clear_covered_pairs(covered_.data() + row, tw, tw, differs_below_.data() + row);
     }
 }
 
@@ -223,7 +227,7 @@ void BucketSampler::decide(const SamplerFrame& frame) {
     const bool all = !frame.adaptive && sub_ > 1;
     refine_.assign(static_cast<std::size_t>(dw) * dh, all ? 1 : 0);
     if (all || sub_ == 1) return;
-    mark_differences(frame.rule, frame.hidden, frame.width);
+    mark_differences(frame.rule, frame.covered, frame.width);
     // A pixel takes all its samples when it differs from a neighbour (which the precondition
     // on `decided` puts inside `traced` whenever it is inside the image), row by row.
     const int tw = traced_.width();
@@ -241,9 +245,9 @@ void BucketSampler::decide(const SamplerFrame& frame) {
         if (frame.rule.surface)
             for (int x = 0; x < dw; ++x)
                 if (!row[x]) row[x] = depth_step(frame, decided_.x0 + x, y);
-        if (frame.hidden)
-            keep_visible(frame.hidden + static_cast<std::size_t>(y) * frame.width + decided_.x0, dw,
-                         row);
+        if (frame.covered)
+            keep_uncovered(frame.covered + static_cast<std::size_t>(y) * frame.width + decided_.x0,
+                           dw, row);
     }
 }
 
@@ -268,7 +272,7 @@ void BucketSampler::trace_refined(const SamplerFrame& frame) {
                     refined_pixels_[count++] = static_cast<std::uint32_t>(p);
                 }
     const std::size_t n = refined_pixels_.size() * per_pixel;
-    rest_.resize(n);
+    rest_.resize(n, frame.rest_fields, static_cast<int>(frame.shading.lights.size()));
     if (n == 0) return;
     const std::size_t padded = (n + kListWidth - 1) / kListWidth * kListWidth;
     resize_exact(rest_dirs_, padded);
@@ -278,9 +282,11 @@ void BucketSampler::trace_refined(const SamplerFrame& frame) {
                   y = decided_.y0 + static_cast<int>(p / dw);
         for (int j = 0; j < sub_; ++j)
             for (int i = 0; i < sub_; ++i)
-                if (i != 0 || j != 0)
+                if (i != 0 || j != 0) {
+                    rest_.image[k] = image_position(x * sub_ + i, y * sub_ + j, sub_);
                     rest_dirs_[k++] =
                         sample_direction(frame.view, x * sub_ + i, y * sub_ + j, sub_);
+                }
     }
     std::fill(rest_dirs_.begin() + static_cast<std::ptrdiff_t>(n), rest_dirs_.end(),
               rest_dirs_[n - 1]);
@@ -293,7 +299,7 @@ void BucketSampler::trace_refined(const SamplerFrame& frame) {
                                static_cast<int>(padded / kListWidth), hits_.data(),
                                hit_found_.get());
     shade_into(frame, static_cast<int>(n), rest_dirs_.data(), hits_.data(), hit_found_.get(), rest_,
-               0, frame.rule.surface || frame.surface_of_all);
+               0);
 }
 
 void BucketSampler::resolve_colours(const PixelRect& rect, ImageRgb8& out, int out_x0,
@@ -343,7 +349,7 @@ void BucketSampler::fill_fine(ImageF& view_depth, Image<Vec3f>& normal, Image<Ve
                         const SurfaceSamples& s = is_first ? first_ : rest_;
                         const std::size_t k = is_first ? a : r++;
                         view_depth(fx0 + i, fy0 + j) = s.view_depth[k];
-                        normal(fx0 + i, fy0 + j) = s.normal[k];
+                        normal(fx0 + i, fy0 + j) = s.geometric_normal[k];
                         colour(fx0 + i, fy0 + j) = s.colour[k];
                         material(fx0 + i, fy0 + j) = s.material[k];
                         object(fx0 + i, fy0 + j) = s.object[k];
@@ -354,7 +360,7 @@ void BucketSampler::fill_fine(ImageF& view_depth, Image<Vec3f>& normal, Image<Ve
             // plane along each ray: z_k = z_0 (n.D_0 / f.D_0) (f.D_k / n.D_k) for rays D through
             // the image plane (unnormalised), n the plane's normal and f the view direction.
             const float z0 = first_.view_depth[a];
-            const Vec3f n = first_.normal[a];
+            const Vec3f n = first_.geometric_normal[a];
             float plane = 0.0f;
             if (first_.found[a]) {
                 const Vec3f d0 = f.view.pixel_point((static_cast<float>(x * sub) + 0.5f) / sub,

@@ -1,8 +1,9 @@
 #pragma once
 /// Adaptive supersampling of one bucket of pixels. Every pixel gets one sample first, the first
 /// of its regular sub x sub grid; a pixel then gets the rest of its grid only where it differs
-/// from a 4-neighbour in what its line mode draws from (colour, and for robust lines also
-/// coverage, surface ids, normals and depth steps). Sample positions are fixed and each pixel's
+/// from a 4-neighbour in the discrete fields of its surface record (whether it hits, ids, band,
+/// accents, the look's edge signal: render/look.h), and for robust lines also in normals and
+/// depth steps. Sample positions are fixed and each pixel's
 /// choice depends only on its own and its neighbours' first samples, so a frame is the same
 /// whatever the bucket size, the bucket order and the thread count. A pixel that takes all its
 /// samples gets exactly the values full supersampling gives it.
@@ -13,7 +14,9 @@
 
 #include "toonray/accel/triangle_accel.h"
 #include "toonray/core/image.h"
+#include "toonray/render/look.h"
 #include "toonray/render/shading.h"
+#include "toonray/render/surface.h"
 #include "toonray/scene/camera.h"
 
 namespace toonray {
@@ -43,24 +46,13 @@ struct BucketGrid {
     [[nodiscard]] PixelRect bucket(int index) const;
 };
 
-/// Per sample, what the renderer keeps of a surface seen there, in separate arrays.
-struct SurfaceSamples {
-    std::vector<Vec3f> colour;      ///< toon colour; the background where the ray misses
-    std::vector<float> view_depth;  ///< along the view direction; +inf where it misses
-    std::vector<Vec3f> normal;      ///< geometric, unit, facing the viewer; 0 on a miss
-    std::vector<std::uint32_t> material, object;  ///< kNoIndex where the ray misses
-    std::vector<std::uint8_t> found;              ///< 1 where the ray hits
-
-    void resize(std::size_t n);
-    [[nodiscard]] std::uint64_t bytes() const;
-};
-
 /// What makes a pixel take all its samples: a 4-neighbour whose first sample differs from its
-/// own in whether it hits, or in its colour as 8-bit values, or by one of these.
+/// own in its refine key (render/look.h: whether it hits, object, material, band, accents and
+/// the look's edge signal), or by one of these.
 struct RefineRule {
-    /// Also compare the surfaces (robust lines): object and material ids, geometric normals
-    /// (cos of the angle between them below cos_normal), and depth steps: a second difference
-    /// of 1/z across the pixel, relative to its own 1/z, above depth_step.
+    /// Also compare the geometry (robust lines): geometric normals (cos of the angle between
+    /// them below cos_normal), and depth steps: a second difference of 1/z across the pixel,
+    /// relative to its own 1/z, above depth_step.
     bool surface = false;
     float cos_normal = 1.0f;
     float depth_step = 0.0f;
@@ -70,20 +62,17 @@ struct RefineRule {
 struct SamplerFrame {
     const TriangleAccel& accel;
     const ShadingContext& shading;
+    const LookFrame& look;
     const ViewPlane& view;
-    Vec3f background;
     int width, height;  ///< of the image, in pixels
     int sub;            ///< samples per pixel side
     bool adaptive;      ///< false: every pixel takes all its samples
     RefineRule rule;
-    /// Keep view depth, normal and ids of every sample (robust lines, feature images), not
-    /// only of first samples.
-    bool surface_of_all = false;
-    /// Keep view depth, normal and ids of first samples (feature images).
-    bool surface_of_first = false;
-    /// Per pixel of the image (row by row), or null: 1 where lines drawn over the frame hide
+    SurfaceFields first_fields = SurfaceFields::Look;  ///< kept of each pixel's first sample
+    SurfaceFields rest_fields = SurfaceFields::Look;   ///< of the other samples
+    /// Per pixel of the image (row by row), or null: 1 where lines drawn over the frame cover
     /// the picture completely. Such pixels never take more than their first sample.
-    const std::uint8_t* hidden = nullptr;
+    const std::uint8_t* covered = nullptr;
 };
 
 /// Samples buckets one after another, keeping its buffers. One per thread.
@@ -108,6 +97,11 @@ public:
     [[nodiscard]] std::size_t refined_count() const { return refined_pixels_.size(); }
     /// Bytes held by the buffers.
     [[nodiscard]] std::uint64_t bytes() const;
+    /// The most bytes the buffers reach for buckets of `traced` and `decided` pixels (every
+    /// decided pixel refined), with `lights` lights: for the frame's memory estimate.
+    [[nodiscard]] static std::uint64_t max_bytes(std::uint64_t traced, std::uint64_t decided,
+                                                 int sub, SurfaceFields first_fields,
+                                                 SurfaceFields rest_fields, int lights);
 
     /// The colours of the pixels of `rect` (within `decided`) as bytes into `out`, whose pixel
     /// (0, 0) is (out_x0, out_y0): a refined pixel's mean over its sub x sub samples, summed row
@@ -116,8 +110,8 @@ public:
 
     /// The fine grid of `decided` (decided.width() * sub by decided.height() * sub samples)
     /// for the robust lines: real samples where a pixel was refined; elsewhere the first
-    /// sample's colour, ids and normal, with the view depth of the first sample's plane along
-    /// each sample's ray, which keeps the depth tests' planes planar.
+    /// sample's colour, ids and geometric normal, with the view depth of the first sample's
+    /// plane along each sample's ray, which keeps the depth tests' planes planar.
     void fill_fine(ImageF& view_depth, Image<Vec3f>& normal, Image<Vec3f>& colour,
                    Image<std::uint32_t>& material, Image<std::uint32_t>& object) const;
 
@@ -125,22 +119,20 @@ private:
     void trace_first(const SamplerFrame& frame);
     void decide(const SamplerFrame& frame);
     void trace_refined(const SamplerFrame& frame);
-    void mark_differences(const RefineRule& rule, const std::uint8_t* hidden, int width);
+    void mark_differences(const RefineRule& rule, const std::uint8_t* covered, int width);
     [[nodiscard]] bool depth_step(const SamplerFrame& frame, int x, int y) const;
 
     const SamplerFrame* frame_ = nullptr;
     PixelRect traced_, decided_;
     int sub_ = 1;
-    SurfaceSamples first_;  ///< per pixel of traced_
-    /// Per pixel of traced_: the first sample's colour as bytes (low 24 bits), and a 1 above
-    /// them where it misses: equal keys are the same colour, seen or not.
-    std::vector<std::uint32_t> key_;
+    SurfaceSamples first_;                   ///< per pixel of traced_
+    std::vector<RefineKey> key_;             ///< per pixel of traced_
     std::vector<std::uint8_t> first_bytes_;  ///< per pixel of traced_: the colour as bytes
     std::vector<std::uint8_t> refine_;       ///< per pixel of decided_
     /// Per pixel of traced_: whether it differs from the pixel to its right, and below.
     std::vector<std::uint8_t> differs_right_, differs_below_;
     std::vector<std::uint8_t> no_differences_;  ///< zeros: the row above the image
-    std::vector<std::uint8_t> hidden_;          ///< per pixel of traced_: SamplerFrame::hidden
+    std::vector<std::uint8_t> covered_;         ///< per pixel of traced_: SamplerFrame::covered
     /// Refined pixels (indices into decided_) and their other sub * sub - 1 samples, pixel by
     /// pixel, each pixel's in row order without the first.
     std::vector<std::uint32_t> refined_pixels_;

@@ -1,9 +1,7 @@
 #include "toonray/render/shading.h"
 
-#include <charconv>
 #include <cmath>
 #include <fmt/format.h>
-#include <sstream>
 
 #include "toonray/core/error.h"
 #include "toonray/core/parse.h"
@@ -11,22 +9,6 @@
 
 namespace toonray {
 namespace {
-
-std::vector<float> parse_float_list(std::string_view text, std::string_view what) {
-    std::vector<float> out;
-    std::string s(text);
-    std::stringstream in(s);
-    std::string item;
-    while (std::getline(in, item, ',')) {
-        float v;
-        const char* b = item.data();
-        auto [p, ec] = std::from_chars(b, b + item.size(), v);
-        if (item.empty() || ec != std::errc() || p != b + item.size() || !std::isfinite(v))
-            throw Error(fmt::format("{}: malformed number '{}'", what, item));
-        out.push_back(v);
-    }
-    return out;
-}
 
 // Bilinear lookup with wrap-around (texture coordinates repeat), v = 0 at the bottom as OBJ has it.
 Vec3f sample_texture(const ImageRgb8& tex, float u, float v) {
@@ -51,10 +33,13 @@ ToonRamp parse_ramp(const std::string& text) {
     auto at = text.find('@');
     ToonRamp ramp;
     const std::string what = fmt::format("ramp '{}'", text);
-    ramp.levels = parse_float_list(text.substr(0, at), what);
+    ramp.levels = parse_number_list(text.substr(0, at), what);
     ramp.thresholds = at == std::string::npos ? std::vector<float>{}
-                                              : parse_float_list(text.substr(at + 1), what);
+                                              : parse_number_list(text.substr(at + 1), what);
     if (ramp.levels.empty()) throw Error(fmt::format("{}: needs at least one level", what));
+    if (ramp.levels.size() > kMaxRampLevels)
+        throw Error(
+            fmt::format("{}: {} levels, more than {}", what, ramp.levels.size(), kMaxRampLevels));
     if (ramp.thresholds.size() + 1 != ramp.levels.size())
         throw Error(fmt::format("ramp '{}': {} levels need {} thresholds after '@', got {}", text,
                                 ramp.levels.size(), ramp.levels.size() - 1,
@@ -65,45 +50,33 @@ ToonRamp parse_ramp(const std::string& text) {
     return ramp;
 }
 
-Light parse_light(const std::string& text) {
-    Light light;
-    std::string body = text;
-    if (body.rfind("point:", 0) == 0) {
-        body = body.substr(6);
-    } else if (body.rfind("dir:", 0) == 0) {
-        light.kind = Light::Kind::Directional;
-        body = body.substr(4);
-    }
-    const std::string what = fmt::format("light '{}'", text);
-    auto at = body.find('@');
-    if (at != std::string::npos) {
-        auto v = parse_float_list(body.substr(at + 1), what);
-        if (v.size() != 1 || v[0] < 0)
-            throw Error(fmt::format("{}: intensity must be one number >= 0", what));
-        light.intensity = v[0];
-        body = body.substr(0, at);
-    }
-    light.vector = parse_vec3(body, what);
-    if (light.kind == Light::Kind::Directional && !(length(light.vector) > 0))
-        throw Error(fmt::format("{}: a directional light needs a non-zero direction", what));
-    return light;
+std::string format_ramp(const ToonRamp& ramp) {
+    std::string out;
+    for (std::size_t i = 0; i < ramp.levels.size(); ++i)
+        out += (i ? "," : "") + format_number(ramp.levels[i]);
+    if (!ramp.thresholds.empty()) out += "@";
+    for (std::size_t i = 0; i < ramp.thresholds.size(); ++i)
+        out += (i ? "," : "") + format_number(ramp.thresholds[i]);
+    return out;
 }
 
 namespace {
 
-// Everything shade_hit can do: any lights, toon shadows, specular and rim bands, textures, for
-// the hit at p. Kept out of line (noinline) so that shade_hit's plain path (shade_plain), taken
-// for almost every hit of a default frame, does not pay for this function's register saves and
-// stack frame.
-[[gnu::noinline]] Vec3f shade_hit_general(const ShadingContext& ctx, const Hit& hit,
-                                          const Vec3f& dir, const Vec3f& n, const Vec3f& p,
-                                          const ImageRgb8* texture) {
+// Everything light_terms can do: any lights, toon shadows, specular and rim bands, textures,
+// vertex colours, for the hit at p. Kept out of line (noinline) so that the plain path
+// (plain_light_terms), taken for almost every hit of a default frame, does not pay for this
+// function's register saves and stack frame.
+[[gnu::noinline]] LightTerms general_light_terms(const ShadingContext& ctx, const Hit& hit,
+                                                 const Vec3f& dir, const Vec3f& n, const Vec3f& p,
+                                                 const ImageRgb8* texture, float* n_dot_l) {
     const Scene& scene = ctx.scene;
     const ShadingSettings& s = ctx.settings;
     const Material& material = scene.materials[scene.tri_material[hit.prim]];
+    LightTerms terms;
     float diffuse = 0.0f;
-    float highlight = 0.0f;
-    for (const Light& light : ctx.lights) {
+    bool highlight = false;
+    for (std::size_t i = 0; i < ctx.lights.size(); ++i) {
+        const Light& light = ctx.lights[i];
         Vec3f to_light;
         float distance = std::numeric_limits<float>::infinity();
         float l_dot_n;
@@ -116,21 +89,23 @@ namespace {
             to_light = -normalize(light.vector);
             l_dot_n = dot(to_light, n);
         }
+        if (n_dot_l) n_dot_l[i] = l_dot_n;
         if (s.shadows && l_dot_n > 0.0f) {
             // Leave the surface along its normal to avoid hitting it again.
             Vec3f origin = p + n * (1e-4f * std::max(1.0f, hit.t));
-            if (ctx.accel.occluded(Ray{origin, to_light, distance})) continue;
+            if (ctx.accel.occluded(Ray{origin, to_light, distance})) {
+                if (i < 32) terms.shadowed |= 1u << i;
+                continue;
+            }
         }
         diffuse += light.intensity * std::max(0.0f, l_dot_n);
         if (s.specular && material.ns > 0.0f &&
             (material.ks.x > 0 || material.ks.y > 0 || material.ks.z > 0)) {
             Vec3f half = normalize(to_light - dir);
             float n_dot_h = std::max(0.0f, dot(n, half));
-            if (portable::pow(n_dot_h, material.ns) > 0.5f)
-                highlight = 1.0f;  // one hard-edged band
+            if (portable::pow(n_dot_h, material.ns) > 0.5f) highlight = true;  // one hard band
         }
     }
-    // With one unit light this is max(0, l.n): the same band as the seed's int(l.n * 16).
     Vec3f kd = material.kd;
     if (!scene.colours.empty()) {
         const auto& tri = scene.tri_positions[hit.prim];
@@ -148,10 +123,13 @@ namespace {
                                      a.y * w0 + b.y * hit.u + c.y * hit.v);
         }
     }
-    Vec3f colour = kd * s.ramp.level(std::min(diffuse, 1.0f));
-    if (highlight > 0.0f) colour += material.ks;
-    if (s.rim > 0.0f && 1.0f - std::abs(dot(n, dir)) > 1.0f - s.rim) colour += kd * s.rim_strength;
-    return colour;
+    // With one unit light the band is that of max(0, l.n): the seed's int(l.n * 16) bands.
+    terms.albedo = kd;
+    terms.diffuse = diffuse;
+    terms.band = s.ramp.band(std::min(diffuse, 1.0f));
+    if (highlight) terms.accents |= kAccentHighlight;
+    if (s.rim > 0.0f && 1.0f - std::abs(dot(n, dir)) > 1.0f - s.rim) terms.accents |= kAccentRim;
+    return terms;
 }
 
 }  // namespace
@@ -163,12 +141,20 @@ const Light* plain_point_light(const ShadingContext& ctx) {
     return plain ? &ctx.lights[0] : nullptr;
 }
 
+LightTerms light_terms(const ShadingContext& ctx, const Hit& hit, const Vec3f& eye,
+                       const Vec3f& dir, const Vec3f& n, float* n_dot_l) {
+    const std::uint32_t m = ctx.scene.tri_material[hit.prim];
+    const ImageRgb8* texture = material_texture(ctx, m);
+    if (const Light* light = plain_point_light(ctx); light && !texture)
+        return plain_light_terms(ctx, *light, ctx.scene.materials[m].kd, hit, eye, dir, n, n_dot_l);
+    return general_light_terms(ctx, hit, dir, n, eye + dir * hit.t, texture, n_dot_l);
+}
+
 Vec3f shade_hit(const ShadingContext& ctx, const Hit& hit, const Vec3f& eye, const Vec3f& dir,
                 const Vec3f& n) {
-    const ImageRgb8* texture = material_texture(ctx, ctx.scene.tri_material[hit.prim]);
-    if (const Light* light = plain_point_light(ctx); light && !texture)
-        return shade_plain(ctx, *light, hit, eye, dir, n);
-    return shade_hit_general(ctx, hit, dir, n, eye + dir * hit.t, texture);
+    const LightTerms t = light_terms(ctx, hit, eye, dir, n);
+    const Material& material = ctx.scene.materials[ctx.scene.tri_material[hit.prim]];
+    return cel_colour(ctx.settings, t.albedo, t.band, t.accents, material.ks);
 }
 
 }  // namespace toonray

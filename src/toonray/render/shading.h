@@ -5,13 +5,17 @@
 /// With the defaults (the seed's ramp, one point light, nothing optional) this is exactly the
 /// seed's cel shading: k = clamp(int(l.n * 16), 0, 15) into {0.5 x4, 0.75 x4, 1.0 x8}.
 
+#include <cstdint>
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
 #include "toonray/accel/triangle_accel.h"
 #include "toonray/core/image.h"
 #include "toonray/core/math.h"
+#include "toonray/render/surface.h"
+#include "toonray/scene/light.h"
 #include "toonray/scene/scene.h"
 
 namespace toonray {
@@ -22,32 +26,27 @@ struct ToonRamp {
     std::vector<float> levels{0.5f, 0.75f, 1.0f};
     std::vector<float> thresholds{0.25f, 0.5f};
 
-    [[nodiscard]] float level(float diffuse) const {
+    /// The band of a diffuse term: the index of its level.
+    [[nodiscard]] std::uint8_t band(float diffuse) const {
         std::size_t i = 0;
         while (i < thresholds.size() && diffuse >= thresholds[i]) ++i;
-        return levels[i];
+        return static_cast<std::uint8_t>(i);
     }
+    [[nodiscard]] float level(float diffuse) const { return levels[band(diffuse)]; }
+    bool operator==(const ToonRamp&) const = default;
 };
 
-/// Parses "0.5,0.75,1.0@0.25,0.5": N levels, then N-1 increasing thresholds. Throws Error
-/// ("ramp '...': ...").
+/// The most levels a ramp may have (a band index is a byte, and one value means no band).
+inline constexpr std::size_t kMaxRampLevels = 64;
+
+/// Parses "0.5,0.75,1.0@0.25,0.5": N levels (at most kMaxRampLevels), then N-1 increasing
+/// thresholds. Throws Error ("ramp '...': ...").
 ToonRamp parse_ramp(const std::string& text);
-
-struct Light {
-    enum class Kind { Point, Directional };
-    Kind kind = Kind::Point;
-    Vec3f vector;  ///< point: position; directional: direction the light travels
-    float intensity = 1.0f;
-};
-
-/// Parses "x,y,z" or "point:x,y,z" (a point light) or "dir:x,y,z" (a directional light,
-/// shining along the vector), each optionally followed by "@intensity". Throws Error
-/// ("light '...': ...").
-Light parse_light(const std::string& text);
+/// The text parse_ramp reads back as `ramp` exactly.
+std::string format_ramp(const ToonRamp& ramp);
 
 struct ShadingSettings {
     ToonRamp ramp;
-    std::vector<Light> lights;   ///< empty: the default point light (see Renderer)
     bool shadows = false;        ///< lights blocked by geometry do not count (toon shadows)
     bool specular = false;       ///< hard highlight band from MTL Ks and Ns where given
     float rim = 0.0f;            ///< rim band width in [0, 1) of (1 - n.v); 0 = off
@@ -69,7 +68,7 @@ struct ShadingContext {
     const Scene& scene;
     const TriangleAccel& accel;  ///< for shadow rays
     const ShadingSettings& settings;
-    const std::vector<Light>& lights;  ///< resolved (never empty)
+    std::span<const Light> lights;
     const TextureSet* textures = nullptr;
 };
 
@@ -109,7 +108,32 @@ inline Vec3f shading_normal(const Scene& scene, const Hit& hit, const Vec3f& dir
     return dot(n, dir) > 0.0f ? -n : n;
 }
 
-/// Toon colour of a hit seen along `dir` from `eye`, with shading normal `n`.
+/// How the lights reach a point of a surface: what the cel look (and every other look) reads.
+struct LightTerms {
+    Vec3f albedo;                ///< Kd times the vertex colour and the texture there
+    float diffuse = 0.0f;        ///< summed intensity times max(0, n.l) of the unblocked lights
+    std::uint8_t band = 0;       ///< the ramp's band for min(diffuse, 1)
+    std::uint8_t accents = 0;    ///< SurfaceAccent bits (render/surface.h)
+    std::uint32_t shadowed = 0;  ///< bit i: light i (i < 32) is blocked (toon shadows)
+};
+
+/// The light terms of a hit seen along `dir` from `eye`, with shading normal `n`; when
+/// `n_dot_l` is not null, each light's n.l into n_dot_l[0, lights.size()).
+LightTerms light_terms(const ShadingContext& ctx, const Hit& hit, const Vec3f& eye,
+                       const Vec3f& dir, const Vec3f& n, float* n_dot_l = nullptr);
+
+/// The cel look of a point (render/look.h): albedo times its band's level, plus the material's
+/// Ks in the highlight band and albedo times the rim strength in the rim band.
+inline Vec3f cel_colour(const ShadingSettings& s, const Vec3f& albedo, std::uint8_t band,
+                        std::uint8_t accents, const Vec3f& ks) {
+    Vec3f colour = albedo * s.ramp.levels[band];
+    if (accents & kAccentHighlight) colour += ks;
+    if (accents & kAccentRim) colour += albedo * s.rim_strength;
+    return colour;
+}
+
+/// Toon colour of a hit seen along `dir` from `eye`, with shading normal `n`: the cel look of
+/// its light terms.
 Vec3f shade_hit(const ShadingContext& ctx, const Hit& hit, const Vec3f& eye, const Vec3f& dir,
                 const Vec3f& n);
 
@@ -139,20 +163,21 @@ inline PointLighting light_point(const Vec3f& light_position, const Vec3f& p, co
     return l;
 }
 
-/// shade_hit under plain lighting (`light` from plain_point_light) on an untextured material:
-/// Kd times the ramp's band for the light's l.n. It is what shade_hit's general path computes
-/// there: its diffuse sum starts at 0 and 0 + x == x, with nothing else added.
-inline Vec3f shade_plain(const ShadingContext& ctx, const Light& light, const Vec3f& kd,
-                         const Hit& hit, const Vec3f& eye, const Vec3f& dir, const Vec3f& n) {
+/// light_terms under plain lighting (`light` from plain_point_light) on an untextured
+/// material of colour `kd`: the band of the light's l.n, nothing blocked, no accents. It is
+/// what light_terms's general path computes there: its diffuse sum starts at 0 and 0 + x == x,
+/// with nothing else added. The light's n.l goes to *n_dot_l when it is not null.
+inline LightTerms plain_light_terms(const ShadingContext& ctx, const Light& light, const Vec3f& kd,
+                                    const Hit& hit, const Vec3f& eye, const Vec3f& dir,
+                                    const Vec3f& n, float* n_dot_l = nullptr) {
     const Vec3f p = eye + dir * hit.t;
-    const float diffuse = light.intensity * std::max(0.0f, light_point(light.vector, p, n).l_dot_n);
-    return kd * ctx.settings.ramp.level(std::min(diffuse, 1.0f));
-}
-/// The same with the hit triangle's material's Kd.
-inline Vec3f shade_plain(const ShadingContext& ctx, const Light& light, const Hit& hit,
-                         const Vec3f& eye, const Vec3f& dir, const Vec3f& n) {
-    const Material& material = ctx.scene.materials[ctx.scene.tri_material[hit.prim]];
-    return shade_plain(ctx, light, material.kd, hit, eye, dir, n);
+    const float l_dot_n = light_point(light.vector, p, n).l_dot_n;
+    if (n_dot_l) *n_dot_l = l_dot_n;
+    LightTerms terms;
+    terms.albedo = kd;
+    terms.diffuse = light.intensity * std::max(0.0f, l_dot_n);
+    terms.band = ctx.settings.ramp.band(std::min(terms.diffuse, 1.0f));
+    return terms;
 }
 
 }  // namespace toonray

@@ -1,7 +1,9 @@
-#include "toonray/frame/lights.h"
+#include "toonray/scene/light.h"
+#include "toonray/scene/scene.h"
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <fstream>
 
 #include "support/test_support.h"
@@ -17,7 +19,7 @@ TEST(LightsFile, ParsesPointAndDirectionalLightsWithComments) {
     EXPECT_EQ(lights[1].kind, Light::Kind::Directional);
     EXPECT_EQ(lights[1].intensity, 0.25f);
     try {
-        parse_lights("point 1 2 3\nspot 1 2 3\n", "l.txt");
+        (void)parse_lights("point 1 2 3\nspot 1 2 3\n", "l.txt");
         FAIL();
     } catch (const Error& e) {
         EXPECT_NE(std::string(e.what()).find("l.txt:2: unknown light 'spot'"), std::string::npos)
@@ -38,7 +40,7 @@ TEST(LightsFile, LoadsAFileAndNamesItInErrors) {
     EXPECT_EQ(lights[0].intensity, 0.5f);
     std::ofstream(dir.path / "bad.lights") << "\npoint x 5 6\n";
     try {
-        load_lights(dir.path / "bad.lights");
+        (void)load_lights(dir.path / "bad.lights");
         FAIL();
     } catch (const Error& e) {
         EXPECT_NE(std::string(e.what()).find("bad.lights:2: malformed number 'x'"),
@@ -48,31 +50,40 @@ TEST(LightsFile, LoadsAFileAndNamesItInErrors) {
     EXPECT_THROW(load_lights(dir.path / "missing.lights"), Error);
 }
 
-TEST(LightsFile, AFrameIsLitByItsLightsFileUnlessLightsAreGiven) {
+TEST(LightsFile, ASceneFileHasTheLightsFileOfItsName) {
     test_support::TempDir dir("frame_lights");
     const auto obj = dir.path / "keys_000030.obj";
     EXPECT_EQ(scene_lights_path(obj), dir.path / "keys_000030.lights");
-    // No lights file: no lights (the renderer's default light).
-    EXPECT_TRUE(frame_lights(obj, {}).empty());
+    EXPECT_TRUE(scene_file_lights(obj).empty());
     std::ofstream(dir.path / "keys_000030.lights")
         << "# toonray lights\ndirectional 0.5 -1 0 1    # sun 'Sun'\npoint 1 2 3 0.25\n";
-    auto lights = frame_lights(obj, {});
+    auto lights = scene_file_lights(obj);
     ASSERT_EQ(lights.size(), 2u);
     EXPECT_EQ(lights[0].kind, Light::Kind::Directional);
     EXPECT_EQ(lights[0].vector, Vec3f(0.5f, -1, 0));
     EXPECT_EQ(lights[1].intensity, 0.25f);
-    // Lights given (--light, --lights) win; the file is not even read.
-    std::ofstream(dir.path / "keys_000031.lights") << "spot 1 2 3\n";
-    const std::vector<Light> given{parse_light("dir:0,0,-1")};
-    lights = frame_lights(dir.path / "keys_000031.obj", given);
-    ASSERT_EQ(lights.size(), 1u);
-    EXPECT_EQ(lights[0].vector, Vec3f(0, 0, -1));
-    try {
-        frame_lights(dir.path / "keys_000031.obj", {});
-        FAIL();
-    } catch (const Error& e) {
-        EXPECT_NE(std::string(e.what()).find("keys_000031.lights:1: unknown light 'spot'"),
-                  std::string::npos)
-            << e.what();
+}
+
+TEST(Light, FormatReadsBackExactly) {
+    for (const char* text : {"point:1,2,3@1", "dir:0.1,-1,0.3333333@0.25", "1e-07,2,3"}) {
+        const Light light = parse_light(text);
+        EXPECT_EQ(parse_light(format_light(light)), light) << text << " -> " << format_light(light);
     }
+    EXPECT_EQ(format_light(parse_light("dir:0,-1,0@0.5")), "dir:0,-1,0@0.5");
+}
+
+TEST(Light, TheDefaultLightIsTheEyeMovedAlongUpAndRight) {
+    Scene s;
+    s.positions = {{-3, -3, 0}, {3, -3, 0}, {3, 3, 0}, {-3, 3, 0}};
+    s.add_triangle({0, 1, 2}, 0, 0);
+    s.add_triangle({0, 2, 3}, 0, 0);
+    const CameraSpec cam{{0, 0, 4}, {0, 0, 3}, {0, 1, 0}};
+    // The radius is half the diagonal of the 6 x 6 x 0 bounds.
+    const float half_radius = 0.5f * std::sqrt(72.0f) * 0.5f;
+    const Light light = default_light(s, cam);
+    EXPECT_EQ(light.kind, Light::Kind::Point);
+    EXPECT_EQ(light.intensity, 1.0f);
+    EXPECT_NEAR(light.vector.x, half_radius, 1e-5f);
+    EXPECT_NEAR(light.vector.y, half_radius, 1e-5f);
+    EXPECT_NEAR(light.vector.z, 4.0f, 1e-5f);
 }

@@ -1,4 +1,4 @@
-#include "toonray/anim/gltf_animation.h"
+#include "toonray/scene/gltf_animation.h"
 
 #include <algorithm>
 #include <array>
@@ -446,6 +446,27 @@ void GltfAnimator::pose(double seconds, int width, int height, Scene& scene,
         }
         lights.push_back(light);
     }
+}
+
+GltfSource::GltfSource(GltfDocument document, const GltfPoseOptions& options, double fps,
+                       SceneSetup setup)
+    : animator_(std::move(document), options), fps_(fps), setup_(std::move(setup)) {}
+
+void GltfSource::load(int frame, SceneFrame& out, Warnings&) const {
+    load_at(gltf_frame_time(frame, fps_), out);
+}
+
+void GltfSource::load_at(double seconds, SceneFrame& out) const {
+    std::vector<Light> lights;
+    animator_.pose(seconds, setup_.width, setup_.height, out.scene, lights);
+    finish_scene(out, std::move(lights), setup_);
+}
+
+void GltfSource::hold_automatic_camera(double seconds) {
+    if (setup_.camera || animator_.has_camera()) return;
+    SceneFrame first;
+    load_at(seconds, first);
+    setup_.camera = first.camera;
 }
 
 }  // namespace toonray

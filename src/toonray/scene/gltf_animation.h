@@ -9,9 +9,10 @@
 #include <vector>
 
 #include "toonray/core/error.h"
-#include "toonray/render/shading.h"
+#include "toonray/scene/light.h"
 #include "toonray/scene/gltf_loader.h"
 #include "toonray/scene/scene.h"
+#include "toonray/scene/scene_source.h"
 
 namespace toonray {
 
@@ -52,6 +53,28 @@ private:
     GltfDocument doc_;
     std::vector<int> animations_;  ///< played
     int camera_node_ = -1;
+};
+
+/// The frames of a glTF animation: frame N is the document posed at gltf_frame_time(N, fps),
+/// lit by its own lights unless the setup gives lights.
+class GltfSource : public SceneSource {
+public:
+    GltfSource(GltfDocument document, const GltfPoseOptions& options, double fps, SceneSetup setup);
+
+    void load(int frame, SceneFrame& out, Warnings& warnings) const override;
+    /// The scene at `seconds`, finished (finish_scene).
+    void load_at(double seconds, SceneFrame& out) const;
+    /// Without a camera in the file or the setup, every frame gets the automatic camera that
+    /// frames the scene at `seconds`, so that an animation moves in a still frame.
+    void hold_automatic_camera(double seconds);
+
+    [[nodiscard]] const GltfAnimator& animator() const { return animator_; }
+    [[nodiscard]] double fps() const { return fps_; }
+
+private:
+    GltfAnimator animator_;
+    double fps_;
+    SceneSetup setup_;
 };
 
 }  // namespace toonray

@@ -1,0 +1,41 @@
+#include "toonray/scene/scene_source.h"
+
+#include "toonray/scene/auto_smooth.h"
+
+namespace toonray {
+
+CameraSpec choose_camera(const Scene& scene, const SceneSetup& setup) {
+    if (setup.camera) return *setup.camera;
+    if (scene.camera) return *scene.camera;
+    // Frame the vertices that triangles and polylines use.
+    std::vector<Vec3f> used;
+    used.reserve(scene.triangle_count() * 3 + scene.polyline_points.size());
+    for (const auto& tri : scene.tri_positions)
+        for (std::uint32_t v : tri) used.push_back(scene.positions[v]);
+    for (std::uint32_t v : scene.polyline_points) used.push_back(scene.positions[v]);
+    return auto_camera(used, setup.width, setup.height);
+}
+
+void finish_scene(SceneFrame& frame, std::vector<Light> own_lights, const SceneSetup& setup) {
+    if (setup.auto_smooth) auto_smooth(frame.scene, *setup.auto_smooth);
+    frame.camera = choose_camera(frame.scene, setup);
+    if (!setup.lights.empty()) frame.lights = setup.lights;
+    else if (!own_lights.empty()) frame.lights = std::move(own_lights);
+    else frame.lights.assign(1, default_light(frame.scene, frame.camera));
+}
+
+ObjFileSource::ObjFileSource(std::filesystem::path path, SceneSetup setup, ObjOptions obj)
+    : path_(std::move(path)), setup_(std::move(setup)), obj_(std::move(obj)) {}
+
+void ObjFileSource::load(int, SceneFrame& out, Warnings& warnings) const {
+    load_file(path_, setup_, obj_, out, warnings);
+}
+
+void ObjFileSource::load_file(const std::filesystem::path& path, const SceneSetup& setup,
+                              const ObjOptions& obj, SceneFrame& out, Warnings& warnings) {
+    load_obj(path, out.scene, warnings, obj);
+    // The scene's own lights file is read only when the settings give no lights.
+    finish_scene(out, setup.lights.empty() ? scene_file_lights(path) : std::vector<Light>{}, setup);
+}
+
+}  // namespace toonray
