@@ -141,6 +141,9 @@ std::vector<BadInput> catalogue() {
         {"GltfCyclicNodes", kRender + "gltf_cycle.gltf" + kTo,
          "{data}/gltf_cycle.gltf: nodes[2].children: the node hierarchy has a cycle through "
          "nodes[1]"},
+        {"GltfNodeWeightsWithoutTargets", kRender + "gltf_node_weights.gltf" + kTo,
+         "{data}/gltf_node_weights.gltf: nodes[0].weights: 1 weights for the 0 morph targets of "
+         "meshes[0]"},
         {"GltfBase64Garbage", kRender + "gltf_base64.gltf" + kTo,
          "{data}/gltf_base64.gltf: buffers[0].uri: the data URI's payload is not base64"},
         {"GltfTruncatedGlb", kRender + "gltf_truncated.glb" + kTo,

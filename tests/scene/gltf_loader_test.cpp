@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "scene/gltf_test_files.h"
+#include "toonray/io/file.h"
 #include "support/test_support.h"
 
 namespace toonray {
@@ -137,11 +138,22 @@ TEST(GltfLoader, ReadsIntegerComponentTypes) {
     EXPECT_EQ(doc.meshes[0].primitives[2].indices, (std::vector<std::uint32_t>{0, 1, 2, 0, 2, 3}));
 }
 
+// A bad file, and the error it gives: "/" + expected must be in the message.
+struct BadFile {
+    std::string name, text, expected;
+};
+
+void expect_errors(const std::vector<BadFile>& cases) {
+    for (const BadFile& c : cases) {
+        const std::string message = load_error(c.name, c.text);
+        EXPECT_NE(message.find("/" + c.expected), std::string::npos) << c.name << ": " << message;
+    }
+}
+
+const std::string kTriangleUri = R"(, "uri": ")" + data_uri(triangle_bin()) + "\"";
+
 TEST(GltfLoader, BadFilesNameTheFileAndJsonPath) {
-    const std::string uri = R"(, "uri": ")" + data_uri(triangle_bin()) + "\"";
-    struct Case {
-        std::string name, text, expected;
-    };
+    const std::string& uri = kTriangleUri;
     std::string huge = triangle_json(uri, "", R"([{"mesh": 0}])", "4294967295");
     std::string view = triangle_json(uri);
     view.replace(view.find(R"("bufferView": 1)"), 15, R"("bufferView": 9)");
@@ -149,7 +161,7 @@ TEST(GltfLoader, BadFilesNameTheFileAndJsonPath) {
     long_view.replace(long_view.find(R"("byteLength": 6)"), 15, R"("byteLength": 99)");
     std::string garbage = triangle_json(R"(, "uri": "data:application/octet-stream;base64,@@@@")");
     std::string glb_text = glb(triangle_json(""), triangle_bin());
-    const std::vector<Case> cases = {
+    expect_errors({
         {"huge.gltf", huge, "huge.gltf: accessors[0].count: 4294967295 exceeds the buffer view"},
         {"view.gltf", view, "view.gltf: accessor[1] invalid bufferView"},  // tinygltf's check
         {"long.gltf", long_view,
@@ -175,11 +187,34 @@ TEST(GltfLoader, BadFilesNameTheFileAndJsonPath) {
          "draco.gltf: extensionsRequired[0]: KHR_draco_mesh_compression is not supported"},
         {"mesh.gltf", triangle_json(uri, "", R"([{"mesh": 3}])"),
          "mesh.gltf: nodes[0].mesh: meshes 3 does not exist (1 meshes)"},
+    });
+}
+
+// A node's weights stand for its mesh's default weights: one per morph target, and only on a
+// node with a mesh.
+TEST(GltfLoader, NodeWeightsMustMatchTheMeshsMorphTargets) {
+    const std::string morph = read_file(kSamples + "SimpleMorph.gltf", 1 << 20);
+    auto with_node = [&](const std::string& members) {
+        std::string text = morph;
+        text.replace(text.find(R"("mesh":0)"), 8, R"("mesh":0, )" + members);
+        return text;
     };
-    for (const Case& c : cases) {
-        const std::string message = load_error(c.name, c.text);
-        EXPECT_NE(message.find("/" + c.expected), std::string::npos) << c.name << ": " << message;
-    }
+    expect_errors({
+        {"three.gltf", with_node(R"("weights": [0.1, 0.2, 0.3])"),
+         "three.gltf: nodes[0].weights: 3 weights for the 2 morph targets of meshes[0]"},
+        {"one.gltf", with_node(R"("weights": [1])"),
+         "one.gltf: nodes[0].weights: 1 weights for the 2 morph targets of meshes[0]"},
+        {"none.gltf", triangle_json(kTriangleUri, "", R"([{"mesh": 0, "weights": [0.5]}])"),
+         "none.gltf: nodes[0].weights: 1 weights for the 0 morph targets of meshes[0]"},
+        {"meshless.gltf",
+         triangle_json(kTriangleUri, "", R"([{"mesh": 0}, {"weights": [0.5, 0.5]}])"),
+         "meshless.gltf: nodes[1].weights: 2 weights on a node without a mesh"},
+    });
+    TempDir dir("gltf");
+    Warnings warnings;
+    const GltfDocument doc =
+        load_text(dir, "two.gltf", with_node(R"("weights": [0.25, 0.75])"), warnings);
+    EXPECT_EQ(doc.nodes[0].weights, (std::vector<float>{0.25f, 0.75f}));
 }
 
 TEST(GltfLoader, HugeCountsHitTheLimitsNotTheMemory) {

@@ -176,6 +176,7 @@ public:
         read_nodes();
         read_materials();
         read_meshes();
+        check_node_weights();
         read_skins();
         read_cameras();
         read_lights();
@@ -594,6 +595,22 @@ private:
                 fail(fmt::format("meshes[{}].weights", i),
                      fmt::format("{} weights for {} morph targets", mesh.weights.size(), targets));
             mesh.weights.resize(targets, 0.0f);
+        }
+    }
+
+    // A node's weights replace its mesh's: one per morph target, on a node with a mesh.
+    void check_node_weights() const {
+        for (std::size_t i = 0; i < doc_.nodes.size(); ++i) {
+            const GltfNode& node = doc_.nodes[i];
+            if (node.weights.empty()) continue;
+            const std::string at = fmt::format("nodes[{}].weights", i);
+            if (node.mesh < 0)
+                fail(at, fmt::format("{} weights on a node without a mesh", node.weights.size()));
+            const std::size_t targets =
+                doc_.meshes[static_cast<std::size_t>(node.mesh)].weights.size();
+            if (node.weights.size() != targets)
+                fail(at, fmt::format("{} weights for the {} morph targets of meshes[{}]",
+                                     node.weights.size(), targets, node.mesh));
         }
     }
 
