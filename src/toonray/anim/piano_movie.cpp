@@ -185,9 +185,8 @@ PianoMovieReport render_piano_movie(const Score& score, const CameraPath& camera
     }
     const std::uint64_t scene = scene_bytes(piano.positions.size(), piano.triangle_count());
     if (options.jobs <= 0)  // one per core, as many as fit
-        while (plan.jobs > 1 && plan.jobs * (plan.frame_bytes + scene) > limits().max_memory)
-            --plan.jobs;
-    check_memory(plan.jobs * (plan.frame_bytes + scene),
+        while (plan.jobs > 1 && plan.bytes(scene) > limits().max_memory) --plan.jobs;
+    check_memory(plan.bytes(scene),
                  fmt::format("{} frame{} at once of the piano ({} triangles)", plan.jobs,
                              plan.jobs == 1 ? "" : "s", piano.triangle_count()));
     std::vector<int> numbers(static_cast<std::size_t>(frames));
