@@ -217,6 +217,74 @@ TEST(GltfLoader, NodeWeightsMustMatchTheMeshsMorphTargets) {
     EXPECT_EQ(doc.nodes[0].weights, (std::vector<float>{0.25f, 0.75f}));
 }
 
+// What tinygltf refuses without a reason, or leaves out without a word, is named by its JSON
+// path, with the glTF 1.0 spelling pointed out where a file uses it.
+TEST(GltfLoader, RefusedStructureIsNamedByJsonPath) {
+    const std::string& uri = kTriangleUri;
+    const std::string skin_1_0 =
+        R"(, "skins": [{"jointNames": ["hip"], "bindShapeMatrix": [1, 0, 0, 0, 0, 1, 0, 0,
+           0, 0, 1, 0, 0, 0, 0, 1]}])";
+    const std::string triangle = triangle_json(uri);
+    auto with_asset = [&](const std::string& asset) {
+        std::string text = triangle;
+        text.replace(text.find(R"("asset": {"version": "2.0"})"), 27, asset);
+        return text;
+    };
+    auto replaced = [&](const std::string& from, const std::string& to) {
+        std::string text = triangle;
+        text.replace(text.find(from), from.size(), to);
+        return text;
+    };
+    expect_errors({
+        {"skin.gltf", triangle_json(uri, skin_1_0),
+         "skin.gltf: skins[0]: missing \"joints\" (jointNames and bindShapeMatrix are glTF 1.0;"},
+        {"skin.glb", glb(triangle_json("", skin_1_0), triangle_bin()),
+         "skin.glb: skins[0]: missing \"joints\" (jointNames and bindShapeMatrix are glTF 1.0;"},
+        {"joints.gltf", triangle_json(uri, R"(, "skins": [{"joints": ["hip"]}])"),
+         "joints.gltf: skins[0].joints[0]: \"hip\" is not an index"},
+        {"noasset.gltf", with_asset(R"("generator": "hand")"),
+         "noasset.gltf: asset: missing (a glTF 2.0 file has \"asset\": {\"version\": \"2.0\"})"},
+        {"assetarray.gltf", with_asset(R"("asset": ["2.0"])"),
+         "assetarray.gltf: asset: an array is not an object"},
+        {"noversion.gltf", with_asset(R"("asset": {"generator": "hand"})"),
+         "noversion.gltf: asset: missing \"version\""},
+        {"number.gltf", with_asset(R"("asset": {"version": 2.0})"),
+         "number.gltf: asset.version: 2.0 is not a string (\"2.0\" for glTF 2.0)"},
+        {"one.gltf", with_asset(R"("asset": {"version": "1.0"})"),
+         "one.gltf: asset.version: \"1.0\": only glTF 2.0 is read"},
+        {"three.gltf", with_asset(R"("asset": {"version": "3.0"})"),
+         "three.gltf: asset.version: \"3.0\": only glTF 2.0 is read"},
+        {"words.gltf", with_asset(R"("asset": {"version": "two"})"),
+         "words.gltf: asset.version: \"two\" is not a version (major.minor, \"2.0\")"},
+        {"min.gltf", with_asset(R"("asset": {"version": "2.0", "minVersion": "2.1"})"),
+         "min.gltf: asset.minVersion: \"2.1\": only glTF 2.0 is read"},
+        {"dict.gltf",
+         replaced(R"("nodes": [{"mesh": 0, "name": "tri"}])",
+                  R"("nodes": {"tri": {"meshes": ["m"]}})"),
+         "dict.gltf: nodes: an object where an array is expected (glTF 1.0 names its objects; "
+         "glTF 2.0 lists them)"},
+        {"attributes.gltf",
+         replaced(R"({"attributes": {"POSITION": 0}, "indices": 1})", R"({"indices": 1})"),
+         "attributes.gltf: meshes[0].primitives[0]: missing \"attributes\""},
+        {"mesh.gltf", replaced(R"({"mesh": 0, "name": "tri"})", R"({"mesh": "0"})"),
+         "mesh.gltf: nodes[0].mesh: \"0\" is not an index"},
+        {"camera.gltf", triangle_json(uri, R"(, "cameras": [{"perspective": {"yfov": 1}}])"),
+         "camera.gltf: cameras[0]: missing \"type\""},
+        {"yfov.gltf",
+         triangle_json(uri, R"(, "cameras": [{"type": "perspective", "perspective": {}}])"),
+         "yfov.gltf: cameras[0].perspective: missing \"yfov\""},
+        {"target.gltf", triangle_json(uri, R"(, "animations": [{"channels": [{"sampler": 0}],
+             "samplers": [{"input": 0, "output": 0}]}])"),
+         "target.gltf: animations[0].channels[0]: missing \"target\""},
+    });
+    // A later minor version reads as 2.0 (glTF 2.x stays compatible).
+    TempDir dir("gltf");
+    Warnings warnings;
+    EXPECT_EQ(load_text(dir, "minor.gltf", with_asset(R"("asset": {"version": "2.1"})"), warnings)
+                  .meshes.size(),
+              1u);
+}
+
 TEST(GltfLoader, HugeCountsHitTheLimitsNotTheMemory) {
     // No buffer view: the values would be zeros, four billion of them.
     std::string text = triangle_json(R"(, "uri": ")" + data_uri(triangle_bin()) + "\"");
