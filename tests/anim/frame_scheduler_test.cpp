@@ -4,6 +4,7 @@
 
 #include <atomic>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <mutex>
 #include <set>
@@ -89,6 +90,20 @@ std::vector<int> range(int first, int last) {
 }
 
 }  // namespace
+
+TEST(FramePlan, MemoryOfTheFramesInFlightSaturates) {
+    constexpr std::uint64_t kMost = std::numeric_limits<std::uint64_t>::max();
+    FramePlan plan{3, 1000};
+    EXPECT_EQ(plan.bytes(), 3000u);
+    EXPECT_EQ(plan.bytes(24), 3072u);
+    plan.frame_bytes = std::uint64_t{1} << 62;
+    EXPECT_EQ(plan.bytes(), 3 * plan.frame_bytes);
+    EXPECT_EQ(plan.bytes(plan.frame_bytes), kMost);  // 3 * 2^63
+    plan.jobs = 5;
+    EXPECT_EQ(plan.bytes(), kMost);
+    plan.jobs = 1;
+    EXPECT_EQ(plan.bytes(kMost), kMost);
+}
 
 TEST(FrameScheduler, ProducesEveryFrameOnceAndReportsEach) {
     for (int jobs : {1, 3}) {

@@ -162,6 +162,24 @@ TEST(GltfAnimation, MorphWeightsMoveVertices) {
               pose(animator, weights.times[1]).bounds().hi);
 }
 
+// Without animated weights, a node's own weights apply, else its mesh's.
+TEST(GltfAnimation, NodeWeightsReplaceTheMeshsUnlessAbsent) {
+    GltfDocument doc = sample("SimpleMorph");
+    doc.animations.clear();
+    const GltfPrimitive prim = doc.meshes[0].primitives[0];
+    const std::vector<float> mesh_weights = doc.meshes[0].weights;
+    ASSERT_EQ(mesh_weights.size(), 2u);
+    for (const std::vector<float>& node_weights : {std::vector<float>{}, {1.0f, 0.25f}}) {
+        doc.nodes[0].weights = node_weights;
+        const std::vector<float>& w = node_weights.empty() ? mesh_weights : node_weights;
+        const Scene scene = pose(GltfAnimator(doc, {}), 0.0);
+        for (std::size_t v = 0; v < prim.positions.size(); ++v)
+            expect_near(scene.positions[v], prim.positions[v] +
+                                                prim.targets[0].positions[v] * w[0] +
+                                                prim.targets[1].positions[v] * w[1]);
+    }
+}
+
 TEST(GltfAnimation, CameraKeepsTheVerticalFieldOfView) {
     GltfDocument doc = one_triangle();
     GltfNode camera;

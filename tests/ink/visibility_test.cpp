@@ -150,6 +150,34 @@ TEST(Visibility, HiddenOrNotAgreesWithBruteForceRaysOnRandomScenes) {
     check_against_brute_force(1);
 }
 
+// A point behind a stack of parallel quads: the nearer ones are on the ignored list (as the
+// rings around a smooth contour are), the farther ones count. However many ignored surfaces
+// come first, the count is exact up to max_invisibility, which caps it.
+TEST(Visibility, CountsEveryOccluderBehindAnyNumberOfIgnoredSurfaces) {
+    constexpr int kIgnoredQuads = 1100, kCountedQuads = 300;
+    Scene s;
+    for (int i = 0; i < kIgnoredQuads + kCountedQuads; ++i) {
+        const float z = 0.5f + 9.0f * static_cast<float>(i) / (kIgnoredQuads + kCountedQuads);
+        add_quad(s, Vec3f(-1, -1, z), Vec3f(1, -1, z), Vec3f(1, 1, z), Vec3f(-1, 1, z));
+    }
+    const TriangleAccel accel = build_accel(s);
+    std::vector<std::uint32_t> ignored(2 * kIgnoredQuads);  // both triangles of each quad
+    for (std::size_t k = 0; k < ignored.size(); ++k) ignored[k] = static_cast<std::uint32_t>(k);
+    // Off the quads' diagonals, so that the ray meets one triangle of each.
+    const Vec3f point(0.3f, -0.2f, 0.0f), eye(0.3f, -0.2f, 10.0f);
+    for (const auto& [max_invisibility, expected] : {std::pair{1, 1},
+                                                     {2, 2},
+                                                     {255, 255},
+                                                     {kCountedQuads, kCountedQuads},
+                                                     {100000, kCountedQuads}}) {
+        ink::VisibilitySettings settings;
+        settings.max_invisibility = max_invisibility;
+        EXPECT_EQ(ink::count_occluders(accel, point, eye, ignored, settings), expected)
+            << "at most " << max_invisibility;
+        EXPECT_EQ(test_support::brute_force_occluders(s, point, eye, ignored, settings), expected);
+    }
+}
+
 TEST(Visibility, SameForAnyThreadCount) {
     Scene s = test_support::random_scene(300, 11);
     const Frame f(std::move(s),

@@ -141,6 +141,16 @@ std::vector<BadInput> catalogue() {
         {"GltfCyclicNodes", kRender + "gltf_cycle.gltf" + kTo,
          "{data}/gltf_cycle.gltf: nodes[2].children: the node hierarchy has a cycle through "
          "nodes[1]"},
+        {"GltfNodeWeightsWithoutTargets", kRender + "gltf_node_weights.gltf" + kTo,
+         "{data}/gltf_node_weights.gltf: nodes[0].weights: 1 weights for the 0 morph targets of "
+         "meshes[0]"},
+        {"GltfSkinOfGltf1", kRender + "gltf_skin_1_0.gltf" + kTo,
+         "{data}/gltf_skin_1_0.gltf: skins[0]: missing \"joints\" (jointNames and bindShapeMatrix "
+         "are glTF 1.0; a glTF 2.0 skin lists its joint nodes by index in \"joints\", and its "
+         "bind shape is part of \"inverseBindMatrices\")"},
+        {"GltfNoAsset", kRender + "gltf_no_asset.gltf" + kTo,
+         "{data}/gltf_no_asset.gltf: asset: missing (a glTF 2.0 file has \"asset\": "
+         "{\"version\": \"2.0\"})"},
         {"GltfBase64Garbage", kRender + "gltf_base64.gltf" + kTo,
          "{data}/gltf_base64.gltf: buffers[0].uri: the data URI's payload is not base64"},
         {"GltfTruncatedGlb", kRender + "gltf_truncated.glb" + kTo,

@@ -367,6 +367,31 @@ TEST(FrameLimits, PlanChecksPixelsAndMemoryAndFitsJobsToMemory) {
     }
 }
 
+// Where one frame fits but the frames in flight need more than 2^64 bytes, the total must
+// saturate and be refused, not wrap around to a small number that fits.
+TEST(FrameLimits, FramesWhoseTotalPassesTwoToTheSixtyFourAreRefused) {
+    FrameOptions o;
+    o.settings.width = 1 << 23;
+    o.settings.height = 1 << 23;
+    const std::uint64_t frame = frame_bytes(o);
+    const std::uint64_t jobs = std::numeric_limits<std::uint64_t>::max() / frame + 1;
+    ASSERT_GT(jobs, 1u);
+    ASSERT_LE(jobs, 1u << 16);  // plan_frame_jobs takes up to 65536 frames at once
+    ScopedLimits l([&](Limits& x) {
+        x.max_image_pixels = std::numeric_limits<std::uint64_t>::max();
+        x.max_memory = frame;
+    });
+    EXPECT_EQ(plan_frame_jobs(o, 1, 1 << 16).jobs, 1);
+    const int requested = static_cast<int>(jobs);
+    EXPECT_EQ(limit_of([&] { plan_frame_jobs(o, requested, 1 << 16); }), Limit::Memory);
+    EXPECT_EQ(error_of([&] { plan_frame_jobs(o, requested, 1 << 16); })
+                  .rfind(fmt::format("{} frames at once (a 8388608x8388608 frame each) needs about "
+                                     "16 EiB of memory",
+                                     jobs),
+                         0),
+              0u);
+}
+
 TEST(FrameLimits, FrameRangesAreCheckedBeforeAllocating) {
     EXPECT_EQ(error_of([] {
                   shard_frames(0, 2147483647, {1, 1});

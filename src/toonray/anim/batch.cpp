@@ -12,7 +12,6 @@
 #include "toonray/core/error.h"
 #include "toonray/anim/scene_frames.h"
 #include "toonray/core/limits.h"
-#include "toonray/core/saturating.h"
 #include "toonray/scene/gltf_loader.h"
 #include "toonray/scene/obj_loader.h"
 
@@ -50,8 +49,7 @@ public:
     ObjSequenceSource(const BatchOptions& options, SceneSetup setup, const FramePlan& plan)
         : input_dir_(options.input_dir), setup_(std::move(setup)) {
         // Each job keeps two scenes (one rendering, the next loading) and its frame buffers.
-        obj_.limits.reserved_memory =
-            mul_saturated(static_cast<std::uint64_t>(plan.jobs), plan.frame_bytes);
+        obj_.limits.reserved_memory = plan.bytes();
         obj_.limits.scenes_in_flight = static_cast<std::uint32_t>(2 * plan.jobs);
         if (options.input_pattern) {
             input_patterns_.emplace_back(*options.input_pattern);
@@ -185,14 +183,11 @@ BatchReport run_batch(const BatchOptions& options, BatchObserver* observer) {
         if (!std::filesystem::exists(file) && std::filesystem::exists(options.input_dir / file))
             file = options.input_dir / file;
         GltfOptions gltf;
-        gltf.limits.reserved_memory =
-            mul_saturated(static_cast<std::uint64_t>(plan.jobs), plan.frame_bytes);
+        gltf.limits.reserved_memory = plan.bytes();
         Warnings warnings;
         GltfDocument document = load_gltf(file, warnings, gltf);
         // Each job poses its own scene.
-        check_memory(add_saturated(gltf.limits.reserved_memory,
-                                   mul_saturated(scene_bytes(document.vertices, document.triangles),
-                                                 static_cast<std::uint64_t>(plan.jobs))),
+        check_memory(plan.bytes(scene_bytes(document.vertices, document.triangles)),
                      fmt::format("{} frames of {} at once", plan.jobs, file.string()));
         GltfSource scenes(std::move(document), options.gltf, options.gltf_fps, setup);
         if (auto w = scenes.animator().aspect_warning(setup.width, setup.height))

@@ -8,6 +8,7 @@
 
 #include "toonray/core/limits.h"
 #include "toonray/core/parallel.h"
+#include "toonray/core/saturating.h"
 #include "toonray/io/png.h"
 
 namespace toonray {
@@ -110,6 +111,10 @@ private:
 
 }  // namespace
 
+std::uint64_t FramePlan::bytes(std::uint64_t per_job) const {
+    return mul_saturated(static_cast<std::uint64_t>(jobs), add_saturated(frame_bytes, per_job));
+}
+
 FramePlan plan_frame_jobs(const FrameOptions& options, int requested, std::size_t frames) {
     const Limits& lim = limits();
     const RenderSettings& settings = options.settings;
@@ -132,8 +137,7 @@ FramePlan plan_frame_jobs(const FrameOptions& options, int requested, std::size_
         static_cast<int>(std::max<std::size_t>(1, std::min<std::size_t>(frames, 1 << 16)));
     plan.jobs = std::max(1, std::min(wanted, most));
     if (requested > 0) {
-        check_memory(plan.jobs * plan.frame_bytes,
-                     fmt::format("{} frames at once ({} each)", plan.jobs, size));
+        check_memory(plan.bytes(), fmt::format("{} frames at once ({} each)", plan.jobs, size));
     } else {
         // One per core, as many as fit.
         const std::uint64_t fit = std::max<std::uint64_t>(

@@ -44,6 +44,10 @@ public:
 struct FramePlan {
     int jobs = 1;                   ///< frames in flight
     std::uint64_t frame_bytes = 0;  ///< estimated memory of one frame (frame_bytes)
+
+    /// Estimated memory of the frames in flight, each with `per_job` more bytes (a posed
+    /// scene), saturating at 2^64 - 1 so that a total too large to count is too much.
+    [[nodiscard]] std::uint64_t bytes(std::uint64_t per_job = 0) const;
 };
 
 /// Checks the image size against limits().max_image_pixels (LimitError) and the memory of the

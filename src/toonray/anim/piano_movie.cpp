@@ -10,7 +10,6 @@
 #include "toonray/core/error.h"
 #include "toonray/core/limits.h"
 #include "toonray/core/parallel.h"
-#include "toonray/core/saturating.h"
 #include "toonray/anim/scene_frames.h"
 #include "toonray/piano/piano_animation.h"
 #include "toonray/piano/piano_model.h"
@@ -183,13 +182,9 @@ PianoMovieReport render_piano_movie(const Score& score, const CameraPath& camera
         plan = plan_frame_jobs(options.render, options.jobs, static_cast<std::size_t>(frames));
     }
     const std::uint64_t scene = scene_bytes(piano.positions.size(), piano.triangle_count());
-    auto in_flight = [&] {
-        return mul_saturated(static_cast<std::uint64_t>(plan.jobs),
-                             add_saturated(plan.frame_bytes, scene));
-    };
     if (options.jobs <= 0)  // one per core, as many as fit
-        while (plan.jobs > 1 && in_flight() > limits().max_memory) --plan.jobs;
-    check_memory(in_flight(),
+        while (plan.jobs > 1 && plan.bytes(scene) > limits().max_memory) --plan.jobs;
+    check_memory(plan.bytes(scene),
                  fmt::format("{} frame{} at once of the piano ({} triangles)", plan.jobs,
                              plan.jobs == 1 ? "" : "s", piano.triangle_count()));
     std::vector<int> numbers(static_cast<std::size_t>(frames));

@@ -37,19 +37,21 @@ std::vector<std::uint32_t> ignored_triangles(const FeatureSegment& segment,
 int count_occluders(const TriangleAccel& accel, const Vec3f& point, const Vec3f& eye,
                     std::span<const std::uint32_t> ignored, const VisibilitySettings& settings) {
     // The ray runs from the point (t = 0) to the eye (t = 1); after each hit it starts again
-    // just past it, so every surface on the way is met once.
+    // just past it, so every surface on the way is met once. Only the count reaching
+    // max_invisibility ends the walk early: however many ignored surfaces come first, the
+    // ones behind them are counted.
     const Vec3f dir = eye - point;
     const float t_end = 1.0f - settings.self_epsilon;
     const float skip = settings.self_epsilon * 0.01f;
     float t = settings.self_epsilon;
     int count = 0;
-    // A bound on the queries, in case a hit ever failed to move the start forward.
-    for (int query = 0; query < 4 * settings.max_invisibility + 64 && t < t_end; ++query) {
+    while (t < t_end) {
         Hit hit;
         if (!accel.intersect(Ray{point + dir * t, dir, t_end - t}, hit)) break;
         if (!std::binary_search(ignored.begin(), ignored.end(), hit.prim))
             if (++count >= settings.max_invisibility) break;
-        t += hit.t + skip;
+        // At least to the next float, so that the walk ends even with no skip.
+        t = std::max(t + hit.t + skip, std::nextafter(t, t_end));
     }
     return count;
 }

@@ -19,8 +19,9 @@ struct VisibilitySettings {
     /// A ray from a point toward the eye ignores hits closer to the point than this fraction
     /// of the distance to the eye, so that the surface a line lies on does not hide it.
     float self_epsilon = 1e-4f;
-    /// Occluders counted at most: 1 tells only visible (0) from hidden (1); then segments
-    /// known to be hidden (FeatureSegment::certainly_hidden) are not traced at all, and each
+    /// The most occluders counted (1 or more): counts are exact up to it, and a point behind
+    /// more surfaces gets it. 1 tells only visible (0) from hidden (1); then segments known
+    /// to be hidden (FeatureSegment::certainly_hidden) are not traced at all, and each
     /// segment's samples are traced as one packet from the eye. More costs a ray query per
     /// extra surface on hidden points.
     int max_invisibility = 255;
@@ -57,8 +58,9 @@ struct VisibilityContext {
                                                            const WeldedMesh& mesh);
 
 /// Surfaces between `point` and the eye: hits of the segment from point to eye with parameter
-/// in (self_epsilon, 1 - self_epsilon), not on an `ignored` triangle (sorted), at most
-/// max_invisibility. Hits closer together than a hundredth of self_epsilon count once.
+/// in (self_epsilon, 1 - self_epsilon), not on an `ignored` triangle (sorted), exactly up to
+/// max_invisibility, which caps the count; any number of ignored hits may come before them.
+/// Hits closer together than a hundredth of self_epsilon count once.
 [[nodiscard]] int count_occluders(const TriangleAccel& accel, const Vec3f& point, const Vec3f& eye,
                                   std::span<const std::uint32_t> ignored,
                                   const VisibilitySettings& settings);

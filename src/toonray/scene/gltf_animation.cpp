@@ -327,10 +327,10 @@ void GltfAnimator::pose(double seconds, int width, int height, Scene& scene,
         const GltfMesh& mesh = doc_.meshes[static_cast<std::size_t>(node.mesh)];
         const auto object = static_cast<std::uint32_t>(scene.objects.size());
         scene.objects.push_back(node_label(doc_, i));
-        const std::vector<float>& w =
-            weights[static_cast<std::size_t>(i)].size() == mesh.weights.size()
-                ? weights[static_cast<std::size_t>(i)]
-                : mesh.weights;
+        // The loader checked that a node's weights, given or animated, match its mesh's.
+        const std::vector<float>& w = weights[static_cast<std::size_t>(i)].empty()
+                                          ? mesh.weights
+                                          : weights[static_cast<std::size_t>(i)];
         const GltfSkin* skin =
             node.skin >= 0 ? &doc_.skins[static_cast<std::size_t>(node.skin)] : nullptr;
         if (skin) {

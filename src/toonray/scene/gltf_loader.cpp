@@ -6,12 +6,11 @@
 #include <cstring>
 #include <fmt/format.h>
 #include <map>
-#include <optional>
-#include <nlohmann/json.hpp>
 #include <tiny_gltf.h>
 
 #include "toonray/core/saturating.h"
 #include "toonray/io/file.h"
+#include "toonray/scene/gltf_json_check.h"
 #include "toonray/scene/gltf_third_party.h"
 
 namespace toonray {
@@ -176,6 +175,7 @@ public:
         read_nodes();
         read_materials();
         read_meshes();
+        check_node_weights();
         read_skins();
         read_cameras();
         read_lights();
@@ -597,6 +597,22 @@ private:
         }
     }
 
+    // A node's weights replace its mesh's: one per morph target, on a node with a mesh.
+    void check_node_weights() const {
+        for (std::size_t i = 0; i < doc_.nodes.size(); ++i) {
+            const GltfNode& node = doc_.nodes[i];
+            if (node.weights.empty()) continue;
+            const std::string at = fmt::format("nodes[{}].weights", i);
+            if (node.mesh < 0)
+                fail(at, fmt::format("{} weights on a node without a mesh", node.weights.size()));
+            const std::size_t targets =
+                doc_.meshes[static_cast<std::size_t>(node.mesh)].weights.size();
+            if (node.weights.size() != targets)
+                fail(at, fmt::format("{} weights for the {} morph targets of meshes[{}]",
+                                     node.weights.size(), targets, node.mesh));
+        }
+    }
+
     bool read_primitive(const tinygltf::Primitive& src, const std::string& at,
                         GltfPrimitive& prim) {
         const int mode = src.mode < 0 ? TINYGLTF_MODE_TRIANGLES : src.mode;
@@ -972,41 +988,6 @@ private:
 };
 
 // tinygltf's first error, cut short: it may quote a whole data URI.
-// Whether a data URI's payload is base64 (RFC 4648 alphabet, '=' padding only at the end).
-bool is_base64(std::string_view text) {
-    std::size_t end = text.size();
-    int padding = 0;
-    while (end > 0 && text[end - 1] == '=' && padding < 2) --end, ++padding;
-    if (text.size() % 4 != 0) return false;
-    return std::all_of(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(end), [](char c) {
-        return std::isalnum(static_cast<unsigned char>(c)) || c == '+' || c == '/';
-    });
-}
-
-// tinygltf's message for a data URI that is not base64 names neither the buffer nor the image;
-// this finds it in the JSON text, for an error with its JSON path ("buffers[0].uri").
-std::optional<std::string> bad_data_uri(std::string_view json_text) {
-    const nlohmann::json doc =
-        nlohmann::json::parse(json_text, nullptr, /*allow_exceptions=*/false);
-    if (!doc.is_object()) return std::nullopt;
-    for (const char* array : {"buffers", "images"}) {
-        const auto found = doc.find(array);
-        if (found == doc.end() || !found->is_array()) continue;
-        for (std::size_t i = 0; i < found->size(); ++i) {
-            const nlohmann::json& item = (*found)[i];
-            if (!item.is_object() || !item.contains("uri") || !item["uri"].is_string()) continue;
-            const std::string& uri = item["uri"].get_ref<const std::string&>();
-            const std::size_t comma = uri.find(',');
-            if (uri.rfind("data:", 0) != 0 || comma == std::string::npos ||
-                uri.substr(0, comma).find(";base64") == std::string::npos)
-                continue;
-            if (!is_base64(std::string_view(uri).substr(comma + 1)))
-                return fmt::format("{}[{}].uri: the data URI's payload is not base64", array, i);
-        }
-    }
-    return std::nullopt;
-}
-
 std::string first_line(std::string text) {
     while (!text.empty() && (text.back() == '\n' || text.back() == ' ')) text.pop_back();
     if (auto nl = text.find('\n'); nl != std::string::npos) text.resize(nl);
@@ -1043,6 +1024,13 @@ GltfDocument parse_gltf(std::span<const std::uint8_t> bytes, const std::filesyst
     check_memory(add_saturated(options.limits.reserved_memory, mul_saturated(bytes.size(), 8)),
                  fmt::format("{} ({})", file, format_bytes(bytes.size())));
 
+    // tinygltf refuses some files without a reason and reads others wrongly without a word;
+    // their JSON is checked first, for an error naming the JSON path.
+    const std::string_view text(reinterpret_cast<const char*>(bytes.data()), bytes.size());
+    if (auto problem = gltf_detail::check_gltf_json(
+            binary ? text.substr(20, read_u32(bytes.data() + 12)) : text))
+        throw Error(fmt::format("{}: {}", file, *problem));
+
     LoadContext context;
     context.max_input_bytes = options.limits.max_input_bytes;
     context.max_image_pixels = options.limits.max_image_pixels;
@@ -1069,12 +1057,10 @@ GltfDocument parse_gltf(std::span<const std::uint8_t> bytes, const std::filesyst
     } catch (const std::exception& e) {
         throw Error(fmt::format("{}: {}", file, e.what()));
     }
-    if (!ok) {
-        const std::string_view text(reinterpret_cast<const char*>(bytes.data()), bytes.size());
-        if (auto where = bad_data_uri(binary ? text.substr(20, read_u32(bytes.data() + 12)) : text))
-            throw Error(fmt::format("{}: {}", file, *where));
-        throw Error(fmt::format("{}: {}", file, err.empty() ? "not a glTF file" : first_line(err)));
-    }
+    if (!ok)
+        throw Error(fmt::format(
+            "{}: {}", file,
+            err.empty() ? "not a glTF 2.0 file (the parser gives no reason)" : first_line(err)));
     DocumentReader reader(model, file, base_dir, warnings, options, context);
     return reader.read();
 }

@@ -42,7 +42,7 @@ struct GltfNode {
     GltfQuat rotation;
     Vec3f scale{1.0f};
     std::optional<GltfMatrix> matrix;  ///< replaces translation, rotation and scale when given
-    std::vector<float> weights;        ///< morph weights; empty: the mesh's
+    std::vector<float> weights;        ///< one per morph target of the mesh; empty: the mesh's
 };
 
 /// One morph target's displacements (an empty array: that attribute does not move).
