@@ -98,8 +98,8 @@ TEST(DrawStrokes, EveryPixelGetsTheRuleOfItsNearestSegmentAtAnySlope) {
 TEST(OpaqueLines, MarkExactlyWhereThePictureCannotShow) {
     const std::vector<Stroke> strokes{stroke({{4.0f, 20.0f}, {60.0f, 27.0f}})};
     std::vector<ink::StrokePen> pens(2);
-    pens[0].thickness = 4.0f;
-    pens[1].thickness = 4.0f;
+    pens[0].width = 4.0f;
+    pens[1].width = 4.0f;
     pens[1].opacity = 0.5f;  // a second, see-through pen for the same line
     for (std::uint16_t style : {0, 1}) {
         std::vector<Stroke> styled = strokes;

@@ -262,6 +262,37 @@ TEST(LineStyle, RulesRoundTripThroughEntries) {
     }
 }
 
+TEST(LineStyle, PensAreTheStyleInPixelsOfTheImage) {
+    ink::LineStyle style;
+    style.colour = {0.2f, 0.4f, 0.6f};
+    style.width = 3.0f;
+    style.opacity = 0.7f;
+    style.dash = {4.0f, 2.0f};
+    style.taper = 10.0f;
+    const ink::StrokePen pen = ink::stroke_pen(style, 1080, 12.0f);
+    // Every length that scales is times 1080 / 720, the rest as they were.
+    EXPECT_EQ(pen.width, ink::stroke_thickness(3.0f, 1080));
+    EXPECT_EQ(pen.taper, 15.0f);
+    EXPECT_EQ(pen.dash, (std::vector<float>{6.0f, 3.0f}));
+    EXPECT_EQ(pen.colour, style.colour);
+    EXPECT_EQ(pen.opacity, 0.7f);
+    EXPECT_EQ(pen.depth_reference, 0.0f);  // this style does not scale by depth
+    style.by_depth = true;
+    EXPECT_EQ(ink::stroke_pen(style, 1080, 12.0f).depth_reference, 12.0f);
+    EXPECT_EQ(static_cast<const ink::LineStyle&>(ink::stroke_pen(style, 720)), style);
+}
+
+ink::StrokePen pen(float width, Vec3f colour = Vec3f{0.0f}, float opacity = 1.0f,
+                   std::vector<float> dash = {}, float taper = 0.0f) {
+    ink::StrokePen p;
+    p.width = width;
+    p.colour = colour;
+    p.opacity = opacity;
+    p.dash = std::move(dash);
+    p.taper = taper;
+    return p;
+}
+
 ink::Stroke line(float y, std::uint16_t style) {
     ink::Stroke s;
     s.points = {{4.0f, y}, {60.0f, y}};
@@ -276,7 +307,7 @@ TEST(StyledStrokes, OneSolidPenDrawsExactlyLikeDrawStrokes) {
         {ink::EdgeType::Crease, true, {{5, 5}, {30, 40}}, false, 0, {}}};
     ImageF plain(64, 48, 0.0f);
     ink::draw_strokes(strokes, 2.5f, plain, 1);
-    const std::vector<ink::StrokePen> pens{{true, 2.5f, Vec3f{0.0f}, 1.0f, {}, 0.0f}};
+    const std::vector<ink::StrokePen> pens{pen(2.5f)};
     ImageF coverage;
     Image<std::uint16_t> style;
     ink::draw_styled_strokes(strokes, pens, 64, 48, coverage, style, 3);
@@ -290,9 +321,10 @@ TEST(StyledStrokes, OneSolidPenDrawsExactlyLikeDrawStrokes) {
 
 TEST(StyledStrokes, DashesOpacityAndTheStrongestStrokeWins) {
     std::vector<ink::StrokePen> pens(3);
-    pens[0] = {true, 2.0f, Vec3f{0.0f}, 1.0f, {}, 0.0f};
-    pens[1] = {true, 2.0f, Vec3f{1.0f, 0.0f, 0.0f}, 0.5f, {4.0f, 4.0f}, 0.0f};
-    pens[2] = {false, 2.0f, Vec3f{0.0f}, 1.0f, {}, 0.0f};
+    pens[0] = pen(2.0f);
+    pens[1] = pen(2.0f, Vec3f{1.0f, 0.0f, 0.0f}, 0.5f, {4.0f, 4.0f});
+    pens[2] = pen(2.0f);
+    pens[2].draw = false;
     ImageF coverage;
     Image<std::uint16_t> style;
     // A dashed line at y = 20, an undrawn one at y = 30.
@@ -332,7 +364,7 @@ TEST(StyledStrokes, DashesOpacityAndTheStrongestStrokeWins) {
 }
 
 TEST(StyledStrokes, TaperThinsOpenStrokesToTheirEnds) {
-    const std::vector<ink::StrokePen> pens{{true, 4.0f, Vec3f{0.0f}, 1.0f, {}, 20.0f}};
+    const std::vector<ink::StrokePen> pens{pen(4.0f, Vec3f{0.0f}, 1.0f, {}, 20.0f)};
     ImageF coverage;
     Image<std::uint16_t> style;
     ink::draw_styled_strokes(std::vector<ink::Stroke>{line(24.0f, 0)}, pens, 64, 48, coverage,
@@ -355,13 +387,14 @@ namespace toonray {
 namespace {
 
 TEST(StyledStrokes, WidthByDepthThinsFartherPoints) {
-    ink::StrokePen pen{true, 4.0f, Vec3f{0.0f}, 1.0f, {}, 0.0f};
-    pen.depth_reference = 10.0f;
+    ink::StrokePen deep = pen(4.0f);
+    deep.by_depth = true;
+    deep.depth_reference = 10.0f;
     ink::Stroke s = line(24.0f, 0);
     s.depth = {10.0f, 20.0f};  // full width at the start, half at the end
     ImageF coverage;
     Image<std::uint16_t> style;
-    ink::draw_styled_strokes(std::vector<ink::Stroke>{s}, std::vector<ink::StrokePen>{pen}, 64, 48,
+    ink::draw_styled_strokes(std::vector<ink::Stroke>{s}, std::vector<ink::StrokePen>{deep}, 64, 48,
                              coverage, style, 1);
     auto across = [&](int x) {
         float sum = 0;

@@ -4,7 +4,8 @@
 
 #include <algorithm>
 #include <iterator>
-
+#include <type_traits>
+#include <variant>
 
 namespace toonray::ink {
 
@@ -24,20 +25,37 @@ std::string coordinate(float v) {
     return s;
 }
 
-// The attributes in which a path's pen differs from its group's stroke colour and width.
-std::string pen_attributes(const StrokePen& pen, const Vec3f& colour, float width) {
+// An attribute's value as SVG writes it: colours #rrggbb, lengths and fractions with three
+// decimals, dash lists comma-separated or `none` (SVG's initial value).
+std::string svg_value(const StyleAttribute& a, const LineStyle& style) {
+    return std::visit(
+        [&](auto field) -> std::string {
+            using Value = std::remove_cvref_t<decltype(style.*field)>;
+            const Value& v = style.*field;
+            if constexpr (std::is_same_v<Value, Vec3f>) {
+                return hex_colour(v);
+            } else if constexpr (std::is_same_v<Value, float>) {
+                return coordinate(v);
+            } else if constexpr (std::is_same_v<Value, bool>) {
+                return v ? "yes" : "no";
+            } else {
+                if (v.empty()) return "none";
+                std::string out;
+                for (std::size_t i = 0; i < v.size(); ++i) out += (i ? "," : "") + coordinate(v[i]);
+                return out;
+            }
+        },
+        a.field);
+}
+
+// The attributes of a stroked path whose pen differs from its group's (`group`: the group's
+// colour and width, the other attributes at their defaults).
+std::string stroke_attributes(const StrokePen& pen, const LineStyle& group) {
     std::string out;
-    auto it = std::back_inserter(out);
-    if (hex_colour(pen.colour) != hex_colour(colour))
-        fmt::format_to(it, " stroke=\"{}\"", hex_colour(pen.colour));
-    if (coordinate(pen.thickness) != coordinate(width))
-        fmt::format_to(it, " stroke-width=\"{}\"", coordinate(pen.thickness));
-    if (pen.opacity != 1.0f) fmt::format_to(it, " stroke-opacity=\"{}\"", coordinate(pen.opacity));
-    if (!pen.dash.empty()) {
-        out += " stroke-dasharray=\"";
-        for (std::size_t i = 0; i < pen.dash.size(); ++i)
-            fmt::format_to(it, "{}{}", i ? "," : "", coordinate(pen.dash[i]));
-        out += "\"";
+    for (const StyleAttribute& a : style_attributes()) {
+        if (a.svg != SvgMapping::PathAttribute || a.svg_stroke.empty()) continue;
+        const std::string value = svg_value(a, pen);
+        if (value != svg_value(a, group)) out += fmt::format(" {}=\"{}\"", a.svg_stroke, value);
     }
     return out;
 }
@@ -80,6 +98,9 @@ std::string svg_text(std::span<const Stroke> strokes, const SvgSettings& setting
         const float width =
             visible ? settings.thickness : settings.thickness * settings.hidden_thickness_scale;
         const Vec3f colour = visible ? settings.colour : settings.hidden_colour;
+        LineStyle group;  // what the group's attributes say, the rest SVG's initial values
+        group.colour = colour;
+        group.width = width;
         fmt::format_to(
             it,
             "<g id=\"{}\" fill=\"none\" stroke=\"{}\" stroke-width=\"{}\" stroke-linecap=\"round\" "
@@ -94,7 +115,7 @@ std::string svg_text(std::span<const Stroke> strokes, const SvgSettings& setting
                     s.style < settings.pens.size() ? &settings.pens[s.style] : nullptr;
                 if (pen && !pen->draw && visible) continue;  // this line set is off
                 const std::string attributes =
-                    pen && pen->draw ? pen_attributes(*pen, colour, width) : std::string();
+                    pen && pen->draw ? stroke_attributes(*pen, group) : std::string();
                 out += "<path";
                 out += attributes;
                 out += " d=\"M";
