@@ -1,10 +1,13 @@
 #include "toonray/ink/draw.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <utility>
 
+#include "toonray/core/error.h"
 #include "toonray/core/parallel.h"
 
 namespace toonray::ink {
@@ -179,6 +182,15 @@ void rasterise(const std::vector<Segment2>& segments, ImageF& coverage, Image<st
     });
 }
 
+// A covered pixel's pen. The style image is drawn with the same pens (draw_styled_strokes), so
+// a style without one is a mistake upstream: drawing another pen instead would hide it.
+const StrokePen& pen_of_pixel(std::span<const StrokePen> pens, std::uint16_t style, int x, int y) {
+    if (style >= pens.size())
+        throw Error(fmt::format("ink: the line pixel ({}, {}) has style {} but there are {} pens",
+                                x, y, style, pens.size()));
+    return pens[style];
+}
+
 std::uint8_t to_byte(float v) {
     return static_cast<std::uint8_t>(std::min(std::max(v, 0.0f), 1.0f) * 255.0f + 0.5f);
 }
@@ -193,6 +205,14 @@ StrokePen stroke_pen(const LineStyle& style, int height, float depth_reference) 
     StrokePen pen{scale_line_style(style, height)};
     pen.depth_reference = style.by_depth ? depth_reference : 0.0f;
     return pen;
+}
+
+const StrokePen& pen_of_stroke(std::span<const StrokePen> pens, const Stroke& stroke,
+                               std::size_t index) {
+    if (stroke.style >= pens.size())
+        throw Error(fmt::format("ink: stroke {} has style {} but there are {} pens", index,
+                                stroke.style, pens.size()));
+    return pens[stroke.style];
 }
 
 bool scales_by_depth(const StrokePen& pen, const Stroke& stroke) {
@@ -230,9 +250,9 @@ void draw_styled_strokes(std::span<const Stroke> strokes, std::span<const Stroke
     style.resize(width, height, 0);
     if (width <= 0 || height <= 0) return;
     std::vector<Segment2> segments;
-    for (const Stroke& s : strokes) {
-        if (s.style >= pens.size()) continue;
-        const StrokePen& pen = pens[s.style];
+    for (std::size_t i = 0; i < strokes.size(); ++i) {
+        const Stroke& s = strokes[i];
+        const StrokePen& pen = pen_of_stroke(pens, s, i);
         if (!pen.draw || !(pen.width > 0.0f) || !(pen.opacity > 0.0f)) continue;
         const bool shaped = !pen.dash.empty() || varies_width(pen, s);
         add_stroke_segments(s, pen.width, s.style, shaped ? &pen : nullptr, width, height,
@@ -248,8 +268,8 @@ void composite_styled_lines(const ImageF& coverage, const Image<std::uint16_t>& 
         const std::uint16_t* style = styles.row(y);
         Rgb8* px = image.row(y);
         for (int x = 0; x < image.width(); ++x) {
-            if (!(cov[x] > 0.0f) || style[x] >= pens.size()) continue;
-            const StrokePen& pen = pens[style[x]];
+            if (!(cov[x] > 0.0f)) continue;
+            const StrokePen& pen = pen_of_pixel(pens, style[x], x, y);
             const float a = cov[x] * pen.opacity;
             for (int c = 0; c < 3; ++c)
                 px[x][c] = to_byte(static_cast<float>(px[x][c]) * (1.0f / 255.0f) * (1.0f - a) +
@@ -267,8 +287,7 @@ void opaque_lines(const ImageF& coverage, const Image<std::uint16_t>& styles,
         std::uint8_t* out = opaque.row(y);
         for (int x = 0; x < coverage.width(); ++x)
             // composite_styled_lines's a: with a = 1 the picture's value is multiplied by 0.
-            out[x] =
-                cov[x] > 0.0f && style[x] < pens.size() && cov[x] * pens[style[x]].opacity == 1.0f;
+            out[x] = cov[x] > 0.0f && cov[x] * pen_of_pixel(pens, style[x], x, y).opacity == 1.0f;
     }
 }
 

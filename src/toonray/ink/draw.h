@@ -40,6 +40,12 @@ struct StrokePen : LineStyle {
 [[nodiscard]] StrokePen stroke_pen(const LineStyle& style, int height,
                                    float depth_reference = 0.0f);
 
+/// pens[stroke.style]. The pens are made with the strokes' styles (ink.h, InkLines), so a style
+/// without a pen is a mistake upstream: throws Error naming the stroke (`index`), its style and
+/// the number of pens rather than drawing it with another pen.
+[[nodiscard]] const StrokePen& pen_of_stroke(std::span<const StrokePen> pens, const Stroke& stroke,
+                                             std::size_t index);
+
 /// Whether the pen scales the stroke's width by depth (it asks for it, has a reference and
 /// the stroke has a depth per point).
 [[nodiscard]] bool scales_by_depth(const StrokePen& pen, const Stroke& stroke);
@@ -60,7 +66,8 @@ struct StrokePen : LineStyle {
 /// clamp(depth_reference / depth, 0.25, 2); 2 for a depth that is not positive.
 [[nodiscard]] float depth_scale(const StrokePen& pen, float depth);
 
-/// Draws each stroke with pens[stroke.style] (strokes whose pen does not draw are skipped)
+/// Draws each stroke with pens[stroke.style] (strokes whose pen does not draw are skipped;
+/// a stroke whose style has no pen throws Error, as the styles and pens are made together)
 /// into the line layer `coverage` and `style` (per pixel, the coverage of the stroke that covers
 /// it most and that stroke's style: 4 + 2 bytes a pixel), resized to width x height and cleared
 /// first. Coverage is the rule of
@@ -75,12 +82,14 @@ void draw_styled_strokes(std::span<const Stroke> strokes, std::span<const Stroke
                          int threads);
 
 /// image = image * (1 - a) + colour * a with a = coverage * opacity of the pixel's pen, per
-/// channel, rounded as composite_lines. With opacity 1 this is composite_lines exactly.
+/// channel, rounded as composite_lines. With opacity 1 this is composite_lines exactly. A
+/// covered pixel whose style has no pen throws Error.
 void composite_styled_lines(const ImageF& coverage, const Image<std::uint16_t>& style,
                             std::span<const StrokePen> pens, ImageRgb8& image);
 
 /// 1 where composite_styled_lines covers a pixel completely (coverage times the pen's opacity
 /// is exactly 1), so that nothing of the picture under it shows; else 0. Sized like coverage.
+/// A covered pixel whose style has no pen throws Error.
 void opaque_lines(const ImageF& coverage, const Image<std::uint16_t>& style,
                   std::span<const StrokePen> pens, Image<std::uint8_t>& opaque);
 

@@ -78,6 +78,11 @@ std::string png_data_uri(std::span<const std::uint8_t> png) {
 }
 
 std::string svg_text(std::span<const Stroke> strokes, const SvgSettings& settings) {
+    // Every stroke's style must have a pen, also of strokes not written (hidden ones without
+    // the hidden layer, dots): the same check as the drawing's, whatever the settings.
+    if (!settings.pens.empty())
+        for (std::size_t i = 0; i < strokes.size(); ++i)
+            static_cast<void>(pen_of_stroke(settings.pens, strokes[i], i));
     std::string out;
     auto it = std::back_inserter(out);
     fmt::format_to(it, "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
@@ -109,10 +114,11 @@ std::string svg_text(std::span<const Stroke> strokes, const SvgSettings& setting
         for (int t = 0; t < kEdgeTypeCount; ++t) {
             const auto type = static_cast<EdgeType>(t);
             fmt::format_to(it, "<g id=\"{}-{}\">\n", name, edge_type_name(type));
-            for (const Stroke& s : strokes) {
+            for (std::size_t index = 0; index < strokes.size(); ++index) {
+                const Stroke& s = strokes[index];
                 if (s.visible != visible || s.type != type || s.points.size() < 2) continue;
                 const StrokePen* pen =
-                    s.style < settings.pens.size() ? &settings.pens[s.style] : nullptr;
+                    settings.pens.empty() ? nullptr : &pen_of_stroke(settings.pens, s, index);
                 if (pen && !pen->draw && visible) continue;  // this line set is off
                 const std::string attributes =
                     pen && pen->draw ? stroke_attributes(*pen, group) : std::string();

@@ -18,10 +18,12 @@ struct SvgSettings {
     bool hidden = false;  ///< write hidden strokes too (in group "hidden")
     Vec3f hidden_colour{0.5f};
     float hidden_thickness_scale = 0.5f;
-    /// The frame's pens (InkLines::pens), indexed by Stroke::style. A path whose pen differs
-    /// from its group's defaults carries its own stroke, stroke-width, stroke-opacity and
-    /// stroke-dasharray; visible strokes whose pen does not draw are left out, hidden ones
-    /// whose pen does not draw keep the hidden layer's defaults. Empty: group defaults only.
+    /// The frame's pens (InkLines::pens), indexed by Stroke::style; a stroke whose style has
+    /// no pen throws Error (draw.h, pen_of_stroke). A path whose pen differs from its group's
+    /// defaults carries its own stroke, stroke-width, stroke-opacity and stroke-dasharray (the
+    /// table's svg_stroke attributes, line_style.h); visible strokes whose pen does not draw
+    /// are left out, hidden ones whose pen does not draw keep the hidden layer's defaults.
+    /// Empty: group defaults only.
     std::span<const StrokePen> pens;
     /// When not empty, an `<image id="fill">` of the whole view under the lines with this
     /// href (a data: URI of the cel-shaded picture).
