@@ -1,5 +1,6 @@
-// Line style files. Checks that every parsed rule is within the documented ranges and that a
-// style resolved from them is too.
+// Line style files. Checks that every parsed rule is within the documented ranges, that a
+// style resolved from them is too, and that each rule written back as (key, value) entries
+// (as a settings document holds it) reads back to an equal rule.
 
 #include <cmath>
 
@@ -16,12 +17,20 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     } catch (const Error&) {
         return 0;
     }
+    for (const ink::LineStyleRule& rule : set.rules) {
+        // Whatever parsed must round-trip: a failure to read the entries back is a bug too.
+        const std::vector<ink::RuleEntry> entries = ink::line_style_rule_entries(rule);
+        const ink::LineStyleRule back =
+            ink::make_line_style_rule(entries, {"fuzz.toml: lines.rule[1]", ".", rule.line});
+        FUZZ_CHECK(back == rule);
+    }
     for (int t = 0; t < ink::kEdgeTypeCount; ++t)
         for (bool visible : {false, true}) {
             const ink::LineStyle s = ink::resolve_line_style(
                 set, ink::LineStyle{}, "w12", "ivory", static_cast<ink::EdgeType>(t), visible);
             FUZZ_CHECK(s.width >= 0.0f && s.width <= 1000.0f);
             FUZZ_CHECK(s.opacity >= 0.0f && s.opacity <= 1.0f);
+            FUZZ_CHECK(s.taper >= 0.0f && s.taper <= 1e4f);
             FUZZ_CHECK(s.dash.size() % 2 == 0);
             float total = 0.0f;
             for (float d : s.dash) {

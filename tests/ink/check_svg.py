@@ -2,9 +2,11 @@
 
 Usage: check_svg.py FILE WIDTH HEIGHT HIDDEN(0|1) MIN_PATHS [MIN_DASHED_HIDDEN]
 Exits 0 when the file is well-formed XML with the expected groups and enough paths, every
-path's own style attributes (stroke, stroke-width, stroke-opacity, stroke-dasharray) are
-well-formed, an embedded fill image (if any) is a PNG data URI under the lines, and at least
-MIN_DASHED_HIDDEN paths of the hidden layer are dashed.
+stroked path is a polyline whose own style attributes (stroke, stroke-width, stroke-opacity,
+stroke-dasharray) are well-formed, every filled outline (a stroke whose width varies: stroke
+none, fill, fill-opacity) is made of closed subpaths of lines and quarter arcs, an embedded
+fill image (if any) is a PNG data URI under the lines, and at least MIN_DASHED_HIDDEN paths of
+the hidden layer are dashed.
 """
 import re
 import sys
@@ -49,17 +51,25 @@ def main():
             fail(f"subgroups {ids}")
         for path_element in layer.iter(SVG + "path"):
             d = path_element.get("d")
-            if not re.fullmatch(r"M -?\d+\.\d{3} -?\d+\.\d{3}( L -?\d+\.\d{3} -?\d+\.\d{3}( -?\d+\.\d{3} -?\d+\.\d{3})*)?( Z)?", d):
-                fail(f"path data {d[:80]}")
-            checks = {"stroke": r"#[0-9a-f]{6}", "stroke-width": number, "stroke-opacity": number,
-                      "stroke-dasharray": rf"{number}(,{number})*"}
+            outline = path_element.get("fill") is not None
+            if outline:
+                point = r"-?\d+\.\d{3} -?\d+\.\d{3}"
+                shape = rf"M {point}( L {point}| A {number} {number} 0 0 0 {point})* Z"
+                if path_element.get("stroke") != "none" or not re.fullmatch(rf"{shape}( {shape})*", d):
+                    fail(f"outline {path_element.get('stroke')} {d[:80]}")
+                checks = {"fill": r"#[0-9a-f]{6}", "fill-opacity": number}
+            else:
+                if not re.fullmatch(r"M -?\d+\.\d{3} -?\d+\.\d{3}( L -?\d+\.\d{3} -?\d+\.\d{3}( -?\d+\.\d{3} -?\d+\.\d{3})*)?( Z)?", d):
+                    fail(f"path data {d[:80]}")
+                checks = {"stroke": r"#[0-9a-f]{6}", "stroke-width": number, "stroke-opacity": number,
+                          "stroke-dasharray": rf"{number}(,{number})*", "stroke-linecap": "butt"}
             for name, pattern in checks.items():
                 value = path_element.get(name)
                 if value is not None and not re.fullmatch(pattern, value):
                     fail(f"path {name}={value}")
-            opacity = path_element.get("stroke-opacity")
+            opacity = path_element.get("fill-opacity" if outline else "stroke-opacity")
             if opacity is not None and not 0.0 <= float(opacity) <= 1.0:
-                fail(f"stroke-opacity {opacity}")
+                fail(f"opacity {opacity}")
             if layer.get("id") == "hidden" and path_element.get("stroke-dasharray"):
                 dashed_hidden += 1
             paths += 1

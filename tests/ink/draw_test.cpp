@@ -5,6 +5,9 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
+#include <string>
+
+#include "toonray/core/error.h"
 
 namespace toonray {
 namespace {
@@ -98,8 +101,8 @@ TEST(DrawStrokes, EveryPixelGetsTheRuleOfItsNearestSegmentAtAnySlope) {
 TEST(OpaqueLines, MarkExactlyWhereThePictureCannotShow) {
     const std::vector<Stroke> strokes{stroke({{4.0f, 20.0f}, {60.0f, 27.0f}})};
     std::vector<ink::StrokePen> pens(2);
-    pens[0].thickness = 4.0f;
-    pens[1].thickness = 4.0f;
+    pens[0].width = 4.0f;
+    pens[1].width = 4.0f;
     pens[1].opacity = 0.5f;  // a second, see-through pen for the same line
     for (std::uint16_t style : {0, 1}) {
         std::vector<Stroke> styled = strokes;
@@ -122,6 +125,45 @@ TEST(OpaqueLines, MarkExactlyWhereThePictureCannotShow) {
         if (style == 0) EXPECT_GT(marked, 100);
         else EXPECT_EQ(marked, 0);
     }
+}
+
+// Styles and pens are made together (ink.h): a style index without a pen is a mistake upstream
+// and must say so, not draw the stroke with another pen or leave it out unnoticed.
+TEST(StyledStrokes, AStyleWithoutAPenThrows) {
+    std::vector<Stroke> strokes{stroke({{4.0f, 20.0f}, {60.0f, 27.0f}}),
+                                stroke({{4.0f, 30.0f}, {60.0f, 30.0f}})};
+    strokes[1].style = 2;
+    const std::vector<ink::StrokePen> pens(2);
+    ImageF coverage;
+    Image<std::uint16_t> styles;
+    auto message = [](auto&& call) {
+        try {
+            call();
+        } catch (const Error& e) {
+            return std::string(e.what());
+        }
+        return std::string("(no error)");
+    };
+    EXPECT_EQ(
+        message([&] { ink::draw_styled_strokes(strokes, pens, 64, 48, coverage, styles, 1); }),
+        "ink: stroke 1 has style 2 but there are 2 pens");
+    // The line layer of a frame drawn with more pens than are given to composite it.
+    strokes[1].style = 1;
+    ink::draw_styled_strokes(strokes, pens, 64, 48, coverage, styles, 1);
+    const std::vector<ink::StrokePen> fewer(1);
+    ImageRgb8 image(64, 48, Rgb8{255, 255, 255});
+    EXPECT_NE(message([&] {
+                  ink::composite_styled_lines(coverage, styles, fewer, image);
+              }).find("has style 1 but there are 1 pens"),
+              std::string::npos);
+    Image<std::uint8_t> opaque;
+    EXPECT_NE(message([&] {
+                  ink::opaque_lines(coverage, styles, fewer, opaque);
+              }).find("has style 1 but there are 1 pens"),
+              std::string::npos);
+    // With every pen there, nothing throws.
+    EXPECT_EQ(message([&] { ink::composite_styled_lines(coverage, styles, pens, image); }),
+              "(no error)");
 }
 
 TEST(DrawStrokes, ThicknessScalesWithImageHeight) {

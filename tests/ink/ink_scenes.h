@@ -1,12 +1,13 @@
 #pragma once
-/// Scenes built in code for the ink tests, a brute-force occluder count to check the
-/// accelerated one against, and the speck count of a line image.
+/// Scenes built in code for the ink tests, the teapot of tests/data, a brute-force occluder
+/// count to check the accelerated one against, and the speck count of a line image.
 
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <numbers>
 #include <random>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -14,6 +15,7 @@
 #include "toonray/core/image.h"
 #include "toonray/ink/visibility.h"
 #include "toonray/scene/camera.h"
+#include "toonray/scene/obj_loader.h"
 #include "toonray/scene/scene.h"
 
 namespace toonray::test_support {
@@ -194,5 +196,22 @@ inline int count_specks(const ImageGray8& lines, int max_size = 12, float thresh
         }
     return specks;
 }
+
+/// tests/data/teapot.obj with its accelerator and a camera that frames it in a width x height
+/// image.
+struct Teapot {
+    Scene scene;
+    TriangleAccel accel;
+    CameraSpec camera;
+    Teapot(int w, int h) {
+        Warnings warnings;
+        load_obj(std::string(TOONRAY_TEST_DATA_DIR) + "/teapot.obj", scene, warnings);
+        accel.build(scene.positions, scene.tri_positions);
+        std::vector<Vec3f> used;
+        for (const auto& t : scene.tri_positions)
+            for (std::uint32_t v : t) used.push_back(scene.positions[v]);
+        camera = auto_camera(used, w, h);
+    }
+};
 
 }  // namespace toonray::test_support

@@ -12,27 +12,13 @@
 #include "toonray/ink/svg.h"
 #include "toonray/io/file.h"
 #include "toonray/io/png.h"
-#include "toonray/scene/obj_loader.h"
 
 namespace toonray {
 namespace {
 
 using test_support::write_svg;
 
-struct Teapot {
-    Scene scene;
-    TriangleAccel accel;
-    CameraSpec camera;
-    Teapot(int w, int h) {
-        Warnings warnings;
-        load_obj(std::string(TOONRAY_TEST_DATA_DIR) + "/teapot.obj", scene, warnings);
-        accel.build(scene.positions, scene.tri_positions);
-        std::vector<Vec3f> used;
-        for (const auto& t : scene.tri_positions)
-            for (std::uint32_t v : t) used.push_back(scene.positions[v]);
-        camera = auto_camera(used, w, h);
-    }
-};
+using test_support::Teapot;
 
 TEST(InkLines, TeapotHasLinesOfEveryStageAndIsThreadIndependent) {
     const Teapot t(640, 360);

@@ -2,6 +2,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <random>
+#include <type_traits>
+#include <variant>
+
 #include "toonray/core/error.h"
 #include "toonray/ink/draw.h"
 
@@ -48,18 +53,23 @@ TEST(LineStyle, ParsesRulesCommentsAndColours) {
                            (1u << static_cast<int>(EdgeType::Silhouette)));
     EXPECT_FALSE(a.match_visible);
     EXPECT_TRUE(a.match_hidden);
-    EXPECT_EQ(a.draw, true);
-    EXPECT_NEAR(a.colour->x, 128.0f / 255.0f, 1e-6f);
-    EXPECT_EQ(a.width, 1.5f);
-    EXPECT_EQ(a.opacity, 0.5f);
-    EXPECT_EQ(a.dash, (std::vector<float>{4.0f, 2.0f}));
+    EXPECT_TRUE(a.sets_field(&ink::LineStyle::draw));
+    EXPECT_TRUE(a.values.draw);
+    EXPECT_NEAR(a.values.colour.x, 128.0f / 255.0f, 1e-6f);
+    EXPECT_EQ(a.values.width, 1.5f);
+    EXPECT_EQ(a.values.opacity, 0.5f);
+    EXPECT_EQ(a.values.dash, (std::vector<float>{4.0f, 2.0f}));
+    EXPECT_FALSE(a.sets_field(&ink::LineStyle::taper));
     const ink::LineStyleRule& b = set.rules[1];
     EXPECT_EQ(b.line, 4);
     EXPECT_TRUE(b.match_visible);  // visible lines unless a rule says otherwise
     EXPECT_FALSE(b.match_hidden);
-    EXPECT_EQ(b.dash, (std::vector<float>{3.0f, 3.0f}));  // an odd pattern repeats, as in SVG
-    EXPECT_EQ(b.taper, 5.0f);
-    EXPECT_FALSE(b.width.has_value());
+    // An odd pattern repeats, as in SVG.
+    EXPECT_EQ(b.values.dash, (std::vector<float>{3.0f, 3.0f}));
+    EXPECT_EQ(b.values.taper, 5.0f);
+    EXPECT_EQ(b.values.colour, (Vec3f{1.0f, 0.0f, 0.0f}));
+    EXPECT_FALSE(b.sets_field(&ink::LineStyle::width));
+    EXPECT_EQ(b.values.width, ink::LineStyle{}.width);  // what it does not set keeps the default
 }
 
 TEST(LineStyle, ErrorsNameTheFileLineAndWhatWasWrong) {
@@ -116,6 +126,173 @@ TEST(LineStyle, LaterRulesOverrideTheAttributesTheySet) {
     EXPECT_TRUE(set.draws_hidden());
 }
 
+TEST(LineStyle, TheKeysAreTheMatchersThenTheTablesAttributes) {
+    const std::vector<std::string_view> keys = ink::line_rule_keys();
+    EXPECT_EQ(keys, (std::vector<std::string_view>{"object", "material", "type", "lines", "draw",
+                                                   "color", "colour", "width", "opacity", "dash",
+                                                   "taper", "width_by_depth"}));
+    for (const ink::StyleAttribute& a : ink::style_attributes()) {
+        EXPECT_FALSE(a.help.empty()) << a.name;
+        EXPECT_TRUE(a.named(a.name));
+        // Lengths in pixels at 720 lines scale with the image; nothing else does.
+        EXPECT_EQ(a.scales(), a.name == "width" || a.name == "taper" || a.name == "dash") << a.name;
+    }
+    for (const ink::RuleMatcher& m : ink::rule_matchers()) EXPECT_FALSE(m.help.empty()) << m.name;
+}
+
+ink::LineStyleRule rule_from(std::vector<ink::RuleEntry> entries) {
+    return ink::make_line_style_rule(entries, {"settings.toml: lines.rule[2]", ".", 0});
+}
+
+std::string rule_error(std::vector<ink::RuleEntry> entries) {
+    try {
+        (void)rule_from(std::move(entries));
+    } catch (const Error& e) {
+        return e.what();
+    }
+    return "(no error)";
+}
+
+// A settings document's rule tables use the keys of a `match` line; their errors name the
+// table and key as the document spells them.
+TEST(LineStyle, RulesFromEntriesNameTheirPlaceInErrors) {
+    EXPECT_EQ(rule_error({{"width", "x"}}),
+              "settings.toml: lines.rule[2].width: expected a number, got 'x'");
+    EXPECT_EQ(rule_error({{"colour", "#12"}}),
+              "settings.toml: lines.rule[2].colour: expected #rrggbb, got '#12'");
+    EXPECT_EQ(rule_error({{"type", "edge"}}).substr(0, 61),
+              "settings.toml: lines.rule[2].type: unknown line type 'edge' (");
+    EXPECT_EQ(rule_error({{"dash", "0,0"}}),
+              "settings.toml: lines.rule[2].dash: the lengths must not all be 0");
+    EXPECT_EQ(rule_error({{"draw", "yes"}, {"colr", "#000000"}}),
+              "settings.toml: lines.rule[2]: unknown key 'colr' (object, material, type, lines, "
+              "draw, color, width, opacity, dash, taper, width_by_depth)");
+    EXPECT_EQ(rule_error({{"width", "1"}, {"width", "2"}}),
+              "settings.toml: lines.rule[2]: 'width' given twice");
+    // Entries and a .style line are read by the same code.
+    const ink::LineStyleSet set = ink::parse_line_styles(
+        "match object=w*,b* lines=all type=crease colour=#ff8000 dash=3 width_by_depth=yes\n",
+        "keys.style");
+    ASSERT_EQ(set.rules.size(), 1u);
+    ink::LineStyleRule rule = rule_from({{"object", "w*,b*"},
+                                         {"lines", "all"},
+                                         {"type", "crease"},
+                                         {"colour", "#ff8000"},
+                                         {"dash", "3"},
+                                         {"width_by_depth", "yes"}});
+    rule.line = 1;
+    EXPECT_EQ(rule, set.rules[0]);
+}
+
+void expect_round_trip(const ink::LineStyleRule& rule) {
+    const std::vector<ink::RuleEntry> entries = ink::line_style_rule_entries(rule);
+    std::string text;
+    for (const auto& [key, value] : entries) text += " " + key + "=" + value;
+    ink::LineStyleRule back = ink::make_line_style_rule(entries, {"again", ": ", rule.line});
+    EXPECT_EQ(back, rule) << text;
+    // The values bit for bit, not only equal (-0 and 0 compare equal).
+    for (const ink::StyleAttribute& a : ink::style_attributes())
+        EXPECT_EQ(ink::format_style_value(a, back.values), ink::format_style_value(a, rule.values))
+            << a.name << " in" << text;
+    // And as a .style line, when no value has a blank (a settings document's globs can).
+    bool blanks = false;
+    for (const auto& [key, value] : entries)
+        blanks = blanks || value.find_first_of(" \t") != std::string::npos;
+    if (!blanks) {
+        const ink::LineStyleSet set = ink::parse_line_styles("match" + text + "\n", "r.style");
+        ASSERT_EQ(set.rules.size(), 1u) << text;
+        back = set.rules[0];
+        back.line = rule.line;
+        EXPECT_EQ(back, rule) << text;
+    }
+}
+
+TEST(LineStyle, RulesRoundTripThroughEntries) {
+    const ink::LineStyleSet set = ink::parse_line_styles(
+        "match\n"
+        "match object=w*,b?,cheek_l material=ivory type=crease,silhouette lines=hidden draw=yes "
+        "color=#808080 width=1.5 opacity=0.5 dash=4,2 taper=6 width_by_depth=no\n"
+        "match lines=all type=all draw=no colour=0.1,0.2,0.30000001 width=0 opacity=0 dash=none "
+        "taper=0 width_by_depth=yes\n"
+        "match type=border,material,intersection,polyline colour=1,0,0 width=1000 opacity=1 "
+        "taper=10000 dash=1,2,3,4,5,6,7,8,9,10,11,12,13,14,15\n"
+        "match object=*,* material=a,b,c dash=0,1e-3 width=3.14159274 color=0.0039215689,1,0\n"
+        "match lines=visible width=-0 dash=0.5,0,0.25 opacity=1e-7\n",
+        "round.style");
+    ASSERT_EQ(set.rules.size(), 6u);
+    for (const ink::LineStyleRule& rule : set.rules) expect_round_trip(rule);
+    // Every matcher and every attribute was written back by some rule above.
+    std::vector<std::string> written;
+    for (const ink::LineStyleRule& rule : set.rules)
+        for (const auto& [key, value] : ink::line_style_rule_entries(rule)) written.push_back(key);
+    for (const ink::RuleMatcher& m : ink::rule_matchers())
+        EXPECT_NE(std::find(written.begin(), written.end(), m.name), written.end()) << m.name;
+    for (const ink::StyleAttribute& a : ink::style_attributes())
+        EXPECT_NE(std::find(written.begin(), written.end(), a.name), written.end()) << a.name;
+    // A glob with a blank (a settings document can hold one).
+    expect_round_trip(rule_from({{"object", "my key,b *"}, {"width", "2"}}));
+    // Values drawn at random over each attribute's range.
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> unit(0.0f, 1.0f);
+    for (int trial = 0; trial < 200; ++trial) {
+        ink::LineStyleRule rule;
+        for (std::size_t i = 0; i < ink::style_attributes().size(); ++i) {
+            const ink::StyleAttribute& a = ink::style_attributes()[i];
+            if (rng() % 2) continue;
+            rule.sets |= 1u << i;
+            std::visit(
+                [&](auto field) {
+                    using Value = std::remove_cvref_t<decltype(rule.values.*field)>;
+                    if constexpr (std::is_same_v<Value, bool>) {
+                        rule.values.*field = rng() % 2 == 0;
+                    } else if constexpr (std::is_same_v<Value, Vec3f>) {
+                        rule.values.*field = {unit(rng), unit(rng), unit(rng)};
+                    } else if constexpr (std::is_same_v<Value, float>) {
+                        rule.values.*field =
+                            unit(rng) * (a.kind == ink::StyleValueKind::Length ? a.max : 1.0f);
+                    } else {
+                        std::vector<float> dash(2 * (1 + rng() % 8));
+                        for (float& d : dash) d = unit(rng) * 50.0f;
+                        rule.values.*field = dash;
+                    }
+                },
+                a.field);
+        }
+        expect_round_trip(rule);
+    }
+}
+
+TEST(LineStyle, PensAreTheStyleInPixelsOfTheImage) {
+    ink::LineStyle style;
+    style.colour = {0.2f, 0.4f, 0.6f};
+    style.width = 3.0f;
+    style.opacity = 0.7f;
+    style.dash = {4.0f, 2.0f};
+    style.taper = 10.0f;
+    const ink::StrokePen pen = ink::stroke_pen(style, 1080, 12.0f);
+    // Every length that scales is times 1080 / 720, the rest as they were.
+    EXPECT_EQ(pen.width, ink::stroke_thickness(3.0f, 1080));
+    EXPECT_EQ(pen.taper, 15.0f);
+    EXPECT_EQ(pen.dash, (std::vector<float>{6.0f, 3.0f}));
+    EXPECT_EQ(pen.colour, style.colour);
+    EXPECT_EQ(pen.opacity, 0.7f);
+    EXPECT_EQ(pen.depth_reference, 0.0f);  // this style does not scale by depth
+    style.by_depth = true;
+    EXPECT_EQ(ink::stroke_pen(style, 1080, 12.0f).depth_reference, 12.0f);
+    EXPECT_EQ(static_cast<const ink::LineStyle&>(ink::stroke_pen(style, 720)), style);
+}
+
+ink::StrokePen pen(float width, Vec3f colour = Vec3f{0.0f}, float opacity = 1.0f,
+                   std::vector<float> dash = {}, float taper = 0.0f) {
+    ink::StrokePen p;
+    p.width = width;
+    p.colour = colour;
+    p.opacity = opacity;
+    p.dash = std::move(dash);
+    p.taper = taper;
+    return p;
+}
+
 ink::Stroke line(float y, std::uint16_t style) {
     ink::Stroke s;
     s.points = {{4.0f, y}, {60.0f, y}};
@@ -130,7 +307,7 @@ TEST(StyledStrokes, OneSolidPenDrawsExactlyLikeDrawStrokes) {
         {ink::EdgeType::Crease, true, {{5, 5}, {30, 40}}, false, 0, {}}};
     ImageF plain(64, 48, 0.0f);
     ink::draw_strokes(strokes, 2.5f, plain, 1);
-    const std::vector<ink::StrokePen> pens{{true, 2.5f, Vec3f{0.0f}, 1.0f, {}, 0.0f}};
+    const std::vector<ink::StrokePen> pens{pen(2.5f)};
     ImageF coverage;
     Image<std::uint16_t> style;
     ink::draw_styled_strokes(strokes, pens, 64, 48, coverage, style, 3);
@@ -144,9 +321,10 @@ TEST(StyledStrokes, OneSolidPenDrawsExactlyLikeDrawStrokes) {
 
 TEST(StyledStrokes, DashesOpacityAndTheStrongestStrokeWins) {
     std::vector<ink::StrokePen> pens(3);
-    pens[0] = {true, 2.0f, Vec3f{0.0f}, 1.0f, {}, 0.0f};
-    pens[1] = {true, 2.0f, Vec3f{1.0f, 0.0f, 0.0f}, 0.5f, {4.0f, 4.0f}, 0.0f};
-    pens[2] = {false, 2.0f, Vec3f{0.0f}, 1.0f, {}, 0.0f};
+    pens[0] = pen(2.0f);
+    pens[1] = pen(2.0f, Vec3f{1.0f, 0.0f, 0.0f}, 0.5f, {4.0f, 4.0f});
+    pens[2] = pen(2.0f);
+    pens[2].draw = false;
     ImageF coverage;
     Image<std::uint16_t> style;
     // A dashed line at y = 20, an undrawn one at y = 30.
@@ -186,7 +364,7 @@ TEST(StyledStrokes, DashesOpacityAndTheStrongestStrokeWins) {
 }
 
 TEST(StyledStrokes, TaperThinsOpenStrokesToTheirEnds) {
-    const std::vector<ink::StrokePen> pens{{true, 4.0f, Vec3f{0.0f}, 1.0f, {}, 20.0f}};
+    const std::vector<ink::StrokePen> pens{pen(4.0f, Vec3f{0.0f}, 1.0f, {}, 20.0f)};
     ImageF coverage;
     Image<std::uint16_t> style;
     ink::draw_styled_strokes(std::vector<ink::Stroke>{line(24.0f, 0)}, pens, 64, 48, coverage,
@@ -209,13 +387,14 @@ namespace toonray {
 namespace {
 
 TEST(StyledStrokes, WidthByDepthThinsFartherPoints) {
-    ink::StrokePen pen{true, 4.0f, Vec3f{0.0f}, 1.0f, {}, 0.0f};
-    pen.depth_reference = 10.0f;
+    ink::StrokePen deep = pen(4.0f);
+    deep.by_depth = true;
+    deep.depth_reference = 10.0f;
     ink::Stroke s = line(24.0f, 0);
     s.depth = {10.0f, 20.0f};  // full width at the start, half at the end
     ImageF coverage;
     Image<std::uint16_t> style;
-    ink::draw_styled_strokes(std::vector<ink::Stroke>{s}, std::vector<ink::StrokePen>{pen}, 64, 48,
+    ink::draw_styled_strokes(std::vector<ink::Stroke>{s}, std::vector<ink::StrokePen>{deep}, 64, 48,
                              coverage, style, 1);
     auto across = [&](int x) {
         float sum = 0;

@@ -1,10 +1,13 @@
 #include "toonray/ink/draw.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <utility>
 
+#include "toonray/core/error.h"
 #include "toonray/core/parallel.h"
 
 namespace toonray::ink {
@@ -27,17 +30,12 @@ struct Segment2 {
 
 constexpr float kMinDepthScale = 0.25f, kMaxDepthScale = 2.0f;
 
-float depth_scale(const StrokePen& pen, float depth) {
-    return depth > 0.0f ? std::clamp(pen.depth_reference / depth, kMinDepthScale, kMaxDepthScale)
-                        : kMaxDepthScale;
-}
-
 // Every segment of every stroke with the pixels it can reach.
 void add_stroke_segments(const Stroke& s, float thickness, std::uint16_t style,
                          const StrokePen* pen, int w, int h, std::vector<Segment2>& out) {
     const float reach = thickness * 0.5f + 0.5f;
     const float total = pen ? polyline_length(s.points) : 0.0f;
-    const bool by_depth = pen && pen->depth_reference > 0.0f && s.depth.size() == s.points.size();
+    const bool by_depth = pen && scales_by_depth(*pen, s);
     float arc = 0.0f;
     for (std::size_t i = 0; i + 1 < s.points.size(); ++i) {
         const Point2 a = s.points[i], b = s.points[i + 1];
@@ -71,8 +69,9 @@ void add_stroke_segments(const Stroke& s, float thickness, std::uint16_t style,
     }
 }
 
-// Whether arc length `s` lies in an "on" dash of the pattern.
-bool in_dash(const std::vector<float>& dash, float s) {
+}  // namespace
+
+bool in_dash(std::span<const float> dash, float s) {
     float period = 0.0f;
     for (float d : dash) period += d;
     float phase = std::fmod(s, period);
@@ -82,6 +81,8 @@ bool in_dash(const std::vector<float>& dash, float s) {
     }
     return false;
 }
+
+namespace {
 
 // The pixels of row y (centre y + 0.5) that a segment's capsule (points within max_reach of it)
 // can cover, within the segment's box: the capsule is convex, so its section is one interval,
@@ -162,13 +163,9 @@ void rasterise(const std::vector<Segment2>& segments, ImageF& coverage, Image<st
                         if (s.pen) {
                             const float arc = s.arc0 + t * len;
                             if (!s.pen->dash.empty() && !in_dash(s.pen->dash, arc)) continue;
-                            float f = 1.0f;
-                            if (s.pen->taper > 0.0f && s.stroke_length >= 0.0f) {
-                                const float end = std::min(arc, s.stroke_length - arc);
-                                f = std::clamp(end / s.pen->taper, 0.0f, 1.0f);
-                            }
-                            if (s.pen->depth_reference > 0.0f && s.d0 > 0.0f)
-                                f *= depth_scale(*s.pen, s.d0 + (s.d1 - s.d0) * t);
+                            float f = taper_scale(*s.pen, arc, s.stroke_length);
+                            // d0 is set (positive) only where the pen scales by depth.
+                            if (s.d0 > 0.0f) f *= depth_scale(*s.pen, s.d0 + (s.d1 - s.d0) * t);
                             reach = (s.reach - 0.5f) * f + 0.5f;
                         }
                         const float c = std::min(1.0f, reach - std::sqrt(ex * ex + ey * ey));
@@ -185,6 +182,15 @@ void rasterise(const std::vector<Segment2>& segments, ImageF& coverage, Image<st
     });
 }
 
+// A covered pixel's pen. The style image is drawn with the same pens (draw_styled_strokes), so
+// a style without one is a mistake upstream: drawing another pen instead would hide it.
+const StrokePen& pen_of_pixel(std::span<const StrokePen> pens, std::uint16_t style, int x, int y) {
+    if (style >= pens.size())
+        throw Error(fmt::format("ink: the line pixel ({}, {}) has style {} but there are {} pens",
+                                x, y, style, pens.size()));
+    return pens[style];
+}
+
 std::uint8_t to_byte(float v) {
     return static_cast<std::uint8_t>(std::min(std::max(v, 0.0f), 1.0f) * 255.0f + 0.5f);
 }
@@ -193,6 +199,40 @@ std::uint8_t to_byte(float v) {
 
 float stroke_thickness(float width, int height) {
     return width * static_cast<float>(height) / 720.0f;
+}
+
+StrokePen stroke_pen(const LineStyle& style, int height, float depth_reference) {
+    StrokePen pen{scale_line_style(style, height)};
+    pen.depth_reference = style.by_depth ? depth_reference : 0.0f;
+    return pen;
+}
+
+const StrokePen& pen_of_stroke(std::span<const StrokePen> pens, const Stroke& stroke,
+                               std::size_t index) {
+    if (stroke.style >= pens.size())
+        throw Error(fmt::format("ink: stroke {} has style {} but there are {} pens", index,
+                                stroke.style, pens.size()));
+    return pens[stroke.style];
+}
+
+bool scales_by_depth(const StrokePen& pen, const Stroke& stroke) {
+    return pen.by_depth && pen.depth_reference > 0.0f &&
+           stroke.depth.size() == stroke.points.size();
+}
+
+bool varies_width(const StrokePen& pen, const Stroke& stroke) {
+    return (pen.taper > 0.0f && !stroke.closed) || scales_by_depth(pen, stroke);
+}
+
+float taper_scale(const StrokePen& pen, float arc, float length) {
+    if (!(pen.taper > 0.0f) || length < 0.0f) return 1.0f;
+    const float end = std::min(arc, length - arc);
+    return std::clamp(end / pen.taper, 0.0f, 1.0f);
+}
+
+float depth_scale(const StrokePen& pen, float depth) {
+    return depth > 0.0f ? std::clamp(pen.depth_reference / depth, kMinDepthScale, kMaxDepthScale)
+                        : kMaxDepthScale;
 }
 
 void draw_strokes(std::span<const Stroke> strokes, float thickness, ImageF& coverage, int threads) {
@@ -210,13 +250,12 @@ void draw_styled_strokes(std::span<const Stroke> strokes, std::span<const Stroke
     style.resize(width, height, 0);
     if (width <= 0 || height <= 0) return;
     std::vector<Segment2> segments;
-    for (const Stroke& s : strokes) {
-        if (s.style >= pens.size()) continue;
-        const StrokePen& pen = pens[s.style];
-        if (!pen.draw || !(pen.thickness > 0.0f) || !(pen.opacity > 0.0f)) continue;
-        const bool shaped = !pen.dash.empty() || (pen.taper > 0.0f && !s.closed) ||
-                            (pen.depth_reference > 0.0f && s.depth.size() == s.points.size());
-        add_stroke_segments(s, pen.thickness, s.style, shaped ? &pen : nullptr, width, height,
+    for (std::size_t i = 0; i < strokes.size(); ++i) {
+        const Stroke& s = strokes[i];
+        const StrokePen& pen = pen_of_stroke(pens, s, i);
+        if (!pen.draw || !(pen.width > 0.0f) || !(pen.opacity > 0.0f)) continue;
+        const bool shaped = !pen.dash.empty() || varies_width(pen, s);
+        add_stroke_segments(s, pen.width, s.style, shaped ? &pen : nullptr, width, height,
                             segments);
     }
     rasterise(segments, coverage, &style, threads);
@@ -229,8 +268,8 @@ void composite_styled_lines(const ImageF& coverage, const Image<std::uint16_t>& 
         const std::uint16_t* style = styles.row(y);
         Rgb8* px = image.row(y);
         for (int x = 0; x < image.width(); ++x) {
-            if (!(cov[x] > 0.0f) || style[x] >= pens.size()) continue;
-            const StrokePen& pen = pens[style[x]];
+            if (!(cov[x] > 0.0f)) continue;
+            const StrokePen& pen = pen_of_pixel(pens, style[x], x, y);
             const float a = cov[x] * pen.opacity;
             for (int c = 0; c < 3; ++c)
                 px[x][c] = to_byte(static_cast<float>(px[x][c]) * (1.0f / 255.0f) * (1.0f - a) +
@@ -248,8 +287,7 @@ void opaque_lines(const ImageF& coverage, const Image<std::uint16_t>& styles,
         std::uint8_t* out = opaque.row(y);
         for (int x = 0; x < coverage.width(); ++x)
             // composite_styled_lines's a: with a = 1 the picture's value is multiplied by 0.
-            out[x] =
-                cov[x] > 0.0f && style[x] < pens.size() && cov[x] * pens[style[x]].opacity == 1.0f;
+            out[x] = cov[x] > 0.0f && cov[x] * pen_of_pixel(pens, style[x], x, y).opacity == 1.0f;
     }
 }
 

@@ -7,6 +7,7 @@
 
 #include "toonray/core/image.h"
 #include "toonray/core/math.h"
+#include "toonray/ink/line_style.h"
 #include "toonray/ink/strokes.h"
 
 namespace toonray::ink {
@@ -23,28 +24,54 @@ namespace toonray::ink {
 /// Each segment is rasterised within its own bounding box.
 void draw_strokes(std::span<const Stroke> strokes, float thickness, ImageF& coverage, int threads);
 
-/// How the strokes of one resolved style are drawn (in pixels of this image).
-struct StrokePen {
-    bool draw = true;
-    float thickness = 2.0f;  ///< pixels
-    Vec3f colour{0.0f};
-    float opacity = 1.0f;
-    std::vector<float>
-        dash;  ///< on, off, ... pixels along the stroke (an even count); empty: solid
-    /// Open strokes grow from zero thickness at their ends to full thickness over this many
-    /// pixels along the stroke; 0: no taper.
-    float taper = 0.0f;
-    /// Width by depth: when > 0 (and strokes have Stroke::depth), the thickness at a point at
-    /// distance d from the eye is scaled by clamp(depth_reference / d, 0.25, 2), d interpolated
-    /// linearly along each segment on the image.
+/// How the strokes of one resolved style are drawn: the style in pixels of this image (every
+/// attribute that scales, StyleAttribute::scales, times height / 720: `width` is the
+/// thickness, `dash` and `taper` are pixels along the stroke), plus what the drawing derives
+/// from the scene.
+struct StrokePen : LineStyle {
+    /// Width by depth: when `by_depth` and > 0 (and strokes have Stroke::depth), the thickness
+    /// at a point at distance d from the eye is scaled by clamp(depth_reference / d, 0.25, 2),
+    /// d interpolated linearly along each segment on the image.
     float depth_reference = 0.0f;
 };
 
-/// Draws each stroke with pens[stroke.style] (strokes whose pen does not draw are skipped)
+/// The pen of `style` in an image `height` pixels tall (scale_line_style); `depth_reference`
+/// is kept when the style has width by depth, else 0.
+[[nodiscard]] StrokePen stroke_pen(const LineStyle& style, int height,
+                                   float depth_reference = 0.0f);
+
+/// pens[stroke.style]. The pens are made with the strokes' styles (ink.h, InkLines), so a style
+/// without a pen is a mistake upstream: throws Error naming the stroke (`index`), its style and
+/// the number of pens rather than drawing it with another pen.
+[[nodiscard]] const StrokePen& pen_of_stroke(std::span<const StrokePen> pens, const Stroke& stroke,
+                                             std::size_t index);
+
+/// Whether the pen scales the stroke's width by depth (it asks for it, has a reference and
+/// the stroke has a depth per point).
+[[nodiscard]] bool scales_by_depth(const StrokePen& pen, const Stroke& stroke);
+
+/// Whether the stroke's width varies along it: tapered (and open) or scaled by depth.
+[[nodiscard]] bool varies_width(const StrokePen& pen, const Stroke& stroke);
+
+/// The taper's factor on the thickness at arc length `arc` of a stroke `length` pixels long:
+/// min(1, distance to the nearer end / taper), at least 0; 1 without taper or for a closed
+/// stroke (length < 0).
+[[nodiscard]] float taper_scale(const StrokePen& pen, float arc, float length);
+
+/// Whether arc length `s` along a stroke lies in an "on" dash of the pattern (on, off, ...
+/// lengths, not all 0), which repeats from the stroke's first point.
+[[nodiscard]] bool in_dash(std::span<const float> dash, float s);
+
+/// Width by depth's factor on the thickness at distance `depth` from the eye:
+/// clamp(depth_reference / depth, 0.25, 2); 2 for a depth that is not positive.
+[[nodiscard]] float depth_scale(const StrokePen& pen, float depth);
+
+/// Draws each stroke with pens[stroke.style] (strokes whose pen does not draw are skipped;
+/// a stroke whose style has no pen throws Error, as the styles and pens are made together)
 /// into the line layer `coverage` and `style` (per pixel, the coverage of the stroke that covers
 /// it most and that stroke's style: 4 + 2 bytes a pixel), resized to width x height and cleared
 /// first. Coverage is the rule of
-/// draw_strokes with the pen's thickness; a dashed stroke covers a pixel only from the parts
+/// draw_strokes with the pen's width as thickness; a dashed stroke covers a pixel only from the parts
 /// of its centreline in an "on" dash (arc length from the stroke's first point, modulo the
 /// pattern), and a tapered one with the thickness at the nearest centreline point. Each pixel
 /// keeps the largest coverage and its style, the lower style index on equal coverage: the
@@ -55,12 +82,14 @@ void draw_styled_strokes(std::span<const Stroke> strokes, std::span<const Stroke
                          int threads);
 
 /// image = image * (1 - a) + colour * a with a = coverage * opacity of the pixel's pen, per
-/// channel, rounded as composite_lines. With opacity 1 this is composite_lines exactly.
+/// channel, rounded as composite_lines. With opacity 1 this is composite_lines exactly. A
+/// covered pixel whose style has no pen throws Error.
 void composite_styled_lines(const ImageF& coverage, const Image<std::uint16_t>& style,
                             std::span<const StrokePen> pens, ImageRgb8& image);
 
 /// 1 where composite_styled_lines covers a pixel completely (coverage times the pen's opacity
 /// is exactly 1), so that nothing of the picture under it shows; else 0. Sized like coverage.
+/// A covered pixel whose style has no pen throws Error.
 void opaque_lines(const ImageF& coverage, const Image<std::uint16_t>& style,
                   std::span<const StrokePen> pens, Image<std::uint8_t>& opaque);
 

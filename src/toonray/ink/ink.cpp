@@ -111,17 +111,13 @@ void draw_ink_lines(const Scene& scene, const TriangleAccel& accel, const Camera
 
     start = std::chrono::steady_clock::now();
     out.pens.clear();
-    for (const LineStyle& style : out.styles) {
-        StrokePen pen{style.draw,   stroke_thickness(style.width, height),
-                      style.colour, style.opacity,
-                      style.dash,   stroke_thickness(style.taper, height)};
-        for (float& d : pen.dash) d = stroke_thickness(d, height);
-        if (style.by_depth) {
-            const BBox bounds = scene.bounds();
-            pen.depth_reference = length((bounds.lo + bounds.hi) * 0.5f - plane.eye);
-        }
-        out.pens.push_back(std::move(pen));
+    float depth_reference = 0.0f;
+    if (by_depth) {
+        const BBox bounds = scene.bounds();
+        depth_reference = length((bounds.lo + bounds.hi) * 0.5f - plane.eye);
     }
+    for (const LineStyle& style : out.styles)
+        out.pens.push_back(stroke_pen(style, height, depth_reference));
     if (settings.drawn_types == (1u << kEdgeTypeCount) - 1) {
         draw_styled_strokes(out.strokes, out.pens, width, height, out.coverage, out.style, threads);
     } else {

@@ -2,11 +2,13 @@
 
 #include <fmt/format.h>
 
+#include <array>
 #include <charconv>
 #include <cmath>
 
 #include "toonray/core/error.h"
 #include "toonray/core/parse.h"
+#include "toonray/ink/draw.h"
 
 namespace toonray::ink {
 
@@ -14,6 +16,85 @@ namespace {
 
 /// A dash pattern longer than this is a mistake, not a style.
 constexpr std::size_t kMaxDashes = 16;
+
+constexpr std::string_view kColourAliases[] = {"colour"};
+
+// The table. Its order is LineStyle's, the order in which the SVG writes path attributes and
+// the order of the keys in messages.
+constexpr std::array kAttributes{
+    StyleAttribute{"draw",
+                   {},
+                   StyleValueKind::YesNo,
+                   &LineStyle::draw,
+                   0.0f,
+                   "whether the matched strokes are drawn (hidden lines start with no)",
+                   SvgMapping::LeaveOut,
+                   "",
+                   ""},
+    StyleAttribute{"color", kColourAliases, StyleValueKind::Colour, &LineStyle::colour, 0.0f,
+                   "line colour", SvgMapping::PathAttribute, "stroke", "fill"},
+    StyleAttribute{"width",
+                   {},
+                   StyleValueKind::Length,
+                   &LineStyle::width,
+                   1000.0f,
+                   "line width, like --line-width",
+                   SvgMapping::PathAttribute,
+                   "stroke-width",
+                   ""},
+    StyleAttribute{"opacity",
+                   {},
+                   StyleValueKind::Fraction,
+                   &LineStyle::opacity,
+                   0.0f,
+                   "how much the line hides what is under it",
+                   SvgMapping::PathAttribute,
+                   "stroke-opacity",
+                   "fill-opacity"},
+    StyleAttribute{"dash",
+                   {},
+                   StyleValueKind::Dash,
+                   &LineStyle::dash,
+                   1e4f,
+                   "on,off,... lengths along the stroke from its first point (an odd list "
+                   "repeats, as in SVG), or none",
+                   SvgMapping::PathAttribute,
+                   "stroke-dasharray",
+                   ""},
+    StyleAttribute{"taper",
+                   {},
+                   StyleValueKind::Length,
+                   &LineStyle::taper,
+                   1e4f,
+                   "length over which an open stroke thins to nothing at each end; 0 = none",
+                   SvgMapping::Outline,
+                   "",
+                   ""},
+    StyleAttribute{"width_by_depth",
+                   {},
+                   StyleValueKind::YesNo,
+                   &LineStyle::by_depth,
+                   0.0f,
+                   "lines thinner farther from the eye: width times clamp(D / d, 0.25, 2)",
+                   SvgMapping::Outline,
+                   "",
+                   ""},
+};
+
+// Each row's field holds the type its kind reads (parse_style_value relies on it), and a rule's
+// mask has a bit for each.
+constexpr bool fields_match_kinds() {
+    for (const StyleAttribute& a : kAttributes) {
+        const std::size_t want = a.kind == StyleValueKind::YesNo    ? 0
+                                 : a.kind == StyleValueKind::Colour ? 1
+                                 : a.kind == StyleValueKind::Dash   ? 3
+                                                                    : 2;
+        if (a.field.index() != want) return false;
+    }
+    return true;
+}
+static_assert(fields_match_kinds());
+static_assert(kAttributes.size() <= 32);
 
 std::vector<std::string_view> split(std::string_view text, char separator) {
     std::vector<std::string_view> parts;
@@ -25,72 +106,49 @@ std::vector<std::string_view> split(std::string_view text, char separator) {
     }
 }
 
-struct LineContext {
-    std::string_view source;
-    int line;
-    [[noreturn]] void fail(const std::string& what) const {
-        throw Error(fmt::format("{}:{}: {}", source, line, what));
-    }
-};
-
-float parse_number(std::string_view text, std::string_view key, const LineContext& at) {
+// Value parsers throw Error with what was wrong only; the rule builder adds key and place.
+float parse_number(std::string_view text) {
     float value = 0.0f;
     const auto [p, ec] = std::from_chars(text.data(), text.data() + text.size(), value);
     if (text.empty() || ec != std::errc() || p != text.data() + text.size() ||
         !std::isfinite(value))
-        at.fail(fmt::format("{}: expected a number, got '{}'", key, text));
+        throw Error(fmt::format("expected a number, got '{}'", text));
     return value;
 }
 
-bool parse_yes_no(std::string_view text, std::string_view key, const LineContext& at) {
+bool parse_yes_no(std::string_view text) {
     if (text == "yes") return true;
     if (text == "no") return false;
-    at.fail(fmt::format("{}: expected yes or no, got '{}'", key, text));
+    throw Error(fmt::format("expected yes or no, got '{}'", text));
 }
 
-unsigned parse_types(std::string_view text, const LineContext& at) {
-    if (text == "all") return (1u << kEdgeTypeCount) - 1;
-    unsigned types = 0;
-    for (std::string_view name : split(text, ',')) {
-        int found = -1;
-        for (int t = 0; t < kEdgeTypeCount; ++t)
-            if (name == edge_type_name(static_cast<EdgeType>(t))) found = t;
-        if (found < 0)
-            at.fail(
-                fmt::format("type: unknown line type '{}' (silhouette, border, crease, "
-                            "material, intersection, polyline or all)",
-                            name));
-        types |= 1u << found;
-    }
-    return types;
-}
-
-std::vector<float> parse_dash(std::string_view text, const LineContext& at) {
+std::vector<float> parse_dash(std::string_view text, float max) {
     if (text == "none") return {};
     std::vector<float> dash;
     float total = 0.0f;
     for (std::string_view part : split(text, ',')) {
-        const float v = parse_number(part, "dash", at);
-        if (v < 0.0f || v > 1e4f)
-            at.fail(fmt::format("dash: lengths must be in [0, 10000], got '{}'", part));
+        const float v = parse_number(part);
+        if (v < 0.0f || v > max)
+            throw Error(fmt::format("lengths must be in [0, {}], got '{}'", max, part));
         dash.push_back(v);
         total += v;
     }
     if (dash.size() > kMaxDashes)
-        at.fail(fmt::format("dash: at most {} lengths, got {}", kMaxDashes, dash.size()));
+        throw Error(fmt::format("at most {} lengths, got {}", kMaxDashes, dash.size()));
     if (dash.size() % 2 != 0) dash.insert(dash.end(), dash.begin(), dash.end());  // as SVG does
-    if (!(total > 0.0f)) at.fail("dash: the lengths must not all be 0");
+    if (!(total > 0.0f)) throw Error("the lengths must not all be 0");
     return dash;
 }
 
-std::vector<std::string> parse_globs(std::string_view text, std::string_view key,
-                                     const LineContext& at) {
-    std::vector<std::string> globs;
-    for (std::string_view g : split(text, ',')) {
-        if (g.empty()) at.fail(fmt::format("{}: empty name pattern in '{}'", key, text));
-        globs.emplace_back(g);
-    }
-    return globs;
+std::string format_dash(const std::vector<float>& dash) {
+    if (dash.empty()) return "none";
+    // An odd list was repeated when read (parse_dash); written again whole it could exceed
+    // kMaxDashes, so it is written as read.
+    std::size_t count = dash.size();
+    const std::size_t half = count / 2;
+    if (half % 2 == 1 && std::equal(dash.begin(), dash.begin() + half, dash.begin() + half))
+        count = half;
+    return fmt::format("{}", fmt::join(dash.begin(), dash.begin() + count, ","));
 }
 
 // '#' starts a comment at the start of a line or after a blank, so colours (#808080) are not
@@ -107,11 +165,131 @@ bool any_glob(const std::vector<std::string>& globs, std::string_view name) {
     return false;
 }
 
-LineStyleRule parse_rule(std::string_view body, const LineContext& at) {
-    LineStyleRule rule;
-    rule.line = at.line;
+std::vector<std::string> parse_globs(std::string_view text) {
+    std::vector<std::string> globs;
+    for (std::string_view g : split(text, ',')) {
+        if (g.empty()) throw Error(fmt::format("empty name pattern in '{}'", text));
+        globs.emplace_back(g);
+    }
+    return globs;
+}
+
+std::string format_globs(const std::vector<std::string>& globs) {
+    return globs == std::vector<std::string>{"*"} ? std::string()
+                                                  : fmt::format("{}", fmt::join(globs, ","));
+}
+
+constexpr unsigned kAllTypes = (1u << kEdgeTypeCount) - 1;
+
+unsigned parse_types(std::string_view text) {
+    if (text == "all") return kAllTypes;
+    unsigned types = 0;
+    for (std::string_view name : split(text, ',')) {
+        int found = -1;
+        std::string known;
+        for (int t = 0; t < kEdgeTypeCount; ++t) {
+            const std::string_view type_name = edge_type_name(static_cast<EdgeType>(t));
+            if (name == type_name) found = t;
+            known += fmt::format("{}{}", t ? ", " : "", type_name);
+        }
+        if (found < 0) throw Error(fmt::format("unknown line type '{}' ({} or all)", name, known));
+        types |= 1u << found;
+    }
+    return types;
+}
+
+std::string format_types(unsigned types) {
+    if (types == kAllTypes) return {};
+    std::string out;
+    for (int t = 0; t < kEdgeTypeCount; ++t)
+        if (types & (1u << t))
+            out += fmt::format("{}{}", out.empty() ? "" : ",",
+                               edge_type_name(static_cast<EdgeType>(t)));
+    return out;
+}
+
+// The matchers: how each is read into a rule and written back ("" when it is the default,
+// which matches whatever).
+struct MatcherRow {
+    RuleMatcher info;
+    void (*parse)(std::string_view text, LineStyleRule& rule);
+    std::string (*format)(const LineStyleRule& rule);
+};
+
+constexpr std::array<MatcherRow, 4> kMatchers{{
+    {{"object", "comma-separated globs (* any run, ? one character) on the object name"},
+     [](std::string_view text, LineStyleRule& r) { r.objects = parse_globs(text); },
+     [](const LineStyleRule& r) { return format_globs(r.objects); }},
+    {{"material", "globs on the material name"},
+     [](std::string_view text, LineStyleRule& r) { r.materials = parse_globs(text); },
+     [](const LineStyleRule& r) { return format_globs(r.materials); }},
+    {{"type",
+      "silhouette, border, crease, material, intersection, polyline, comma-separated, or all"},
+     [](std::string_view text, LineStyleRule& r) { r.types = parse_types(text); },
+     [](const LineStyleRule& r) { return format_types(r.types); }},
+    {{"lines", "visible, hidden or all (visible when not given)"},
+     [](std::string_view text, LineStyleRule& r) {
+         if (text != "visible" && text != "hidden" && text != "all")
+             throw Error(fmt::format("expected visible, hidden or all, got '{}'", text));
+         r.match_visible = text != "hidden";
+         r.match_hidden = text != "visible";
+     },
+     [](const LineStyleRule& r) {
+         return std::string(r.match_hidden ? (r.match_visible ? "all" : "hidden") : "");
+     }},
+}};
+
+constexpr std::array<RuleMatcher, 4> kMatcherInfo{kMatchers[0].info, kMatchers[1].info,
+                                                  kMatchers[2].info, kMatchers[3].info};
+
+// A rule built key by key, in the order written, so that the first mistake is the one named.
+class RuleBuilder {
+public:
+    explicit RuleBuilder(const RuleLocation& at) : at_(at) { rule_.line = at.line; }
+
+    void add(std::string_view key, std::string_view value) {
+        for (const std::string& s : seen_)
+            if (s == key) fail(fmt::format("'{}' given twice", key));
+        seen_.emplace_back(key);
+        for (const MatcherRow& m : kMatchers)
+            if (m.info.name == key) return read(key, [&] { m.parse(value, rule_); });
+        for (std::size_t i = 0; i < kAttributes.size(); ++i)
+            if (kAttributes[i].named(key)) {
+                read(key, [&] { parse_style_value(kAttributes[i], value, rule_.values); });
+                rule_.sets |= 1u << i;
+                return;
+            }
+        std::string keys;
+        for (const MatcherRow& m : kMatchers) keys += fmt::format("{}, ", m.info.name);
+        for (const StyleAttribute& a : kAttributes) keys += fmt::format("{}, ", a.name);
+        keys.resize(keys.size() - 2);
+        fail(fmt::format("unknown key '{}' ({})", key, keys));
+    }
+
+    [[noreturn]] void fail(const std::string& what) const {
+        throw Error(fmt::format("{}: {}", at_.where, what));
+    }
+
+    LineStyleRule take() { return std::move(rule_); }
+
+private:
+    template <class Read>
+    void read(std::string_view key, Read&& read_value) {
+        try {
+            read_value();
+        } catch (const Error& e) {
+            throw Error(fmt::format("{}{}{}: {}", at_.where, at_.key_separator, key, e.what()));
+        }
+    }
+
+    const RuleLocation& at_;
+    LineStyleRule rule_;
+    std::vector<std::string> seen_;
+};
+
+LineStyleRule parse_rule(std::string_view body, const RuleLocation& at) {
+    RuleBuilder builder(at);
     bool first = true;
-    std::vector<std::string_view> seen;
     while (!body.empty()) {
         const std::size_t start = body.find_first_not_of(" \t\r");
         if (start == std::string_view::npos) break;
@@ -120,66 +298,130 @@ LineStyleRule parse_rule(std::string_view body, const LineContext& at) {
         const std::string_view word = body.substr(0, end);
         body.remove_prefix(end);
         if (first) {
-            if (word != "match") at.fail(fmt::format("expected 'match', got '{}'", word));
+            if (word != "match") builder.fail(fmt::format("expected 'match', got '{}'", word));
             first = false;
             continue;
         }
         const std::size_t eq = word.find('=');
         if (eq == std::string_view::npos)
-            at.fail(fmt::format("expected key=value, got '{}'", word));
-        const std::string_view key = word.substr(0, eq), value = word.substr(eq + 1);
-        for (std::string_view s : seen)
-            if (s == key) at.fail(fmt::format("'{}' given twice", key));
-        seen.push_back(key);
-        if (key == "object") {
-            rule.objects = parse_globs(value, key, at);
-        } else if (key == "material") {
-            rule.materials = parse_globs(value, key, at);
-        } else if (key == "type") {
-            rule.types = parse_types(value, at);
-        } else if (key == "lines") {
-            if (value != "visible" && value != "hidden" && value != "all")
-                at.fail(fmt::format("lines: expected visible, hidden or all, got '{}'", value));
-            rule.match_visible = value != "hidden";
-            rule.match_hidden = value != "visible";
-        } else if (key == "draw") {
-            rule.draw = parse_yes_no(value, key, at);
-        } else if (key == "width_by_depth") {
-            rule.by_depth = parse_yes_no(value, key, at);
-        } else if (key == "color" || key == "colour") {
-            try {
-                rule.colour = parse_colour(value, key);
-            } catch (const Error& e) {
-                at.fail(e.what());
-            }
-        } else if (key == "width") {
-            const float w = parse_number(value, key, at);
-            if (w < 0.0f || w > 1000.0f)
-                at.fail(fmt::format("width: expected pixels in [0, 1000], got '{}'", value));
-            rule.width = w;
-        } else if (key == "taper") {
-            const float t = parse_number(value, key, at);
-            if (t < 0.0f || t > 1e4f)
-                at.fail(fmt::format("taper: expected pixels in [0, 10000], got '{}'", value));
-            rule.taper = t;
-        } else if (key == "opacity") {
-            const float o = parse_number(value, key, at);
-            if (o < 0.0f || o > 1.0f)
-                at.fail(fmt::format("opacity: expected a value in [0, 1], got '{}'", value));
-            rule.opacity = o;
-        } else if (key == "dash") {
-            rule.dash = parse_dash(value, at);
-        } else {
-            at.fail(
-                fmt::format("unknown key '{}' (object, material, type, lines, draw, color, "
-                            "width, opacity, dash, taper, width_by_depth)",
-                            key));
-        }
+            builder.fail(fmt::format("expected key=value, got '{}'", word));
+        builder.add(word.substr(0, eq), word.substr(eq + 1));
     }
-    return rule;
+    return builder.take();
 }
 
 }  // namespace
+
+bool StyleAttribute::named(std::string_view key) const {
+    if (key == name) return true;
+    for (std::string_view alias : aliases)
+        if (key == alias) return true;
+    return false;
+}
+
+std::span<const StyleAttribute> style_attributes() { return kAttributes; }
+
+std::span<const RuleMatcher> rule_matchers() { return kMatcherInfo; }
+
+std::vector<std::string_view> line_rule_keys() {
+    std::vector<std::string_view> keys;
+    for (const MatcherRow& m : kMatchers) keys.push_back(m.info.name);
+    for (const StyleAttribute& a : kAttributes) {
+        keys.push_back(a.name);
+        keys.insert(keys.end(), a.aliases.begin(), a.aliases.end());
+    }
+    return keys;
+}
+
+void parse_style_value(const StyleAttribute& a, std::string_view text, LineStyle& style) {
+    switch (a.kind) {
+        case StyleValueKind::YesNo:
+            style.*std::get<bool LineStyle::*>(a.field) = parse_yes_no(text);
+            return;
+        case StyleValueKind::Colour:
+            try {
+                style.*std::get<Vec3f LineStyle::*>(a.field) = parse_colour(text, a.name);
+            } catch (const Error& e) {
+                // parse_colour names the option it was given; the rule builder names the key.
+                std::string_view what = e.what();
+                what.remove_prefix(std::min(what.size(), a.name.size() + 2));
+                throw Error(std::string(what));
+            }
+            return;
+        case StyleValueKind::Length: {
+            const float v = parse_number(text);
+            if (v < 0.0f || v > a.max)
+                throw Error(fmt::format("expected pixels in [0, {}], got '{}'", a.max, text));
+            style.*std::get<float LineStyle::*>(a.field) = v;
+            return;
+        }
+        case StyleValueKind::Fraction: {
+            const float v = parse_number(text);
+            if (v < 0.0f || v > 1.0f)
+                throw Error(fmt::format("expected a value in [0, 1], got '{}'", text));
+            style.*std::get<float LineStyle::*>(a.field) = v;
+            return;
+        }
+        case StyleValueKind::Dash:
+            style.*std::get<std::vector<float> LineStyle::*>(a.field) = parse_dash(text, a.max);
+            return;
+    }
+}
+
+std::string format_style_value(const StyleAttribute& a, const LineStyle& style) {
+    switch (a.kind) {
+        case StyleValueKind::YesNo:
+            return style.*std::get<bool LineStyle::*>(a.field) ? "yes" : "no";
+        case StyleValueKind::Colour:
+            return format_colour(style.*std::get<Vec3f LineStyle::*>(a.field));
+        case StyleValueKind::Length:
+        case StyleValueKind::Fraction:
+            // The shortest text that reads back to the same float.
+            return fmt::format("{}", style.*std::get<float LineStyle::*>(a.field));
+        case StyleValueKind::Dash:
+            return format_dash(style.*std::get<std::vector<float> LineStyle::*>(a.field));
+    }
+    return {};
+}
+
+LineStyle scale_line_style(const LineStyle& style, int height) {
+    LineStyle out = style;
+    for (const StyleAttribute& a : kAttributes) {
+        if (a.kind == StyleValueKind::Length) {
+            float& v = out.*std::get<float LineStyle::*>(a.field);
+            v = stroke_thickness(v, height);
+        } else if (a.kind == StyleValueKind::Dash) {
+            for (float& v : out.*std::get<std::vector<float> LineStyle::*>(a.field))
+                v = stroke_thickness(v, height);
+        }
+    }
+    return out;
+}
+
+bool LineStyleRule::sets_field(const StyleField& field) const {
+    for (std::size_t i = 0; i < kAttributes.size(); ++i)
+        if (kAttributes[i].field == field) return (sets >> i & 1u) != 0;
+    return false;
+}
+
+LineStyleRule make_line_style_rule(std::span<const RuleEntry> entries, const RuleLocation& at) {
+    RuleBuilder builder(at);
+    for (const auto& [key, value] : entries) builder.add(key, value);
+    return builder.take();
+}
+
+std::vector<RuleEntry> line_style_rule_entries(const LineStyleRule& rule) {
+    std::vector<RuleEntry> entries;
+    for (const MatcherRow& m : kMatchers) {
+        std::string text = m.format(rule);
+        if (!text.empty()) entries.emplace_back(m.info.name, std::move(text));
+    }
+    for (std::size_t i = 0; i < kAttributes.size(); ++i)
+        if (rule.sets >> i & 1u)
+            entries.emplace_back(kAttributes[i].name,
+                                 format_style_value(kAttributes[i], rule.values));
+    return entries;
+}
 
 bool glob_match(std::string_view pattern, std::string_view name) {
     // Iterative match with one backtrack point: linear in practice, never exponential.
@@ -207,8 +449,9 @@ LineStyleSet parse_line_styles(std::string_view text, std::string_view source) {
     int line = 0;
     for (std::string_view row : split(text, '\n')) {
         ++line;
-        const LineContext at{source, line};
-        if (row.find('\0') != std::string_view::npos) at.fail("NUL byte in the line");
+        const RuleLocation at{fmt::format("{}:{}", source, line), ": ", line};
+        if (row.find('\0') != std::string_view::npos)
+            throw Error(fmt::format("{}: NUL byte in the line", at.where));
         row = row.substr(0, comment_start(row));
         if (row.find_first_not_of(" \t\r") == std::string_view::npos) continue;
         set.rules.push_back(parse_rule(row, at));
@@ -225,13 +468,10 @@ LineStyle resolve_line_style(const LineStyleSet& set, const LineStyle& base,
         if (!(visible ? rule.match_visible : rule.match_hidden)) continue;
         if ((rule.types & (1u << static_cast<unsigned>(type))) == 0) continue;
         if (!any_glob(rule.objects, object) || !any_glob(rule.materials, material)) continue;
-        if (rule.draw) style.draw = *rule.draw;
-        if (rule.colour) style.colour = *rule.colour;
-        if (rule.width) style.width = *rule.width;
-        if (rule.opacity) style.opacity = *rule.opacity;
-        if (rule.dash) style.dash = *rule.dash;
-        if (rule.taper) style.taper = *rule.taper;
-        if (rule.by_depth) style.by_depth = *rule.by_depth;
+        for (std::size_t i = 0; i < kAttributes.size(); ++i)
+            if (rule.sets >> i & 1u)
+                std::visit([&](auto field) { style.*field = rule.values.*field; },
+                           kAttributes[i].field);
     }
     return style;
 }

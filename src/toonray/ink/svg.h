@@ -18,10 +18,15 @@ struct SvgSettings {
     bool hidden = false;  ///< write hidden strokes too (in group "hidden")
     Vec3f hidden_colour{0.5f};
     float hidden_thickness_scale = 0.5f;
-    /// The frame's pens (InkLines::pens), indexed by Stroke::style. A path whose pen differs
-    /// from its group's defaults carries its own stroke, stroke-width, stroke-opacity and
-    /// stroke-dasharray; visible strokes whose pen does not draw are left out, hidden ones
-    /// whose pen does not draw keep the hidden layer's defaults. Empty: group defaults only.
+    /// The frame's pens (InkLines::pens), indexed by Stroke::style; a stroke whose style has
+    /// no pen throws Error (draw.h, pen_of_stroke). A path whose pen differs from its group's
+    /// defaults carries its own stroke, stroke-width, stroke-opacity and stroke-dasharray (the
+    /// table's svg_stroke attributes, line_style.h); visible strokes whose pen does not draw
+    /// are left out, hidden ones whose pen does not draw keep the hidden layer's defaults.
+    /// A stroke whose width varies (taper, width by depth: draw.h, varies_width) is written as
+    /// its filled outline instead: `stroke="none"`, `fill` and `fill-opacity`, and path data
+    /// of shapes whose union is what the drawing covers by more than half, dashes cut out
+    /// (svg.cpp, outline_data). Empty: group defaults only.
     std::span<const StrokePen> pens;
     /// When not empty, an `<image id="fill">` of the whole view under the lines with this
     /// href (a data: URI of the cel-shaded picture).
@@ -33,8 +38,9 @@ struct SvgSettings {
 
 /// The SVG text: a `<g id="visible">` with one subgroup per line type (`visible-silhouette`,
 /// `visible-border`, `visible-crease`, `visible-material`, `visible-intersection`), each
-/// stroke a `<path>` in pixel units with round caps and joins; with hidden lines, a
-/// `<g id="hidden">` with `hidden-...` subgroups after it. Coordinates have three decimals.
+/// stroke a `<path>` in pixel units with round caps and joins (or a filled outline, above); with
+/// hidden lines, a `<g id="hidden">` with `hidden-...` subgroups after it. Coordinates have three
+/// decimals.
 [[nodiscard]] std::string svg_text(std::span<const Stroke> strokes, const SvgSettings& settings);
 
 }  // namespace toonray::ink
