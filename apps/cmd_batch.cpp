@@ -17,7 +17,7 @@ struct BatchArgs {
     std::string pattern, output_pattern, shard;
     int jobs = 0;
     bool resume = false, fail_fast = false, quiet = false;
-    RenderArgs render;
+    SettingsArgs render;
     GltfArgs gltf;
     SvgArgs svg;
 
@@ -62,9 +62,10 @@ int run_batch(const BatchArgs& args, const CLI::App& command) {
     options.output_dir = args.output;
     if (!args.pattern.empty()) options.input_pattern = args.pattern;
     if (!args.output_pattern.empty()) options.output_pattern = args.output_pattern;
-    options.render = args.render.resolve();
-    options.scene = args.render.scene_setup();
-    args.svg.apply(options.render, true);
+    const Settings settings = args.render.apply();
+    options.render = args.render.frame_options(settings);
+    options.scene = settings.scene_setup();
+    args.svg.apply(options.render, true, args.render);
     options.jobs = args.jobs;
     options.resume = args.resume;
     options.fail_fast = args.fail_fast;
@@ -87,7 +88,7 @@ int run_batch(const BatchArgs& args, const CLI::App& command) {
 
 }  // namespace
 
-Subcommand add_batch_command(CLI::App& app, LimitArgs& limit_args) {
+Subcommand add_batch_command(CLI::App& app) {
     auto args = std::make_shared<BatchArgs>();
     CLI::App* batch = app.add_subcommand(
         "batch",
@@ -96,7 +97,6 @@ Subcommand add_batch_command(CLI::App& app, LimitArgs& limit_args) {
     args->render.add_to(*batch);
     args->gltf.add_to(*batch, false);
     args->svg.add_to(*batch, true);
-    limit_args.add_to(*batch);
     return {batch, [args, batch] { return run_batch(*args, *batch); }};
 }
 

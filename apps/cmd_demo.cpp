@@ -35,7 +35,7 @@ private:
 
 struct DemoArgs {
     PianoArgs piano;
-    RenderArgs render;
+    SettingsArgs render;
     SvgArgs svg;
     std::string output = "out";
     bool full = false;
@@ -50,9 +50,10 @@ int run_demo(const DemoArgs& args, const CLI::App& command) {
     options.output_dir = args.output;
     options.seconds = args.full ? std::optional<double>() : std::optional<double>(piano.seconds);
     options.soundfont = piano.soundfont;
-    options.movie.render = args.render.resolve();
-    options.movie.scene = args.render.scene_setup();
-    args.svg.apply(options.movie.render, true);
+    const Settings settings = args.render.apply();
+    options.movie.render = args.render.frame_options(settings);
+    options.movie.scene = settings.scene_setup();
+    args.svg.apply(options.movie.render, true, args.render);
     options.movie.start = piano.start;
     options.movie.fps = piano.fps;
     options.movie.jobs = piano.jobs;
@@ -80,7 +81,7 @@ int run_demo(const DemoArgs& args, const CLI::App& command) {
 
 }  // namespace
 
-Subcommand add_demo_command(CLI::App& app, LimitArgs& limit_args) {
+Subcommand add_demo_command(CLI::App& app) {
     auto args = std::make_shared<DemoArgs>();
     PianoArgs& demo_args = args->piano;
     demo_args.seconds = 30.0;
@@ -98,7 +99,6 @@ Subcommand add_demo_command(CLI::App& app, LimitArgs& limit_args) {
     demo_args.add_common(*demo);
     args->render.add_to(*demo);
     args->svg.add_to(*demo, true);
-    limit_args.add_to(*demo);
     return {demo, [args, demo] { return run_demo(*args, *demo); }};
 }
 

@@ -16,7 +16,7 @@ namespace {
 
 struct PianoCommandArgs {
     PianoArgs piano;
-    RenderArgs render;
+    SettingsArgs render;
     SvgArgs svg;
     std::string output;
 };
@@ -55,9 +55,10 @@ int run_piano(const PianoCommandArgs& args, const CLI::App& command) {
     options.output_dir = args.output;
     if (!piano.export_obj.empty()) options.export_obj_dir = piano.export_obj;
     if (piano.seconds > 0) options.seconds = piano.seconds;
-    options.render = args.render.resolve();
-    options.scene = args.render.scene_setup();
-    args.svg.apply(options.render, true);
+    const Settings settings = args.render.apply();
+    options.render = args.render.frame_options(settings);
+    options.scene = settings.scene_setup();
+    args.svg.apply(options.render, true, args.render);
     std::optional<AudioOptions> audio_opts;  // checked before the frames are rendered
     if (!piano.audio.empty()) audio_opts = audio_options(score, piano, options.seconds);
     PianoMovieReport report = run_piano_movie(score, piano, options, command);
@@ -73,7 +74,7 @@ int run_piano(const PianoCommandArgs& args, const CLI::App& command) {
 
 }  // namespace
 
-Subcommand add_piano_command(CLI::App& app, LimitArgs& limit_args) {
+Subcommand add_piano_command(CLI::App& app) {
     auto args = std::make_shared<PianoCommandArgs>();
     PianoArgs& piano_args = args->piano;
     CLI::App* piano = app.add_subcommand(
@@ -96,7 +97,6 @@ Subcommand add_piano_command(CLI::App& app, LimitArgs& limit_args) {
     piano_args.add_common(*piano);
     args->render.add_to(*piano);
     args->svg.add_to(*piano, true);
-    limit_args.add_to(*piano);
     return {piano, [args, piano] { return run_piano(*args, *piano); }};
 }
 

@@ -16,7 +16,7 @@ namespace toonray::cli {
 namespace {
 
 struct RenderCommandArgs {
-    RenderArgs render;
+    SettingsArgs render;
     std::string input, output;
     SvgArgs svg;
     GltfArgs gltf;
@@ -36,9 +36,10 @@ void load_gltf_frame(const RenderCommandArgs& args, const SceneSetup& setup, Sce
 }
 
 int run_render(const RenderCommandArgs& args) {
-    FrameOptions options = args.render.resolve();
-    args.svg.apply(options, false);
-    const SceneSetup setup = args.render.scene_setup();
+    const Settings settings = args.render.apply();
+    FrameOptions options = args.render.frame_options(settings);
+    args.svg.apply(options, false, args.render);
+    const SceneSetup setup = settings.scene_setup();
     {  // The frame buffers come first: the loader counts them in its memory estimate.
         Limits l = limits();
         l.reserved_memory = plan_frame_jobs(options, 1, 1).frame_bytes;
@@ -61,7 +62,7 @@ int run_render(const RenderCommandArgs& args) {
 
 }  // namespace
 
-Subcommand add_render_command(CLI::App& app, LimitArgs& limit_args) {
+Subcommand add_render_command(CLI::App& app) {
     auto args = std::make_shared<RenderCommandArgs>();
     CLI::App* render = app.add_subcommand("render", "Render one OBJ or glTF scene to a PNG image");
     render
@@ -73,7 +74,6 @@ Subcommand add_render_command(CLI::App& app, LimitArgs& limit_args) {
     args->render.add_to(*render);
     args->svg.add_to(*render, false);
     args->gltf.add_to(*render, true);
-    limit_args.add_to(*render);
     return {render, [args] { return run_render(*args); }};
 }
 

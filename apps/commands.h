@@ -15,12 +15,14 @@ struct Subcommand {
     std::function<int()> run;
 };
 
-// Each adds its subcommand to `app`; `limit_args` is one set, shared by the commands that read inputs.
-Subcommand add_render_command(CLI::App& app, LimitArgs& limit_args);
-Subcommand add_batch_command(CLI::App& app, LimitArgs& limit_args);
+// Each adds its subcommand to `app`. The commands that render take their limits with their
+// settings (SettingsArgs); `score` reads inputs only and takes `limit_args`.
+Subcommand add_render_command(CLI::App& app);
+Subcommand add_batch_command(CLI::App& app);
 Subcommand add_encode_command(CLI::App& app);
 Subcommand add_score_command(CLI::App& app, LimitArgs& limit_args);
-Subcommand add_piano_command(CLI::App& app, LimitArgs& limit_args);
-Subcommand add_demo_command(CLI::App& app, LimitArgs& limit_args);
+Subcommand add_piano_command(CLI::App& app);
+Subcommand add_demo_command(CLI::App& app);
+Subcommand add_settings_command(CLI::App& app);
 
 }  // namespace toonray::cli

@@ -9,6 +9,7 @@
 #include "commands.h"
 #include "hints.h"
 #include "toonray/core/error.h"
+#include "toonray/frame/settings.h"
 
 namespace {
 
@@ -28,16 +29,14 @@ int run(const Subcommand& command) {
 int main(int argc, char** argv) {
     CLI::App app{"toonray: a toon ray tracer. OBJ/MTL scenes in, cel-shaded and outlined PNG out."};
     app.require_subcommand(1);
-    app.set_version_flag("--version", "toonray 0.1.0");
+    app.set_version_flag("--version", "toonray " + std::string(toonray::toonray_version()));
 
     LimitArgs limit_args;
     const Subcommand commands[] = {
-        add_render_command(app, limit_args),
-        add_batch_command(app, limit_args),
-        add_encode_command(app),
-        add_score_command(app, limit_args),
-        add_piano_command(app, limit_args),
-        add_demo_command(app, limit_args),
+        add_render_command(app),   add_batch_command(app),
+        add_encode_command(app),   add_score_command(app, limit_args),
+        add_piano_command(app),    add_demo_command(app),
+        add_settings_command(app),
     };
 
     try {

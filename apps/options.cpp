@@ -16,186 +16,135 @@
 
 namespace toonray::cli {
 
-void RenderArgs::add_to(CLI::App& app) {
-    app.add_option("--size", size, "Image size WIDTHxHEIGHT")->capture_default_str();
-    app.add_option(
-        "--light", lights,
-        "A light, repeatable: x,y,z or point:x,y,z (a point light), dir:x,y,z (a directional "
-        "light shining along the vector), each with an optional @intensity (default: one "
-        "point light at the eye moved by half the scene radius along the camera's up and right)");
-    app.add_option(
-           "--lights", lights_file,
-           "File of lights, one per line: point x y z [intensity] | directional x y z [intensity]")
+std::string limit_help(std::string_view flag) {
+    const Limits d;
+    if (flag == "--max-triangles")
+        return fmt::format("Largest scene, in triangles (default {}; k, M, G suffixes)",
+                           d.max_triangles);
+    if (flag == "--max-vertices")
+        return fmt::format("Most OBJ v, vn and vt statements, each (default {})", d.max_vertices);
+    if (flag == "--max-image-pixels")
+        return fmt::format("Largest image, width x height (default {} = 8192x8192)",
+                           d.max_image_pixels);
+    if (flag == "--max-memory")
+        return "Memory the estimate of a run may reach (frame buffers and scenes of all frames in "
+               "flight), e.g. 4G (default: 3/4 of physical memory)";
+    return fmt::format("Largest input file: OBJ, MTL, score, camera path (default {})",
+                       format_bytes(d.max_input_bytes));
+}
+
+namespace {
+
+// A default value as the help shows it.
+std::string default_text(const SettingValue& value) {
+    return std::visit(
+        [](const auto& v) -> std::string {
+            using T = std::decay_t<decltype(v)>;
+            if constexpr (std::is_same_v<T, std::string>) return v;
+            else if constexpr (std::is_same_v<T, std::vector<std::string>>) return "";
+            else if constexpr (std::is_same_v<T, double>)
+                return format_number(static_cast<float>(v));
+            else return fmt::format("{}", v);
+        },
+        value);
+}
+
+}  // namespace
+
+void SettingsArgs::add_to(CLI::App& app) {
+    app.add_option("--settings", settings_file_,
+                   "A settings document (TOML, docs/settings.md: `toonray settings` prints one); "
+                   "options given on the command line override its keys")
+        ->check(CLI::ExistingFile);
+    const Settings defaults;
+    for (const Setting& setting : settings_table()) {
+        if (setting.flag.empty()) continue;
+        Entry& e = entries_.emplace_back();
+        e.setting = &setting;
+        const std::string flag(setting.flag), help(setting.help);
+        switch (setting.form) {
+            case SettingForm::Option: e.option = app.add_option(flag, e.text, help); break;
+            case SettingForm::Repeated: e.option = app.add_option(flag, e.list, help); break;
+            case SettingForm::Flag:
+            case SettingForm::NegatedFlag: e.option = app.add_flag(flag, e.flag, help); break;
+        }
+        if (setting.key.starts_with("limits.")) {
+            e.option->description(limit_help(flag));
+            e.option->group("Limits");
+        } else if (setting.form == SettingForm::Option) {
+            if (const auto value = setting.get(defaults))
+                e.option->default_str(default_text(*value));
+        }
+    }
+    lights_file_option_ =
+        app.add_option("--lights", lights_file_,
+                       "File of lights, one per line: point x y z [intensity] | directional x y z "
+                       "[intensity]; with --light, both")
+            ->check(CLI::ExistingFile);
+    app.add_option("--line-style", line_style_,
+                   "Line sets and styles file (docs/ink.md): rules matching objects, materials, "
+                   "line types and visible/hidden lines, setting draw, color, width, opacity, "
+                   "dash, taper and width_by_depth; replaces the settings' rules")
         ->check(CLI::ExistingFile);
     app.add_option(
-        "--ramp", ramp,
-        "Toon bands LEVELS@THRESHOLDS, e.g. 0.5,0.75,1.0@0.25,0.5 (the seed's ramp, the default): "
-        "diffuse light below the first threshold gives the first level, and so on");
-    app.add_flag("--shadows", shadows,
-                 "Toon shadows: lights blocked by geometry do not light a point");
-    app.add_flag("--specular", specular,
-                 "A hard-edged highlight band from the material's Ks and Ns");
-    app.add_option("--rim", rim,
-                   "Rim band width in [0,1) (0 = off): brightens surfaces seen edge-on")
-        ->check(CLI::Range(0.0f, 0.99f))
-        ->capture_default_str();
-    app.add_flag("--no-textures", no_textures, "Ignore map_Kd textures");
-    app.add_option("--auto-smooth", auto_smooth,
-                   "Smooth normals for meshes without vertex normals: faces meeting at less than "
-                   "ANGLE degrees shade as one smooth surface, sharper edges stay creases "
-                   "(as Blender's auto-smooth; default off)")
-        ->check(CLI::Range(0.0f, 180.0f));
-    app.add_option("--camera", camera,
-                   "Camera ex,ey,ez,gx,gy,gz,ux,uy,uz: eye, gaze point, up; overrides the "
-                   "file's camera block (default: the block, else a camera framing the scene)");
-    app.add_option("--background", background, "Background colour r,g,b in [0,1] or #rrggbb")
-        ->capture_default_str();
-    app.add_option(
-           "--edges", edges,
-           "Line mode: ink (lines found on the geometry, with ray-traced visibility, drawn as "
-           "exact strokes; render --svg writes them), robust (supersampled, plane-aware lines "
-           "found between samples) or classic (the seed's Sobel pipeline, exactly)")
-        ->check(CLI::IsMember({"robust", "classic", "ink"}))
-        ->capture_default_str();
-    app.add_option(
-           "--lines", lines,
-           "Robust: line types to draw, from silhouette,crease,depth,object,material (or all, none)")
-        ->capture_default_str();
-    app.add_option(
-           "--crease-angle", crease_angle,
-           "Robust: angle in degrees between neighbouring surfaces above which a crease is drawn")
-        ->check(CLI::Range(0.0f, 180.0f))
-        ->capture_default_str();
-    app.add_option(
-           "--depth-step", depth_step,
-           "Robust: relative jump in depth (second difference of 1/z over 1/z) that makes a depth line")
-        ->check(CLI::PositiveNumber)
-        ->capture_default_str();
-    app.add_option("--line-width", line_width,
-                   "Robust: line width in pixels at 720 lines; scales with the image height")
-        ->check(CLI::Range(0.0f, 100.0f))
-        ->capture_default_str();
-    app.add_option("--line-color", line_colour, "Robust: line colour r,g,b in [0,1] or #rrggbb")
-        ->capture_default_str();
-    app.add_option("--samples", samples,
-                   "Robust and ink: samples per pixel on a regular grid (1, 4, 9 or 16); lines and "
-                   "colours are filtered down from it")
-        ->check(CLI::IsMember({1, 4, 9, 16}))
-        ->capture_default_str();
-    app.add_option("--adaptive", adaptive,
-                   "Robust and ink: on traces one sample per pixel and the rest of the grid only "
-                   "where neighbours differ (colour, and for robust lines ids, normals, depth "
-                   "steps); off traces every sample of every pixel (full supersampling)")
-        ->check(CLI::IsMember({"on", "off"}))
-        ->capture_default_str();
-    app.add_option("--tile-size", tile_size,
-                   "Robust and ink: pixels per side of the buckets a frame is rendered in; "
-                   "memory follows the bucket, and the image is the same for any size")
-        ->check(CLI::Range(1, 4096))
-        ->capture_default_str();
-    app.add_option(
-           "--depth-threshold", depth_threshold,
-           "Classic mode: Sobel magnitude on the 8-bit depth map above which a pixel is a line")
-        ->capture_default_str();
-    app.add_option(
-           "--normal-threshold", normal_threshold,
-           "Classic mode: Sobel magnitude on the 8-bit normal map above which a pixel is a line")
-        ->capture_default_str();
-    app.add_option(
-        "--aov", aov_dir,
+        "--aov", aov_dir_,
         "Also write feature images to this directory, named after the output: "
         "NAME_depth, _normal, _edges, _cel .png, and per mode: classic _edges_depth, "
         "_edges_normal; robust _lines_silhouette, _lines_crease, _lines_depth, _lines_object, "
         "_lines_material, _object_id, _material_id, _samples; ink _lines_silhouette, "
         "_lines_crease, _lines_material, _lines_border, _lines_intersection, _lines_polyline, "
         "_object_id, _material_id, _samples");
-    app.add_option("--aov-exr", aov_exr,
-                   "Also write the feature images as one multi-layer OpenEXR (docs/exr.md): "
+    app.add_option("--aov-exr", aov_exr_,
+                   "Also write the frame's layers as one multi-layer OpenEXR (docs/exr.md): "
                    "render: this .exr file; batch, piano, demo: a directory, one NAME.exr a frame");
-    app.add_option("--threads", threads, "Threads to use (0 = all)")
-        ->check(CLI::Range(0, 1024))
-        ->capture_default_str();
-    app.add_option("--bvh-leaf-size", leaf_size, "Largest number of triangles in a BVH leaf")
-        ->check(CLI::Range(1, 64))
-        ->capture_default_str();
-    app.add_option("--png-level", png_level, "PNG compression level, 1 (fast) to 12 (small)")
-        ->check(CLI::Range(1, 12))
-        ->capture_default_str();
-    add_ink_style_options(app);
 }
 
-void RenderArgs::add_ink_style_options(CLI::App& app) {
-    app.add_option("--line-style", line_style,
-                   "Ink: line sets and styles file (docs/ink.md): rules matching objects, "
-                   "materials, line types and visible/hidden lines, setting draw, color, width, "
-                   "opacity, dash and taper")
-        ->check(CLI::ExistingFile);
-    app.add_option("--line-taper", line_taper,
-                   "Ink: open strokes thin to nothing at their ends over this many pixels at 720 "
-                   "lines (0 = off); a style's taper overrides it")
-        ->check(CLI::Range(0.0f, 1000.0f))
-        ->capture_default_str();
-    app.add_flag("--line-width-by-depth", line_width_by_depth,
-                 "Ink: lines thinner farther away: full width at the distance of the scene's "
-                 "centre, scaled by it over the line's distance, within 0.25x-2x");
-}
-
-void RenderArgs::resolve_ink_style(FrameOptions& options) const {
-    options.settings.lines.ink.taper = line_taper;
-    options.settings.lines.ink.width_by_depth = line_width_by_depth;
-    if (!line_style.empty())
-        options.settings.lines.ink.styles =
-            ink::parse_line_styles(read_file(line_style), line_style);
-}
-
-FrameOptions RenderArgs::resolve() const {
-    FrameOptions o;
-    ImageSize s = parse_image_size(size, "--size");
-    o.settings.width = s.width;
-    o.settings.height = s.height;
-    if (!ramp.empty())
-        o.settings.shading.ramp = with_flag("--ramp", [&] { return parse_ramp(ramp); });
-    o.settings.shading.shadows = shadows;
-    o.settings.shading.specular = specular;
-    o.settings.shading.rim = rim;
-    o.settings.shading.textures = !no_textures;
-    o.settings.background = parse_colour(background, "--background");
-    o.settings.lines.mode = parse_line_mode(edges, "--edges");
-    o.settings.lines.types = with_flag("--lines", [&] { return parse_line_types(lines); });
-    o.settings.lines.crease_angle = crease_angle;
-    o.settings.lines.robust.depth_step = depth_step;
-    o.settings.lines.width = line_width;
-    o.settings.lines.colour = parse_colour(line_colour, "--line-color");
-    o.settings.sampling.samples = samples;
-    o.settings.sampling.adaptive = adaptive == "on";
-    o.settings.sampling.tile_size = tile_size;
-    o.settings.lines.classic.depth_threshold = depth_threshold;
-    o.settings.lines.classic.normal_threshold = normal_threshold;
-    o.settings.threads = threads;
-    o.bvh.max_leaf_size = leaf_size;
-    o.png.level = png_level;
-    if (!aov_dir.empty()) o.aov_dir = aov_dir;
-    if (!aov_exr.empty()) o.aov_exr = aov_exr;
-    resolve_ink_style(o);
-    with_flag("--lines", [&] { check_line_settings(o.settings.lines); });
-    return o;
-}
-
-SceneSetup RenderArgs::scene_setup() const {
-    SceneSetup setup;
-    const ImageSize s = parse_image_size(size, "--size");
-    setup.width = s.width;
-    setup.height = s.height;
-    if (auto_smooth >= 0.0f) setup.auto_smooth = auto_smooth;
-    for (const std::string& l : lights)
-        setup.lights.push_back(with_flag("--light", [&] { return parse_light(l); }));
-    if (!lights_file.empty()) {
-        auto from_file = load_lights(lights_file);
-        setup.lights.insert(setup.lights.end(), from_file.begin(), from_file.end());
+Settings SettingsArgs::settings() const {
+    Settings settings;
+    if (!settings_file_.empty()) load_settings(settings_file_, settings);
+    for (const Entry& e : entries_) {
+        if (e.option->count() == 0) continue;
+        SettingValue value;
+        switch (e.setting->form) {
+            case SettingForm::Option: value = e.text; break;
+            case SettingForm::Repeated: value = e.list; break;
+            case SettingForm::Flag: value = e.flag; break;
+            case SettingForm::NegatedFlag: value = !e.flag; break;
+        }
+        const std::string flag(e.setting->flag.substr(0, e.setting->flag.find(',')));
+        with_flag(flag, [&] {
+            try {
+                e.setting->set(settings, value);
+            } catch (const Error& error) {
+                throw Error(fmt::format("{}: {}", flag, error.what()));
+            }
+        });
     }
-    if (!camera.empty())
-        setup.camera = with_flag("--camera", [&] { return parse_camera_spec(camera); });
-    return setup;
+    if (!lights_file_.empty()) {
+        // With --light both, else the file's lights replace the settings'.
+        if (!given("scene.lights")) settings.scene.lights.clear();
+        const std::vector<Light> from_file = load_lights(lights_file_);
+        settings.scene.lights.insert(settings.scene.lights.end(), from_file.begin(),
+                                     from_file.end());
+    }
+    if (!line_style_.empty())
+        settings.render.lines.ink.styles =
+            ink::parse_line_styles(read_file(line_style_), line_style_);
+    with_flag("--lines", [&] { check_settings(settings); });
+    return settings;
+}
+
+Settings SettingsArgs::apply() const {
+    Settings s = settings();
+    set_limits(s.applied_limits(limits()));
+    return s;
+}
+
+FrameOptions SettingsArgs::frame_options(const Settings& settings) const {
+    FrameOptions o = settings.frame_options();
+    if (!aov_dir_.empty()) o.aov_dir = aov_dir_;
+    if (!aov_exr_.empty()) o.aov_exr = aov_exr_;
+    return o;
 }
 
 void SvgArgs::add_to(CLI::App& app, bool per_frame) {
@@ -206,47 +155,31 @@ void SvgArgs::add_to(CLI::App& app, bool per_frame) {
                        : "Also write the ink lines as SVG paths in pixel units, grouped by type "
                          "(silhouette, border, crease, material, intersection), in any --edges "
                          "mode");
-    app.add_flag("--hidden-lines,--svg-hidden", hidden,
-                 "With --svg: also write the hidden lines, in a layer of their own");
-    app.add_flag("--svg-fill", fill,
-                 "With --svg: the cel-shaded colours as an embedded PNG under the lines");
 }
 
-void SvgArgs::apply(FrameOptions& options, bool per_frame) const {
+bool SettingsArgs::given(std::string_view key) const {
+    return std::any_of(entries_.begin(), entries_.end(), [&](const Entry& e) {
+        return e.setting->key == key && e.option->count() > 0;
+    });
+}
+
+void SvgArgs::apply(FrameOptions& options, bool per_frame, const SettingsArgs& settings) const {
     if (svg.empty()) {
-        if (hidden) throw Error("--hidden-lines needs --svg");
-        if (fill) throw Error("--svg-fill needs --svg");
+        if (settings.given("output.svg_hidden")) throw Error("--hidden-lines needs --svg");
+        if (settings.given("output.svg_fill")) throw Error("--svg-fill needs --svg");
         return;
     }
     if (per_frame) options.svg_dir = svg;
     else options.svg = svg;
-    options.svg_hidden = hidden;
-    options.svg_fill = fill;
 }
 
 void LimitArgs::add_to(CLI::App& app) {
-    const Limits d;
-    app.add_option("--max-triangles", triangles,
-                   fmt::format("Largest scene, in triangles (default {}; k, M, G suffixes)",
-                               d.max_triangles))
-        ->group("Limits");
-    app.add_option(
-           "--max-vertices", vertices,
-           fmt::format("Most OBJ v, vn and vt statements, each (default {})", d.max_vertices))
-        ->group("Limits");
-    app.add_option("--max-image-pixels", pixels,
-                   fmt::format("Largest image, width x height (default {} = 8192x8192)",
-                               d.max_image_pixels))
-        ->group("Limits");
-    app.add_option(
-           "--max-memory", memory,
-           "Memory the estimate of a run may reach (frame buffers and scenes of all frames in "
-           "flight), e.g. 4G (default: 3/4 of physical memory)")
-        ->group("Limits");
-    app.add_option("--max-input-size", input_size,
-                   fmt::format("Largest input file: OBJ, MTL, score, camera path (default {})",
-                               format_bytes(d.max_input_bytes)))
-        ->group("Limits");
+    for (auto [flag, text] : {std::pair{"--max-triangles", &triangles},
+                              {"--max-vertices", &vertices},
+                              {"--max-image-pixels", &pixels},
+                              {"--max-memory", &memory},
+                              {"--max-input-size", &input_size}})
+        app.add_option(flag, *text, limit_help(flag))->group("Limits");
 }
 
 void LimitArgs::apply() const {

@@ -4,6 +4,7 @@
 
 #include <CLI/CLI.hpp>
 #include <atomic>
+#include <deque>
 #include <optional>
 #include <string>
 #include <vector>
@@ -11,65 +12,55 @@
 #include "toonray/core/error.h"
 #include "toonray/media/audio.h"
 #include "toonray/frame/frame_renderer.h"
+#include "toonray/frame/settings.h"
 #include "toonray/score/score.h"
 
 namespace toonray::cli {
 
-/// Options shared by every command that renders, kept as text until validated.
-struct RenderArgs {
-    std::string size = "1280x720";
-    std::vector<std::string> lights;
-    std::string lights_file;
-    std::string ramp;
-    bool shadows = false, specular = false, no_textures = false;
-    float rim = 0.0f;
-    std::string camera;
-    std::string background = "1,1,1";
-    std::string edges = "ink";  // the fewest specks and whole creases (docs/lines.md)
-    float depth_threshold = 8.0f;
-    float normal_threshold = 4.0f;
-    std::string lines = "all";
-    float crease_angle = LineSettings{}.crease_angle;
-    float depth_step = RobustLineSettings{}.depth_step;
-    float line_width = LineSettings{}.width;
-    std::string line_colour = "0,0,0";
-    int samples = SamplingSettings{}.samples;
-    std::string adaptive = "on";
-    int tile_size = SamplingSettings{}.tile_size;
-    int threads = 0;
-    int leaf_size = Bvh::Config{}.max_leaf_size;
-    int png_level = PngOptions{}.level;
-    std::string aov_dir;
-    std::string aov_exr;
-    // Ink line styles (add_ink_style_options).
-    std::string line_style;
-    float line_taper = 0.0f;
-    bool line_width_by_depth = false;
-
-    float auto_smooth = -1.0f;  ///< degrees; below 0: off
-
+/// The settings of every command that renders: one command-line option per key of the
+/// settings document (frame/settings.h, settings_table()), given as text and read by the
+/// table's own setters; `--settings FILE` (the document as TOML, which the options given
+/// override); `--lights FILE` and `--line-style FILE`; and where feature images go.
+class SettingsArgs {
+public:
     void add_to(CLI::App& app);
-    [[nodiscard]] FrameOptions resolve() const;
-    /// Auto-smooth, the lights given (--light, --lights) and the camera (--camera), for an
-    /// image of --size.
-    [[nodiscard]] SceneSetup scene_setup() const;
+    /// The defaults, then the settings file, then every option given. Throws Error naming the
+    /// option (or the file, line and key) of a bad value.
+    [[nodiscard]] Settings settings() const;
+    /// Frame options of `settings` with the feature image outputs (--aov, --aov-exr) and
+    /// what the outputs record.
+    [[nodiscard]] FrameOptions frame_options(const Settings& settings) const;
+    /// settings(), with the limits it gives made the process-wide limits (before any work).
+    [[nodiscard]] Settings apply() const;
+    /// Whether the option of a settings key was given on the command line.
+    [[nodiscard]] bool given(std::string_view key) const;
 
 private:
-    void add_ink_style_options(CLI::App& app);
-    void resolve_ink_style(FrameOptions& options) const;
+    /// One option of the table, with where CLI11 puts its value.
+    struct Entry {
+        const Setting* setting = nullptr;
+        CLI::Option* option = nullptr;
+        std::string text;
+        std::vector<std::string> list;
+        bool flag = false;
+    };
+    std::deque<Entry> entries_;  // stable addresses: CLI11 writes into them
+    std::string settings_file_, lights_file_, line_style_, aov_dir_, aov_exr_;
+    CLI::Option* lights_file_option_ = nullptr;
 };
 
 /// Vector output of the ink lines: `--svg FILE` (render) or `--svg DIR` (one SVG per frame,
-/// named like its PNG), `--hidden-lines` (alias `--svg-hidden`), `--svg-fill`.
+/// named like its PNG). Its look (hidden lines, fill) is in the settings.
 struct SvgArgs {
     std::string svg;
-    bool hidden = false, fill = false;
 
     void add_to(CLI::App& app, bool per_frame);
-    /// Sets options.svg (or svg_dir), svg_hidden, svg_fill; Error for --hidden-lines or
-    /// --svg-fill without --svg.
-    void apply(FrameOptions& options, bool per_frame) const;
+    /// Sets options.svg (or svg_dir); Error for --hidden-lines or --svg-fill without --svg.
+    void apply(FrameOptions& options, bool per_frame, const SettingsArgs& settings) const;
 };
+
+/// The help of a limit's option, with its default.
+[[nodiscard]] std::string limit_help(std::string_view flag);
 
 /// Limits on what inputs may ask for (docs/robustness.md), as text until validated.
 struct LimitArgs {

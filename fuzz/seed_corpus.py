@@ -134,6 +134,23 @@ put("line_style", "all_keys.style",
     "width=0 opacity=1 dash=none taper=0\nmatch object=a?c*,d lines=hidden dash=1,2,3 color=#ff00ff\n")
 put("line_style", "bad.style", "match width=-1\n")
 
+# --- settings documents ---
+put("settings", "every_key.toml",
+    "[image]\nsize = \"320x180\"\nbackground = \"#ffffff\"\n[scene]\n"
+    "camera = \"1,2,3,0,0,0,0,1,0\"\nlights = [\"dir:0,-1,0@0.5\", \"point:1,2,3\"]\n"
+    "auto_smooth = 30.0\n[shading]\nramp = \"0.5,0.75,1@0.25,0.5\"\nshadows = true\n"
+    "specular = false\nrim = 0.2\nrim_strength = 0.35\ntextures = true\n[lines]\n"
+    "mode = \"robust\"\ntypes = \"silhouette,depth\"\ncrease_angle = 40.0\nwidth = 2.0\n"
+    "colour = \"#000000\"\n[lines.classic]\ndepth_threshold = 8.0\nnormal_threshold = 4.0\n"
+    "[lines.robust]\ndepth_step = 0.02\nsilhouette_ratio = 0.1\n[lines.ink]\ntaper = 2.0\n"
+    "width_by_depth = true\n[sampling]\nsamples = 9\nadaptive = false\ntile_size = 64\n"
+    "[render]\nthreads = 1\nbvh_leaf_size = 4\n[output]\npng_level = 3\nsvg_hidden = true\n"
+    "svg_fill = false\n[limits]\nmemory = \"4G\"\ntriangles = \"5M\"\n")
+put("settings", "rules.toml",
+    "[[lines.rule]]\ntype = \"crease\"\ncolor = \"#3050a0\"\nwidth = 1.0\n"
+    "[[lines.rule]]\nobject = \"box*\"\nlines = \"hidden\"\ndraw = true\ndash = [4, 3]\n")
+put("settings", "bad_key.toml", "[lines]\nwidht = 2\n")
+
 
 # --- PNG ---
 def png(width, height, colour_type, rows):

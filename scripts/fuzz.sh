@@ -4,7 +4,7 @@
 #   scripts/fuzz.sh [SECONDS] [TARGET...]
 #
 # SECONDS per target (default 60); TARGETs default to all: obj mtl camera note_script midi
-# camera_path options png render shading line_style. Before fuzzing, every target replays its seeds and the inputs
+# camera_path options png render shading line_style settings. Before fuzzing, every target replays its seeds and the inputs
 # that once crashed it (tests/robustness/data/fuzz/TARGET). Fails (exit 1) on any crash, leak,
 # timeout (an input running over TOONRAY_FUZZ_TIMEOUT, 10 s) or out-of-memory (over 2 GiB) and leaves the input in
 # BUILD_DIR/artifacts/TARGET/; replay it with `BUILD_DIR/fuzz_TARGET FILE`. Ends with a summary:
@@ -24,7 +24,7 @@ cd "$(dirname "$0")/.."
 
 seconds=${1:-60}
 shift || true
-all_targets=(obj mtl camera note_script midi camera_path options png render shading gltf glb line_style)
+all_targets=(obj mtl camera note_script midi camera_path options png render shading gltf glb line_style settings)
 targets=("$@")
 [ ${#targets[@]} -gt 0 ] || targets=("${all_targets[@]}")
 build=${TOONRAY_FUZZ_BUILD_DIR:-build-fuzz}

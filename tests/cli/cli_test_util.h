@@ -10,6 +10,7 @@
 #include <string>
 
 #include "support/test_support.h"
+#include "toonray/io/png.h"
 
 struct CommandResult {
     int exit_code = -1;
@@ -31,3 +32,10 @@ inline CommandResult run_toonray(const std::string& args) {
 }
 
 using toonray::test_support::TempDir;
+
+/// The pixels of a PNG file, decoded, as bytes: frames compare by picture, since every PNG
+/// also records the settings that made it.
+inline std::string png_pixels(const std::filesystem::path& path) {
+    const toonray::DecodedPng png = toonray::read_png(path);
+    return std::string(reinterpret_cast<const char*>(png.rgb.data()), png.rgb.size() * 3);
+}

@@ -223,12 +223,6 @@ TEST(RenderCli, InkLinesAreTheDefault) {
     EXPECT_TRUE(fs::exists(dir / "default.svg"));
 }
 
-namespace {
-std::string file_bytes(const fs::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    return {std::istreambuf_iterator<char>(in), {}};
-}
-}  // namespace
 
 TEST(RenderCli, TheScenesLightsFileLightsItUnlessLightsAreGiven) {
     TempDir dir("cli_scene_lights");
@@ -238,7 +232,7 @@ TEST(RenderCli, TheScenesLightsFileLightsItUnlessLightsAreGiven) {
         CommandResult r = run_toonray("render " + (dir / "pot.obj").string() + " -o " +
                                       (dir / out).string() + common + extra);
         EXPECT_EQ(r.exit_code, 0) << r.output;
-        return file_bytes(dir / out);
+        return png_pixels(dir / out);
     };
     const std::string plain = render("default.png", "");
     const std::string given = render("given.png", " --light dir:1,-1,-0.5");
@@ -266,7 +260,7 @@ TEST(RenderCli, AutoSmoothChangesOnlyMeshesWithoutNormalsAndChecksTheAngle) {
         CommandResult r = run_toonray("render " + kData + "/teapot.obj -o " + (dir / out).string() +
                                       common + extra);
         EXPECT_EQ(r.exit_code, 0) << r.output;
-        return file_bytes(dir / out);
+        return png_pixels(dir / out);
     };
     const std::string flat = render("flat.png", "");
     const std::string smooth = render("smooth.png", " --auto-smooth 30");

@@ -16,6 +16,12 @@ namespace fs = std::filesystem;
 
 namespace {
 
+PngOptions at_level(int level) {
+    PngOptions options;
+    options.level = level;
+    return options;
+}
+
 fs::path temp_dir(const std::string& name) {
     fs::path dir =
         fs::temp_directory_path() / ("toonray_io_" + name + "_" + std::to_string(::getpid()));
@@ -70,7 +76,7 @@ TEST(Png, RgbRoundTripsThroughLibpng) {
                            static_cast<std::uint8_t>(y * 11)};
     fs::path dir = temp_dir("rgb");
     for (int level : {1, 6, 12}) {
-        write_png(dir / "a.png", image, {level});
+        write_png(dir / "a.png", image, at_level(level));
         DecodedPng decoded = read_png(dir / "a.png");
         ASSERT_EQ(decoded.width, 37);
         ASSERT_EQ(decoded.height, 23);
@@ -152,7 +158,8 @@ TEST(Png, FewColoursAreIndexedAndRoundTrip) {
             for (int y = 0; y < h; ++y)
                 for (int x = 0; x < w; ++x)
                     used.insert(image(x, y)[0] << 16 | image(x, y)[1] << 8 | image(x, y)[2]);
-            for (int level : {1, 12}) expect_round_trip(image, {level}, used.size() <= 256 ? 3 : 2);
+            for (int level : {1, 12})
+                expect_round_trip(image, at_level(level), used.size() <= 256 ? 3 : 2);
         }
     }
 }

@@ -26,6 +26,8 @@ int toonray_fuzz_render(const std::uint8_t*, std::size_t);
 int toonray_fuzz_shading(const std::uint8_t*, std::size_t);
 int toonray_fuzz_gltf(const std::uint8_t*, std::size_t);
 int toonray_fuzz_glb(const std::uint8_t*, std::size_t);
+int toonray_fuzz_line_style(const std::uint8_t*, std::size_t);
+int toonray_fuzz_settings(const std::uint8_t*, std::size_t);
 int toonray_fuzz_init_png(int*, char***);
 }
 
@@ -72,17 +74,15 @@ TEST_P(FuzzReplay, SeedsAndPastCrashesPass) {
     toonray::set_limits(saved);
 }
 
-INSTANTIATE_TEST_SUITE_P(Targets, FuzzReplay,
-                         ::testing::Values(Target{"obj", toonray_fuzz_obj},
-                                           Target{"mtl", toonray_fuzz_mtl},
-                                           Target{"camera", toonray_fuzz_camera},
-                                           Target{"note_script", toonray_fuzz_note_script},
-                                           Target{"midi", toonray_fuzz_midi},
-                                           Target{"camera_path", toonray_fuzz_camera_path},
-                                           Target{"options", toonray_fuzz_options},
-                                           Target{"png", toonray_fuzz_png, toonray_fuzz_init_png},
-                                           Target{"render", toonray_fuzz_render},
-                                           Target{"shading", toonray_fuzz_shading},
-                                           Target{"gltf", toonray_fuzz_gltf},
-                                           Target{"glb", toonray_fuzz_glb}),
-                         [](const auto& info) { return std::string(info.param.name); });
+INSTANTIATE_TEST_SUITE_P(
+    Targets, FuzzReplay,
+    ::testing::Values(
+        Target{"obj", toonray_fuzz_obj}, Target{"mtl", toonray_fuzz_mtl},
+        Target{"camera", toonray_fuzz_camera}, Target{"note_script", toonray_fuzz_note_script},
+        Target{"midi", toonray_fuzz_midi}, Target{"camera_path", toonray_fuzz_camera_path},
+        Target{"options", toonray_fuzz_options},
+        Target{"png", toonray_fuzz_png, toonray_fuzz_init_png},
+        Target{"render", toonray_fuzz_render}, Target{"shading", toonray_fuzz_shading},
+        Target{"gltf", toonray_fuzz_gltf}, Target{"glb", toonray_fuzz_glb},
+        Target{"line_style", toonray_fuzz_line_style}, Target{"settings", toonray_fuzz_settings}),
+    [](const auto& info) { return std::string(info.param.name); });

@@ -99,13 +99,17 @@ void gather_feature_layers(const FrameLayers& layers, FeatureLayers& out) {
     }
 }
 
-void write_feature_exr(const std::filesystem::path& path, const FeatureLayers& layers) {
+void write_feature_exr(const std::filesystem::path& path, const FeatureLayers& layers,
+                       const OutputRecord& record) {
     std::vector<ExrChannel> channels;
     channels.reserve(layers.channels.size());
     for (const FeatureLayers::Layer& layer : layers.channels)
         channels.push_back(
             {layer.name, layer.half ? ExrSample::Half : ExrSample::Float, layer.values});
-    write_exr(path, layers.width, layers.height, channels);
+    std::vector<ExrAttribute> attributes;
+    if (!record.software.empty()) attributes.emplace_back("software", record.software);
+    if (!record.settings.empty()) attributes.emplace_back("toonraySettings", record.settings);
+    write_exr(path, layers.width, layers.height, channels, attributes);
 }
 
 std::uint64_t feature_exr_bytes(std::uint64_t pixels) {

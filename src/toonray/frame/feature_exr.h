@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "toonray/io/record.h"
 #include "toonray/render/frame_layers.h"
 
 namespace toonray {
@@ -42,8 +43,11 @@ struct FeatureLayers {
 /// from is missing or not the size of the picture.
 void gather_feature_layers(const FrameLayers& layers, FeatureLayers& out);
 
-/// Writes the layers as one EXR file, atomically. Throws Error when the build has no OpenEXR.
-void write_feature_exr(const std::filesystem::path& path, const FeatureLayers& layers);
+/// Writes the layers as one EXR file, atomically, with the record in string attributes of its
+/// header ("software", "toonraySettings") when it has one. Throws Error when the build has no
+/// OpenEXR.
+void write_feature_exr(const std::filesystem::path& path, const FeatureLayers& layers,
+                       const OutputRecord& record = {});
 
 /// Bytes of the layers and their encoding for a frame of `pixels` pixels (for frame_bytes).
 [[nodiscard]] std::uint64_t feature_exr_bytes(std::uint64_t pixels);

@@ -58,6 +58,8 @@ void write_svg(const FrameLayers& layers, const RenderSettings& settings,
     svg.colour = settings.lines.colour;
     svg.hidden = options.svg_hidden;
     svg.pens = lines.pens;
+    svg.software = options.record.software;
+    svg.metadata = options.record.settings;
     if (options.svg_fill) {
         const ImageRgb8& cel = layers.cel;
         svg.fill_href = ink::png_data_uri(
@@ -128,6 +130,11 @@ void FrameRenderer::render(const SceneFrame& frame, const std::filesystem::path&
         settings.shading.textures ? &textures_.load(scene, warnings) : nullptr;
     renderer_.render(scene, accel, frame.camera, frame.lights, settings, textures);
     const FrameLayers& layers = renderer_.layers();
+    PngOptions png = options.png;
+    if (!options.record.software.empty())
+        png.text.emplace_back("Software", options.record.software);
+    if (!options.record.settings.empty())
+        png.text.emplace_back("toonray settings", options.record.settings);
     if (options.aov_dir) {
         std::filesystem::create_directories(*options.aov_dir);
         FeatureBytes bytes;
@@ -135,8 +142,8 @@ void FrameRenderer::render(const SceneFrame& frame, const std::filesystem::path&
             if (!feature.in(settings.lines.mode)) continue;
             feature.encode(layers, settings.threads, bytes);
             const std::filesystem::path path = aov_path(*options.aov_dir, output, feature.name);
-            if (bytes.channels == 1) write_png(path, bytes.gray, options.png);
-            else write_png(path, bytes.rgb, options.png);
+            if (bytes.channels == 1) write_png(path, bytes.gray, png);
+            else write_png(path, bytes.rgb, png);
         }
     }
     if (options.aov_exr) {
@@ -145,13 +152,13 @@ void FrameRenderer::render(const SceneFrame& frame, const std::filesystem::path&
         const std::filesystem::path path = exr_path(*options.aov_exr, output);
         if (path.has_parent_path()) std::filesystem::create_directories(path.parent_path());
         gather_feature_layers(layers, exr_layers_);
-        write_feature_exr(path, exr_layers_);
+        write_feature_exr(path, exr_layers_, options.record);
     }
     if (const auto svg_path = options.svg_path(output)) {
         if (options.svg_dir && !options.svg) std::filesystem::create_directories(*options.svg_dir);
         write_svg(layers, settings, options, *svg_path);
     }
-    write_png(output, layers.image, options.png);
+    write_png(output, layers.image, png);
 }
 
 }  // namespace toonray

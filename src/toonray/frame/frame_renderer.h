@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <optional>
+#include <string>
 #include <string_view>
 
 #include "toonray/core/error.h"
@@ -14,6 +15,7 @@
 #include "toonray/frame/feature_exr.h"
 #include "toonray/frame/textures.h"
 #include "toonray/io/png.h"
+#include "toonray/io/record.h"
 #include "toonray/render/renderer.h"
 #include "toonray/scene/camera.h"
 #include "toonray/scene/scene.h"
@@ -40,6 +42,9 @@ struct FrameOptions {
     bool svg_fill = false;
     Bvh::Config bvh;
     PngOptions png;
+    /// Recorded in every PNG (tEXt chunks "Software" and "toonray settings"), in the EXR's
+    /// header (string attributes "software" and "toonraySettings") and in the SVG (metadata).
+    OutputRecord record;
 
     /// The settings a frame is rendered with: feature images exactly when they are written.
     [[nodiscard]] RenderSettings render_settings() const;

@@ -252,6 +252,21 @@ std::string png_data_uri(std::span<const std::uint8_t> png) {
     return out;
 }
 
+std::string xml_escaped(std::string_view text) {
+    std::string out;
+    out.reserve(text.size());
+    for (const char c : text) {
+        switch (c) {
+            case '&': out += "&amp;"; break;
+            case '<': out += "&lt;"; break;
+            case '>': out += "&gt;"; break;
+            case '"': out += "&quot;"; break;
+            default: out += c;
+        }
+    }
+    return out;
+}
+
 std::string svg_text(std::span<const Stroke> strokes, const SvgSettings& settings) {
     // Every stroke's style must have a pen, also of strokes not written (hidden ones without
     // the hidden layer, dots): the same check as the drawing's, whatever the settings.
@@ -267,6 +282,9 @@ std::string svg_text(std::span<const Stroke> strokes, const SvgSettings& setting
         "height=\"{1}\" viewBox=\"0 0 {0} {1}\">\n",
         settings.width, settings.height,
         settings.fill_href.empty() ? "" : " xmlns:xlink=\"http://www.w3.org/1999/xlink\"");
+    if (!settings.metadata.empty() || !settings.software.empty())
+        fmt::format_to(it, "<metadata id=\"toonray\" data-software=\"{}\">{}</metadata>\n",
+                       xml_escaped(settings.software), xml_escaped(settings.metadata));
     if (!settings.fill_href.empty())
         fmt::format_to(it,
                        "<image id=\"fill\" x=\"0\" y=\"0\" width=\"{}\" height=\"{}\" "

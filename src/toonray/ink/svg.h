@@ -4,6 +4,7 @@
 
 #include <span>
 #include <string>
+#include <string_view>
 
 #include "toonray/core/math.h"
 #include "toonray/ink/draw.h"
@@ -31,7 +32,14 @@ struct SvgSettings {
     /// When not empty, an `<image id="fill">` of the whole view under the lines with this
     /// href (a data: URI of the cel-shaded picture).
     std::string fill_href;
+    /// When not empty, a `<metadata id="toonray">` first in the drawing with the software that
+    /// wrote it (its `data-software` attribute) and this text (the settings that made it),
+    /// escaped as XML character data.
+    std::string software, metadata;
 };
+
+/// `text` with &, <, > and " escaped, for XML character data and attribute values.
+[[nodiscard]] std::string xml_escaped(std::string_view text);
 
 /// `data:image/png;base64,...` for PNG bytes.
 [[nodiscard]] std::string png_data_uri(std::span<const std::uint8_t> png);

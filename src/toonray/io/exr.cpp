@@ -13,6 +13,7 @@
 #include <OpenEXR/ImfHeader.h>
 #include <OpenEXR/ImfIO.h>
 #include <OpenEXR/ImfOutputFile.h>
+#include <OpenEXR/ImfStringAttribute.h>
 #include <OpenEXR/Iex.h>
 #endif
 
@@ -60,12 +61,14 @@ private:
 
 bool exr_available() { return TOONRAY_WITH_OPENEXR != 0; }
 
-std::vector<std::uint8_t> encode_exr(int width, int height, std::span<const ExrChannel> channels) {
+std::vector<std::uint8_t> encode_exr(int width, int height, std::span<const ExrChannel> channels,
+                                     std::span<const ExrAttribute> attributes) {
     check_channels(width, height, channels);
 #if TOONRAY_WITH_OPENEXR
     try {
         Imf::Header header(width, height);
         header.compression() = Imf::ZIP_COMPRESSION;
+        for (const auto& [name, text] : attributes) header.insert(name, Imf::StringAttribute(text));
         Imf::FrameBuffer frame;
         const std::size_t pixels =
             static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
@@ -105,8 +108,8 @@ std::vector<std::uint8_t> encode_exr(int width, int height, std::span<const ExrC
 }
 
 void write_exr(const std::filesystem::path& path, int width, int height,
-               std::span<const ExrChannel> channels) {
-    const std::vector<std::uint8_t> bytes = encode_exr(width, height, channels);
+               std::span<const ExrChannel> channels, std::span<const ExrAttribute> attributes) {
+    const std::vector<std::uint8_t> bytes = encode_exr(width, height, channels, attributes);
     write_file_atomic(path, bytes);
 }
 

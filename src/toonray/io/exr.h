@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace toonray {
@@ -26,13 +27,17 @@ struct ExrChannel {
 /// True when this build can write EXR files.
 [[nodiscard]] bool exr_available();
 
-/// The EXR file of the channels, in memory. The channels are stored sorted by name, as the
-/// format requires. Throws Error when a channel has the wrong number of values, two channels
-/// share a name, or the build has no OpenEXR.
-std::vector<std::uint8_t> encode_exr(int width, int height, std::span<const ExrChannel> channels);
+/// A string attribute of the file's header: its name and text.
+using ExrAttribute = std::pair<std::string, std::string>;
+
+/// The EXR file of the channels, in memory, with string attributes in its header. The channels
+/// are stored sorted by name, as the format requires. Throws Error when a channel has the
+/// wrong number of values, two channels share a name, or the build has no OpenEXR.
+std::vector<std::uint8_t> encode_exr(int width, int height, std::span<const ExrChannel> channels,
+                                     std::span<const ExrAttribute> attributes = {});
 
 /// encode_exr, written atomically (io/file.h).
 void write_exr(const std::filesystem::path& path, int width, int height,
-               std::span<const ExrChannel> channels);
+               std::span<const ExrChannel> channels, std::span<const ExrAttribute> attributes = {});
 
 }  // namespace toonray

@@ -1,5 +1,7 @@
 #include "toonray/io/png.h"
 
+#include <algorithm>
+
 #include <libdeflate.h>
 #include <png.h>
 
@@ -31,6 +33,21 @@ void put_chunk(std::vector<std::uint8_t>& out, const char type[4], const std::ui
     if (size) out.insert(out.end(), data, data + size);
     std::uint32_t crc = libdeflate_crc32(0, out.data() + type_at, size + 4);
     put_u32(out, crc);
+}
+
+// A text chunk: tEXt (keyword, NUL, Latin-1 text) when the text is ASCII, else iTXt (keyword,
+// NUL, uncompressed, no method, no language tag, no translated keyword, UTF-8 text).
+void put_text_chunk(std::vector<std::uint8_t>& out, const std::string& keyword,
+                    const std::string& text) {
+    if (keyword.empty() || keyword.size() > 79 || keyword.find('\0') != std::string::npos)
+        throw Error(fmt::format("PNG: text keyword '{}' is not 1 to 79 characters", keyword));
+    const bool ascii =
+        std::all_of(text.begin(), text.end(), [](char c) { return (c & 0x80) == 0 && c != 0; });
+    std::vector<std::uint8_t> data(keyword.begin(), keyword.end());
+    data.push_back(0);
+    if (!ascii) data.insert(data.end(), {0, 0, 0, 0});  // flag, method, language, translated
+    data.insert(data.end(), text.begin(), text.end());
+    put_chunk(out, ascii ? "tEXt" : "iTXt", data.data(), data.size());
 }
 
 struct CompressorDeleter {
@@ -128,6 +145,7 @@ std::vector<std::uint8_t> encode_png(int width, int height, int channels,
     ihdr[10] = ihdr[11] = ihdr[12] = 0;             // deflate, adaptive filtering, no interlace
     put_chunk(out, "IHDR", ihdr, sizeof ihdr);
     if (indexed) put_chunk(out, "PLTE", palette.data(), palette.size());
+    for (const auto& [keyword, text] : options.text) put_text_chunk(out, keyword, text);
     put_chunk(out, "IDAT", idat.data(), idat_size);
     put_chunk(out, "IEND", nullptr, 0);
     return out;

@@ -12,7 +12,9 @@
 #include <cstdint>
 #include <filesystem>
 #include <span>
+#include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "toonray/core/image.h"
@@ -21,6 +23,9 @@ namespace toonray {
 
 struct PngOptions {
     int level = 1;  ///< libdeflate level, 1 (fastest) to 12 (smallest)
+    /// Text chunks written before the image data, keyword and text: tEXt when the text is
+    /// ASCII, else iTXt (UTF-8). Keywords are 1 to 79 printable Latin-1 characters.
+    std::vector<std::pair<std::string, std::string>> text;
 };
 
 /// Encodes 8-bit pixels (channels 1 = gray, 3 = RGB) as a complete PNG file in memory.
