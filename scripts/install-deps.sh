@@ -20,6 +20,8 @@ demo_packages=(
   libcli11-dev libfmt-dev libtbb-dev libdeflate-dev libpng-dev libfluidsynth-dev
   # glTF scenes (tinygltf, its JSON and image headers) and multi-layer OpenEXR feature images
   libtinygltf-dev nlohmann-json3-dev libstb-dev libopenexr-dev
+  # the settings document (TOML), read with toml++ as a header-only library
+  libtomlplusplus-dev
   # media: video encoding and the piano sound
   ffmpeg fluid-soundfont-gm
 )

@@ -43,7 +43,8 @@ std::string sphere_gltf() {
     for (int j = 0; j < rows; ++j)
         for (int i = 0; i < cols; ++i) {
             const int a = j * (cols + 1) + i, b = a + 1, c = a + cols + 1, d = c + 1;
-            for (int v : {a, c, b, b, c, d}) put<std::uint16_t>(bin, {static_cast<std::uint16_t>(v)});
+            for (int v : {a, c, b, b, c, d})
+                put<std::uint16_t>(bin, {static_cast<std::uint16_t>(v)});
         }
     const std::size_t indices = bin.size() - positions;
     put<float>(bin, {0.0f, 1.0f});
@@ -62,11 +63,13 @@ std::string sphere_gltf() {
 {"bufferView":3,"componentType":5126,"count":2,"type":"VEC3"}],
 "bufferViews":[{"buffer":0,"byteLength":)" +
            std::to_string(positions) + R"(},
-{"buffer":0,"byteOffset":)" + std::to_string(positions) +
-           R"(,"byteLength":)" + std::to_string(indices) + R"(},
-{"buffer":0,"byteOffset":)" + std::to_string(positions + indices) +
+{"buffer":0,"byteOffset":)" +
+           std::to_string(positions) + R"(,"byteLength":)" + std::to_string(indices) + R"(},
+{"buffer":0,"byteOffset":)" +
+           std::to_string(positions + indices) +
            R"(,"byteLength":8},
-{"buffer":0,"byteOffset":)" + std::to_string(positions + indices + 8) +
+{"buffer":0,"byteOffset":)" +
+           std::to_string(positions + indices + 8) +
            R"(,"byteLength":24}],
 "buffers":[{"byteLength":)" +
            std::to_string(bin.size()) + R"(,"uri":")" + data_uri(bin) + R"("}]})";
@@ -99,10 +102,11 @@ TEST(SettingsCli, RenderingWithThePrintedSettingsGivesByteIdenticalFrames) {
 
     const fs::path gltf = dir.write("ball.gltf", sphere_gltf());
     write_settings(dir / "ball.toml", " --size 160x120 --auto-smooth 40 --edges robust");
-    ASSERT_EQ(run_toonray("render " + gltf.string() + " --time 0.5 -o " +
-                          (dir / "g1.png").string() + " --size 160x120 --auto-smooth 40 --edges robust")
-                  .exit_code,
-              0);
+    ASSERT_EQ(
+        run_toonray("render " + gltf.string() + " --time 0.5 -o " + (dir / "g1.png").string() +
+                    " --size 160x120 --auto-smooth 40 --edges robust")
+            .exit_code,
+        0);
     ASSERT_EQ(run_toonray("render " + gltf.string() + " --time 0.5 -o " +
                           (dir / "g2.png").string() + " --settings " + (dir / "ball.toml").string())
                   .exit_code,
@@ -153,18 +157,17 @@ TEST(SettingsCli, OptionsGivenOverrideTheDocument) {
 
 TEST(SettingsCli, EveryOutputRecordsTheVersionAndTheSettings) {
     TempDir dir("cli_settings_record");
-    CommandResult r = run_toonray("render " + kData + "/teapot.obj -o " +
-                                  (dir / "f.png").string() + " --size 96x64 --shadows --aov " +
-                                  (dir / "aov").string() + " --aov-exr " +
-                                  (dir / "f.exr").string() + " --svg " + (dir / "f.svg").string());
+    CommandResult r =
+        run_toonray("render " + kData + "/teapot.obj -o " + (dir / "f.png").string() +
+                    " --size 96x64 --shadows --aov " + (dir / "aov").string() + " --aov-exr " +
+                    (dir / "f.exr").string() + " --svg " + (dir / "f.svg").string());
     ASSERT_EQ(r.exit_code, 0) << r.output;
     const std::string version = run_toonray("--version").output;
     ASSERT_EQ(version.rfind("toonray ", 0), 0u) << version;
     const std::string software = version.substr(0, version.find('\n'));
     for (const fs::path& png : {dir / "f.png", dir / "aov" / "f_depth.png"}) {
         const std::string bytes = bytes_of(png);
-        EXPECT_NE(bytes.find("tEXtSoftware" + std::string(1, '\0') + software),
-                  std::string::npos)
+        EXPECT_NE(bytes.find("tEXtSoftware" + std::string(1, '\0') + software), std::string::npos)
             << png;
         EXPECT_NE(bytes.find("tEXttoonray settings"), std::string::npos) << png;
         EXPECT_NE(bytes.find("shadows = true"), std::string::npos) << png;

@@ -103,8 +103,7 @@ TEST(Settings, ErrorsNameTheFileThePlaceAndTheKey) {
     EXPECT_EQ(error("[sampling]\nsamples = 5\n"),
               "bad.toml:2:11: sampling.samples: 5 samples per pixel: must be 1, 4, 9 or 16 (a "
               "square grid per pixel)");
-    EXPECT_EQ(error("[shading]\nrim = 2.0\n"),
-              "bad.toml:2:7: shading.rim: 2 is outside [0, 0.99]");
+    EXPECT_EQ(error("[shading]\nrim = 2.0\n"), "bad.toml:2:7: shading.rim: 2 is outside [0, 0.99]");
     EXPECT_EQ(error("[lines]\nmode = \"fancy\"\n"),
               "bad.toml:2:8: lines.mode: mode: unknown line mode 'fancy' (ink, robust or classic)");
     EXPECT_EQ(error("[shading]\nshadows = 1\n"),

@@ -74,18 +74,21 @@ TEST(ShadeSamples, EqualsTheScalarShadingOfEverySample) {
     ASSERT_GT(hit_count, n / 8);
 
     const LookFrame look{scene, settings, background, false};
-    for (SurfaceFields level : {SurfaceFields::Look, SurfaceFields::Geometry, SurfaceFields::All}) {
+    // Every set of fields a line mode keeps, and all of them.
+    for (unsigned fields : {0u, unsigned(kSurfaceKeys), unsigned(kSurfaceDistance),
+                            unsigned(kSurfaceKeys | kSurfaceViewDepth), unsigned(kSurfaceAll)}) {
         SurfaceSamples out;
-        out.resize(static_cast<std::size_t>(n) + 3, level, 1);
-        shade_samples(ctx, view, n, dirs.data(), hits.data(), found.get(), out, 3);
-        apply_look(look, out, 3, out.size());
+        out.resize(static_cast<std::size_t>(n) + 3, fields, 1);
+        shade_samples(ctx, look, view, n, dirs.data(), hits.data(), found.get(), out, 3);
         for (int k = 0; k < n; ++k) {
             const std::size_t i = static_cast<std::size_t>(k) + 3;
             ASSERT_EQ(out.found[i], found[k] ? 1 : 0);
             if (!found[k]) {
                 ASSERT_TRUE(same_bits(out.colour[i], background));
-                ASSERT_EQ(out.object[i], kNoIndex);
-                ASSERT_EQ(out.band[i], kNoBand);
+                if (out.has(kSurfaceKeys)) {
+                    ASSERT_EQ(out.object[i], kNoIndex);
+                    ASSERT_EQ(out.band[i], kNoBand);
+                }
                 continue;
             }
             const Hit& hit = hits[k];
@@ -94,29 +97,35 @@ TEST(ShadeSamples, EqualsTheScalarShadingOfEverySample) {
                 << "sample " << k;
             float n_dot_l = 0.0f;
             const LightTerms terms = light_terms(ctx, hit, view.eye, dirs[k], normal, &n_dot_l);
-            ASSERT_EQ(out.band[i], terms.band);
-            ASSERT_EQ(out.accents[i], terms.accents);
-            ASSERT_TRUE(same_bits(out.albedo[i], terms.albedo));
-            ASSERT_EQ(out.material[i], scene.tri_material[hit.prim]);
-            ASSERT_EQ(out.object[i], scene.tri_object[hit.prim]);
-            if (level >= SurfaceFields::Geometry) {
-                ASSERT_TRUE(
-                    same_bits(out.geometric_normal[i], geometric_normal(scene, hit, dirs[k])));
+            if (out.has(kSurfaceKeys)) {
+                ASSERT_EQ(out.band[i], terms.band);
+                ASSERT_EQ(out.accents[i], terms.accents);
+                ASSERT_EQ(out.material[i], scene.tri_material[hit.prim]);
+                ASSERT_EQ(out.object[i], scene.tri_object[hit.prim]);
+            }
+            if (out.has(kSurfaceDistance)) {
                 ASSERT_TRUE(same_bits(out.normal[i], normal)) << "sample " << k;
-                ASSERT_EQ(out.view_depth[i], hit.t * dot(dirs[k], view.forward));
                 ASSERT_EQ(out.distance[i], hit.t);
             }
-            if (level >= SurfaceFields::All) {
+            if (out.has(kSurfaceViewDepth)) {
+                ASSERT_TRUE(
+                    same_bits(out.geometric_normal[i], geometric_normal(scene, hit, dirs[k])));
+                ASSERT_EQ(out.view_depth[i], hit.t * dot(dirs[k], view.forward));
+            }
+            if (out.has(kSurfaceWhere)) {
                 ASSERT_EQ(out.prim[i], hit.prim);
+                ASSERT_TRUE(same_bits(out.albedo[i], terms.albedo));
                 ASSERT_TRUE(same_bits(out.position[i], view.eye + dirs[k] * hit.t));
                 ASSERT_EQ(out.diffuse[i], terms.diffuse);
                 ASSERT_EQ(out.n_dot_l[i], n_dot_l);
                 ASSERT_EQ(out.shadowed[i], 0u);
             }
         }
-        // Only the level's arrays are kept.
-        EXPECT_EQ(out.distance.size(), level >= SurfaceFields::Geometry ? out.size() : 0u);
-        EXPECT_EQ(out.position.size(), level >= SurfaceFields::All ? out.size() : 0u);
+        // Only the arrays of the fields asked for are kept.
+        EXPECT_EQ(out.object.size(), out.has(kSurfaceKeys) ? out.size() : 0u);
+        EXPECT_EQ(out.distance.size(), out.has(kSurfaceDistance) ? out.size() : 0u);
+        EXPECT_EQ(out.view_depth.size(), out.has(kSurfaceViewDepth) ? out.size() : 0u);
+        EXPECT_EQ(out.position.size(), out.has(kSurfaceWhere) ? out.size() : 0u);
     }
 }
 
@@ -137,6 +146,7 @@ TEST(ShadeSamples, LightTermsRecordEachLightAndItsShadow) {
     const std::vector<Light> lights{{Light::Kind::Directional, {0, 0, -1}, 1.0f},
                                     {Light::Kind::Directional, {0.6f, 0, -0.8f}, 0.25f}};
     const ShadingContext ctx{s, accel, settings, lights, nullptr};
+    const LookFrame look{s, settings, Vec3f(1.0f), false};
     // Straight down onto the floor: under the square (blocked) and beside it (lit).
     const Vec3f eye(0, 0, 20);
     std::vector<Vec3f> dirs{normalize(Vec3f(0, 0, -20)), normalize(Vec3f(8, 0, -20))};
@@ -150,14 +160,14 @@ TEST(ShadeSamples, LightTermsRecordEachLightAndItsShadow) {
     ASSERT_TRUE(found[0] && found[1]);
     const ViewPlane view0{side, {}, {}, {}, {1, 0, 0}, {0, 0, 1}, dirs[0]};
     SurfaceSamples out;
-    out.resize(1, SurfaceFields::All, 2);
-    shade_samples(ctx, view0, 1, dirs.data(), hits.data(), found, out, 0);
+    out.resize(1, kSurfaceAll, 2);
+    shade_samples(ctx, look, view0, 1, dirs.data(), hits.data(), found, out, 0);
     EXPECT_EQ(out.shadowed[0], 1u);  // the first light is blocked, the slanted one is not
     EXPECT_FLOAT_EQ(out.n_dot_l[0], 1.0f);
     EXPECT_FLOAT_EQ(out.n_dot_l[1], 0.8f);
     EXPECT_FLOAT_EQ(out.diffuse[0], 0.25f * 0.8f);
     const ViewPlane view1{eye, {}, {}, {}, {1, 0, 0}, {0, 1, 0}, {0, 0, -1}};
-    shade_samples(ctx, view1, 1, dirs.data() + 1, hits.data() + 1, found + 1, out, 0);
+    shade_samples(ctx, look, view1, 1, dirs.data() + 1, hits.data() + 1, found + 1, out, 0);
     EXPECT_EQ(out.shadowed[0], 0u);
     EXPECT_FLOAT_EQ(out.diffuse[0], 1.0f + 0.25f * 0.8f);
 }

@@ -220,8 +220,8 @@ constexpr Setting kSettings[] = {
      "Line width in pixels at 720 lines; scales with the image height", true,
      [](const Settings& s) -> std::optional<SettingValue> { return number(s.render.lines.width); },
      [](Settings& s, const SettingValue& v) { s.render.lines.width = as_float(v, 0, 100); }},
-    {"lines.colour", "--line-color", SettingForm::Option,
-     "Line colour r,g,b in [0,1] or #rrggbb", true,
+    {"lines.colour", "--line-color", SettingForm::Option, "Line colour r,g,b in [0,1] or #rrggbb",
+     true,
      [](const Settings& s) -> std::optional<SettingValue> {
          return format_colour(s.render.lines.colour);
      },
@@ -278,9 +278,7 @@ constexpr Setting kSettings[] = {
      [](const Settings& s) -> std::optional<SettingValue> {
          return s.render.lines.ink.width_by_depth;
      },
-     [](Settings& s, const SettingValue& v) {
-         s.render.lines.ink.width_by_depth = as_bool(v);
-     }},
+     [](Settings& s, const SettingValue& v) { s.render.lines.ink.width_by_depth = as_bool(v); }},
     // [sampling]
     {"sampling.samples", "--samples", SettingForm::Option,
      "Robust and ink: samples per pixel on a regular grid (1, 4, 9 or 16); lines and colours are "
@@ -329,9 +327,7 @@ constexpr Setting kSettings[] = {
     {"output.png_level", "--png-level", SettingForm::Option,
      "PNG compression level, 1 (fast) to 12 (small)", false,
      [](const Settings& s) -> std::optional<SettingValue> { return std::int64_t{s.png.level}; },
-     [](Settings& s, const SettingValue& v) {
-         s.png.level = static_cast<int>(as_int(v, 1, 12));
-     }},
+     [](Settings& s, const SettingValue& v) { s.png.level = static_cast<int>(as_int(v, 1, 12)); }},
     {"output.svg_hidden", "--hidden-lines,--svg-hidden", SettingForm::Flag,
      "With --svg: also write the hidden lines, in a layer of their own", true,
      [](const Settings& s) -> std::optional<SettingValue> { return s.svg_hidden; },

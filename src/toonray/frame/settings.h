@@ -53,7 +53,8 @@ struct Settings {
 
 /// A setting's value as TOML, Python and the command line give it. Text is read as the command
 /// line reads the option's text.
-using SettingValue = std::variant<bool, std::int64_t, double, std::string, std::vector<std::string>>;
+using SettingValue =
+    std::variant<bool, std::int64_t, double, std::string, std::vector<std::string>>;
 
 /// How the command line gives a setting.
 enum class SettingForm {

@@ -25,7 +25,8 @@ std::string rule_text(const toml::node& node, const std::string& at) {
     if (const auto* s = node.as_string()) return s->get();
     if (const auto* b = node.as_boolean()) return b->get() ? "yes" : "no";
     if (const auto* i = node.as_integer()) return fmt::format("{}", i->get());
-    if (const auto* f = node.as_floating_point()) return format_number(static_cast<float>(f->get()));
+    if (const auto* f = node.as_floating_point())
+        return format_number(static_cast<float>(f->get()));
     if (const auto* a = node.as_array()) {
         std::string out;
         for (const toml::node& item : *a) {
@@ -57,8 +58,8 @@ SettingValue setting_value(const toml::node& node, const std::string& at) {
 void read_table(const toml::table& table, const std::string& prefix, std::string_view source,
                 Settings& settings) {
     for (const auto& [key, node] : table) {
-        const std::string path = prefix.empty() ? std::string(key.str())
-                                                : prefix + "." + std::string(key.str());
+        const std::string path =
+            prefix.empty() ? std::string(key.str()) : prefix + "." + std::string(key.str());
         const std::string at = place(source, node.source());
         if (path == "lines.rule") {
             const toml::array* rules = node.as_array();
@@ -68,13 +69,15 @@ void read_table(const toml::table& table, const std::string& prefix, std::string
                 const toml::table& rule = *(*rules)[i].as_table();
                 std::vector<std::pair<std::string, std::string>> entries;
                 for (const auto& [rule_key, value] : rule) {
-                    const std::string key_path = fmt::format("lines.rule[{}].{}", i + 1, rule_key.str());
+                    const std::string key_path =
+                        fmt::format("lines.rule[{}].{}", i + 1, rule_key.str());
                     entries.emplace_back(
                         std::string(rule_key.str()),
                         rule_text(value, place(source, value.source()) + ": " + key_path));
                 }
-                add_line_rule(settings, entries,
-                              fmt::format("{}: lines.rule[{}]", place(source, rule.source()), i + 1));
+                add_line_rule(
+                    settings, entries,
+                    fmt::format("{}: lines.rule[{}]", place(source, rule.source()), i + 1));
             }
             continue;
         }
@@ -108,8 +111,7 @@ std::string toml_quoted(std::string_view text) {
             default:
                 if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f)
                     out += fmt::format("\\u{:04x}", static_cast<unsigned>(c));
-                else
-                    out += c;
+                else out += c;
         }
     }
     return out + "\"";
@@ -133,7 +135,8 @@ std::string toml_value(const SettingValue& v) {
                 return toml_quoted(x);
             } else {
                 std::string out = "[";
-                for (std::size_t i = 0; i < x.size(); ++i) out += (i ? ", " : "") + toml_quoted(x[i]);
+                for (std::size_t i = 0; i < x.size(); ++i)
+                    out += (i ? ", " : "") + toml_quoted(x[i]);
                 return out + "]";
             }
         },
@@ -181,8 +184,7 @@ std::string settings_toml(const Settings& settings, bool picture_only) {
         }
         if (const std::optional<SettingValue> value = s.get(settings))
             out += fmt::format("{} = {}\n", key, toml_value(*value));
-        else
-            out += fmt::format("# {} is not set: the default\n", key);
+        else out += fmt::format("# {} is not set: the default\n", key);
     }
     for (const ink::LineStyleRule& rule : settings.render.lines.ink.styles.rules) {
         out += "\n[[lines.rule]]\n";

@@ -42,9 +42,10 @@ public:
     [[nodiscard]] virtual int halo(const RenderSettings&) const { return 0; }
     /// What makes a pixel take all its samples beyond its refine key.
     [[nodiscard]] virtual RefineRule refine_rule(const RenderSettings&) const { return {}; }
-    /// The fields the lines read of each pixel's first sample, and of its other samples.
-    [[nodiscard]] virtual SurfaceFields first_fields() const { return SurfaceFields::Look; }
-    [[nodiscard]] virtual SurfaceFields rest_fields() const { return SurfaceFields::Look; }
+    /// The fields (SurfaceFields bits) the step reads of each pixel's first sample, and of its
+    /// other samples. (The sampler keeps the keys of first samples it refines by.)
+    [[nodiscard]] virtual unsigned first_fields(const RenderSettings&) const { return 0; }
+    [[nodiscard]] virtual unsigned rest_fields(const RenderSettings&) const { return 0; }
 
     /// Before the buckets.
     virtual void begin(const FrameContext&, FrameLayers&) {}

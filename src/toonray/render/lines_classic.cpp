@@ -12,7 +12,7 @@ namespace {
 class ClassicLines : public LineStep {
 public:
     int samples_per_side(const RenderSettings&) const override { return 1; }
-    SurfaceFields first_fields() const override { return SurfaceFields::Geometry; }
+    unsigned first_fields(const RenderSettings&) const override { return kSurfaceDistance; }
 
     void begin(const FrameContext& frame, FrameLayers&) override {
         const int w = frame.settings.width, h = frame.settings.height;

@@ -43,8 +43,13 @@ public:
         rule.depth_step = settings.lines.robust.depth_step * 0.5f;
         return rule;
     }
-    SurfaceFields first_fields() const override { return SurfaceFields::Geometry; }
-    SurfaceFields rest_fields() const override { return SurfaceFields::Geometry; }
+    // The fine grid: ids, view depths and geometric normals of every sample.
+    unsigned first_fields(const RenderSettings&) const override {
+        return kSurfaceKeys | kSurfaceViewDepth;
+    }
+    unsigned rest_fields(const RenderSettings&) const override {
+        return kSurfaceKeys | kSurfaceViewDepth;
+    }
 
     void begin(const FrameContext& frame, FrameLayers& out) override {
         if (!frame.settings.layers) return;

@@ -9,6 +9,7 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "toonray/render/classic.h"
 #include "toonray/render/shading.h"
 #include "toonray/render/surface.h"
 #include "toonray/scene/scene.h"
@@ -25,27 +26,53 @@ struct LookFrame {
     bool varying_albedo = false;
 };
 
-/// The fields a look needs (its own, beyond what lines and layers ask for).
-[[nodiscard]] SurfaceFields look_fields(const ShadingSettings& shading);
+/// The fields (SurfaceFields bits) a look reads after shading, beyond what lines and layers ask
+/// for.
+[[nodiscard]] unsigned look_fields(const ShadingSettings& shading);
 
-/// Colours and edge signals of samples [begin, end) of `samples`.
+/// What a look gives a sample.
+struct LookResult {
+    Vec3f colour;
+    std::uint32_t edge = 0;  ///< the edge signal (SurfaceSamples::edge)
+};
+
+/// The look of a hit on `material` with these light terms (the values its surface fields
+/// hold). Shading calls it for each sample it fills (render/shade_samples.h), with the terms
+/// still at hand.
+inline LookResult look_hit(const LookFrame& frame, std::uint32_t material, const Vec3f& albedo,
+                           std::uint8_t band, std::uint8_t accents) {
+    // Ks only counts in the highlight band: looked up only there.
+    const Vec3f ks = accents & kAccentHighlight ? frame.scene.materials[material].ks : Vec3f(0.0f);
+    LookResult out;
+    out.colour = cel_colour(frame.shading, albedo, band, accents, ks);
+    // The albedo as bytes where a texture or vertex colours vary it within a band.
+    if (frame.varying_albedo)
+        out.edge = static_cast<std::uint32_t>(to_byte(albedo.x)) |
+                   static_cast<std::uint32_t>(to_byte(albedo.y)) << 8 |
+                   static_cast<std::uint32_t>(to_byte(albedo.z)) << 16;
+    return out;
+}
+
+/// The look of a sample that sees nothing: the background.
+inline LookResult look_miss(const LookFrame& frame) { return {frame.background, 0}; }
+
+/// Colours and edge signals of samples [begin, end) of `samples`, which keep kSurfaceKeys and
+/// kSurfaceWhere (the albedo): a look applied again after shading.
 void apply_look(const LookFrame& frame, SurfaceSamples& samples, std::size_t begin,
                 std::size_t end);
 
 /// What adaptive refinement compares between two samples: whether they hit, their object and
 /// material, band and accents, and the look's edge signal. Equal keys: the look gives the same
 /// colour (up to the edge signal's resolution).
+/// Packed in two words, so that comparing keys is two loads and no branch.
 struct RefineKey {
-    std::uint32_t object, material;
-    std::uint32_t shade;  ///< hit, band and accents
-    std::uint32_t edge;
-    bool operator==(const RefineKey&) const = default;
+    std::uint64_t ids;    ///< object (high half) and material
+    std::uint64_t shade;  ///< hit, band and accents (high half) and the edge signal
 };
 [[nodiscard]] inline RefineKey refine_key(const SurfaceSamples& s, std::size_t i) {
-    return {s.object[i], s.material[i],
-            static_cast<std::uint32_t>(s.found[i]) << 16 |
-                static_cast<std::uint32_t>(s.band[i]) << 8 | s.accents[i],
-            s.edge[i]};
+    const std::uint64_t shade = static_cast<std::uint64_t>(s.found[i]) << 16 |
+                                static_cast<std::uint64_t>(s.band[i]) << 8 | s.accents[i];
+    return {static_cast<std::uint64_t>(s.object[i]) << 32 | s.material[i], shade << 32 | s.edge[i]};
 }
 
 }  // namespace toonray

@@ -31,14 +31,15 @@ LineStep& step_for(LineMode mode, const std::unique_ptr<LineStep>& classic,
     return mode == LineMode::Classic ? *classic : (mode == LineMode::Robust ? *robust : *ink);
 }
 
-// The fields of first samples: the lines', and everything when the layers are asked for.
-SurfaceFields first_fields(const LineStep& step, const RenderSettings& settings) {
-    return settings.layers ? SurfaceFields::All
-                           : std::max(step.first_fields(), look_fields(settings.shading));
+// The fields of first samples: the lines' and the look's, and everything when the layers are
+// asked for.
+unsigned first_fields(const LineStep& step, const RenderSettings& settings) {
+    if (settings.layers) return kSurfaceAll;
+    return step.first_fields(settings) | look_fields(settings.shading);
 }
 
-SurfaceFields rest_fields(const LineStep& step, const RenderSettings& settings) {
-    return std::max(step.rest_fields(), look_fields(settings.shading));
+unsigned rest_fields(const LineStep& step, const RenderSettings& settings) {
+    return step.rest_fields(settings) | look_fields(settings.shading);
 }
 
 // Whether a frame keeps strokes: the ink lines, polylines (drawn as strokes in every mode), or
@@ -152,8 +153,12 @@ void Renderer::render_buckets(const FrameContext& frame, const ShadingContext& s
     const RenderSettings& settings = frame.settings;
     const int w = settings.width, h = settings.height;
     const bool layers = settings.layers;
+    // Colours vary inside a surface and band only with textures or vertex colours.
+    bool textured = false;
+    for (std::uint32_t m = 0; m < frame.scene.materials.size(); ++m)
+        textured = textured || material_texture(shading, m) != nullptr;
     const LookFrame look{frame.scene, settings.shading, settings.background,
-                         settings.shading.textures || !frame.scene.colours.empty()};
+                         textured || !frame.scene.colours.empty()};
     SamplerFrame sampling{frame.accel,
                           shading,
                           look,

@@ -19,11 +19,10 @@ constexpr int kListWidth = 4;
 // Refined pixels are listed in blocks of this many pixels a side.
 constexpr int kBlock = 16;
 
-// The surface records of n traced samples into out[offset, offset + n), then their look.
+// The surface records and looks of n traced samples into out[offset, offset + n).
 void shade_into(const SamplerFrame& f, int n, const Vec3f* dirs, const Hit* hits, const bool* found,
                 SurfaceSamples& out, std::size_t offset) {
-    shade_samples(f.shading, f.view, n, dirs, hits, found, out, offset);
-    apply_look(f.look, out, offset, offset + static_cast<std::size_t>(n));
+    shade_samples(f.shading, f.look, f.view, n, dirs, hits, found, out, offset);
 }
 
 // Where fine-grid sample (x, y) lies on the image, in pixels.
@@ -46,9 +45,10 @@ PixelRect BucketGrid::bucket(int index) const {
 }
 
 std::uint64_t BucketSampler::bytes() const {
-    return first_.bytes() + rest_.bytes() + refine_.capacity() + first_bytes_.capacity() +
-           key_.capacity() * sizeof(RefineKey) + differs_right_.capacity() +
-           differs_below_.capacity() + no_differences_.capacity() + covered_.capacity() +
+    return first_.bytes() + rest_.bytes() + refine_.capacity() +
+           (key_ids_.capacity() + key_shade_.capacity()) * sizeof(std::uint64_t) +
+           differs_right_.capacity() + differs_below_.capacity() + no_differences_.capacity() +
+           covered_.capacity() +
            (refined_pixels_.capacity() + refined_slot_.capacity()) * sizeof(std::uint32_t) +
            (dirs_.capacity() + rest_dirs_.capacity()) * sizeof(Vec3f) +
            hits_.capacity() * sizeof(Hit) + hit_found_size_ +
@@ -56,17 +56,17 @@ std::uint64_t BucketSampler::bytes() const {
 }
 
 std::uint64_t BucketSampler::max_bytes(std::uint64_t traced, std::uint64_t decided, int sub,
-                                       SurfaceFields first_fields, SurfaceFields rest_fields,
-                                       int lights) {
+                                       unsigned first_fields, unsigned rest_fields, int lights) {
     const std::uint64_t tile_rays = static_cast<std::uint64_t>(kTile) * kTile;
     const std::uint64_t ray = sizeof(Vec3f) + sizeof(Hit) + 1;  // direction, hit, found flag
     const std::uint64_t others = static_cast<std::uint64_t>(sub) * sub - 1;
     // The rays of one traced tile and their sample columns and rows.
     std::uint64_t bytes = tile_rays * ray + 2 * kTile * sizeof(int);
-    // The first samples, with their colours as bytes and refine keys, the differences to their
-    // neighbours, whether lines cover them, and a row of no differences.
-    const std::uint64_t first = SurfaceSamples::bytes_per_sample(first_fields, lights) +
-                                sizeof(Rgb8) + sizeof(RefineKey) + 3;
+    // The first samples, with their refine keys, the differences to their neighbours, whether
+    // lines cover them, and a row of no differences.
+    const unsigned first_kept = first_fields | (sub > 1 ? kSurfaceKeys : 0u);
+    const std::uint64_t first = SurfaceSamples::bytes_per_sample(first_kept, lights) +
+                                (sub > 1 ? sizeof(RefineKey) : 0) + 3;
     bytes = add_saturated(bytes, mul_saturated(traced, first));
     bytes = add_saturated(bytes, traced);
     // Every other sample of every decided pixel (its record and its ray, four rays a row at
@@ -91,10 +91,14 @@ void BucketSampler::sample(const SamplerFrame& frame, const PixelRect& traced,
 
 void BucketSampler::trace_first(const SamplerFrame& frame) {
     const int tw = traced_.width(), th = traced_.height();
-    first_.resize(static_cast<std::size_t>(tw) * th, frame.first_fields,
+    // One sample a pixel: nothing to refine, no keys to compare; else refinement compares the
+    // first samples' keys.
+    const bool keys = sub_ > 1;
+    first_.resize(static_cast<std::size_t>(tw) * th,
+                  frame.first_fields | (keys ? kSurfaceKeys : 0u),
                   static_cast<int>(frame.shading.lights.size()));
-    resize_exact(key_, static_cast<std::size_t>(tw) * th);
-    resize_exact(first_bytes_, 3 * static_cast<std::size_t>(tw) * th);
+    resize_exact(key_ids_, keys ? static_cast<std::size_t>(tw) * th : 0);
+    resize_exact(key_shade_, keys ? static_cast<std::size_t>(tw) * th : 0);
     resize_exact(dirs_, kTile * kTile);
     resize_exact(hits_, std::max<std::size_t>(hits_.size(), kTile * kTile));
     if (hit_found_size_ < static_cast<std::size_t>(kTile * kTile)) {
@@ -116,12 +120,17 @@ void BucketSampler::trace_first(const SamplerFrame& frame) {
             for (int j = 0; j < rows; ++j) {
                 const std::size_t at = static_cast<std::size_t>(j) * cols;
                 const std::size_t to = first_index(tx, ty + j);
-                for (int i = 0; i < cols; ++i)
-                    first_.image[to + i] = image_position(columns_[i], rows_[j], sub_);
+                if (first_.has(kSurfaceWhere))
+                    for (int i = 0; i < cols; ++i)
+                        first_.image[to + i] = image_position(columns_[i], rows_[j], sub_);
                 shade_into(frame, cols, dirs_.data() + at, hits_.data() + at, hit_found_.get() + at,
                            first_, to);
-                to_bytes(&first_.colour[to].x, 3 * cols, first_bytes_.data() + 3 * to);
-                for (int i = 0; i < cols; ++i) key_[to + i] = refine_key(first_, to + i);
+                if (!keys) continue;
+                for (int i = 0; i < cols; ++i) {
+                    const RefineKey key = refine_key(first_, to + i);
+                    key_ids_[to + i] = key.ids;
+                    key_shade_[to + i] = key.shade;
+                }
             }
         }
     }
@@ -169,6 +178,14 @@ void neighbours_differ(const std::uint8_t* __restrict right, std::uint8_t left_o
     for (int x = 1; x < n; ++x) out[x] = right[x] | right[x - 1] | below[x] | above[x];
 }
 
+// out[x] = whether the refine keys of pixels x and x + offset differ, for x in [0, n): plain
+// arrays and no branch, so that the loop vectorises.
+void keys_differ(const std::uint64_t* __restrict ids, const std::uint64_t* __restrict shade,
+                 int offset, int n, std::uint8_t* __restrict out) {
+    for (int x = 0; x < n; ++x)
+        out[x] = ((ids[x] ^ ids[x + offset]) | (shade[x] ^ shade[x + offset])) != 0;
+}
+
 // pair[x] = 0 where pixel x or its partner x + offset is covered, for x in [0, n).
 void clear_covered_pairs(const std::uint8_t* __restrict covered, int offset, int n,
                          std::uint8_t* __restrict pair) {
@@ -191,14 +208,15 @@ void BucketSampler::mark_differences(const RefineRule& rule, const std::uint8_t*
     const std::size_t n = static_cast<std::size_t>(tw) * th;
     differs_right_.assign(n, 0);
     differs_below_.assign(n, 0);
-    const RefineKey* key = key_.data();
     for (int y = 0; y < th; ++y) {
         const std::size_t row = static_cast<std::size_t>(y) * tw;
+        const std::uint64_t* ids = key_ids_.data() + row;
+        const std::uint64_t* shade = key_shade_.data() + row;
         std::uint8_t* right = differs_right_.data() + row;
-        for (int x = 0; x + 1 < tw; ++x) right[x] = key[row + x] != key[row + x + 1];
+        keys_differ(ids, shade, 1, tw - 1, right);
         if (y + 1 == th) continue;
         std::uint8_t* below = differs_below_.data() + row;
-        for (int x = 0; x < tw; ++x) below[x] = key[row + x] != key[row + x + tw];
+        keys_differ(ids, shade, tw, tw, below);
         if (!rule.surface) continue;
         for (int x = 0; x + 1 < tw; ++x)
             right[x] |= normals_differ(first_, row + x, row + x + 1, rule);
@@ -252,6 +270,11 @@ void BucketSampler::decide(const SamplerFrame& frame) {
 }
 
 void BucketSampler::trace_refined(const SamplerFrame& frame) {
+    if (sub_ == 1) {  // nothing refined
+        refined_pixels_.clear();
+        rest_.resize(0, frame.rest_fields, static_cast<int>(frame.shading.lights.size()));
+        return;
+    }
     const int dw = decided_.width();
     const int per_pixel = sub_ * sub_ - 1;
     // Sized before filling (not grown), so that the buffers hold no more than they need.
@@ -283,7 +306,8 @@ void BucketSampler::trace_refined(const SamplerFrame& frame) {
         for (int j = 0; j < sub_; ++j)
             for (int i = 0; i < sub_; ++i)
                 if (i != 0 || j != 0) {
-                    rest_.image[k] = image_position(x * sub_ + i, y * sub_ + j, sub_);
+                    if (rest_.has(kSurfaceWhere))
+                        rest_.image[k] = image_position(x * sub_ + i, y * sub_ + j, sub_);
                     rest_dirs_[k++] =
                         sample_direction(frame.view, x * sub_ + i, y * sub_ + j, sub_);
                 }
@@ -310,7 +334,7 @@ void BucketSampler::resolve_colours(const PixelRect& rect, ImageRgb8& out, int o
     for (int y = rect.y0; y < rect.y1; ++y) {
         Rgb8* row = out.row(y - out_y0) + (rect.x0 - out_x0);
         const std::size_t first_row = first_index(rect.x0, y);
-        std::memcpy(row, first_bytes_.data() + 3 * first_row, 3 * rect.width());
+        to_bytes(&first_.colour[first_row].x, 3 * rect.width(), &(*row)[0]);
     }
     for (std::uint32_t p : refined_pixels_) {
         const int x = decided_.x0 + static_cast<int>(p % dw),

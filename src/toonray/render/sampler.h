@@ -68,8 +68,8 @@ struct SamplerFrame {
     int sub;            ///< samples per pixel side
     bool adaptive;      ///< false: every pixel takes all its samples
     RefineRule rule;
-    SurfaceFields first_fields = SurfaceFields::Look;  ///< kept of each pixel's first sample
-    SurfaceFields rest_fields = SurfaceFields::Look;   ///< of the other samples
+    unsigned first_fields = 0;  ///< SurfaceFields kept of each pixel's first sample
+    unsigned rest_fields = 0;   ///< of the other samples
     /// Per pixel of the image (row by row), or null: 1 where lines drawn over the frame cover
     /// the picture completely. Such pixels never take more than their first sample.
     const std::uint8_t* covered = nullptr;
@@ -100,8 +100,8 @@ public:
     /// The most bytes the buffers reach for buckets of `traced` and `decided` pixels (every
     /// decided pixel refined), with `lights` lights: for the frame's memory estimate.
     [[nodiscard]] static std::uint64_t max_bytes(std::uint64_t traced, std::uint64_t decided,
-                                                 int sub, SurfaceFields first_fields,
-                                                 SurfaceFields rest_fields, int lights);
+                                                 int sub, unsigned first_fields,
+                                                 unsigned rest_fields, int lights);
 
     /// The colours of the pixels of `rect` (within `decided`) as bytes into `out`, whose pixel
     /// (0, 0) is (out_x0, out_y0): a refined pixel's mean over its sub x sub samples, summed row
@@ -125,10 +125,10 @@ private:
     const SamplerFrame* frame_ = nullptr;
     PixelRect traced_, decided_;
     int sub_ = 1;
-    SurfaceSamples first_;                   ///< per pixel of traced_
-    std::vector<RefineKey> key_;             ///< per pixel of traced_
-    std::vector<std::uint8_t> first_bytes_;  ///< per pixel of traced_: the colour as bytes
-    std::vector<std::uint8_t> refine_;       ///< per pixel of decided_
+    SurfaceSamples first_;  ///< per pixel of traced_
+    /// Per pixel of traced_: the first sample's refine key (RefineKey), in two arrays.
+    std::vector<std::uint64_t> key_ids_, key_shade_;
+    std::vector<std::uint8_t> refine_;  ///< per pixel of decided_
     /// Per pixel of traced_: whether it differs from the pixel to its right, and below.
     std::vector<std::uint8_t> differs_right_, differs_below_;
     std::vector<std::uint8_t> no_differences_;  ///< zeros: the row above the image

@@ -1,7 +1,10 @@
 #include "toonray/render/shade_samples.h"
 
 #include <cmath>
+#include <fmt/format.h>
 #include <limits>
+
+#include "toonray/core/error.h"
 
 namespace toonray {
 namespace {
@@ -79,32 +82,86 @@ struct HitTriangle {
     }
 };
 
-// One level of fields, as a template parameter so that the per-sample loop tests nothing but
-// the hit.
-template <SurfaceFields kLevel>
-void shade_run(const ShadingContext& ctx, const ViewPlane& view, const Light* plain, int n,
-               const Vec3f* dirs, const Hit* hits, const bool* found, SurfaceSamples& out,
-               std::size_t offset) {
-    constexpr bool kGeometry = kLevel >= SurfaceFields::Geometry;
-    constexpr bool kAll = kLevel >= SurfaceFields::All;
-    const std::size_t lights = kAll ? static_cast<std::size_t>(out.light_count) : 0;
+// Where shade_run writes: the arrays of a SurfaceSamples from the first sample written, as
+// plain pointers. The byte arrays (found, band, accents) could alias anything through the
+// vectors: with restrict pointers the loop does not reload every array's address after each
+// store.
+struct Outputs {
+    std::uint8_t* __restrict found;
+    std::uint32_t* __restrict object;
+    std::uint32_t* __restrict material;
+    std::uint8_t* __restrict band;
+    std::uint8_t* __restrict accents;
+    Vec3f* __restrict albedo;
+    Vec3f* __restrict colour;
+    std::uint32_t* __restrict edge;
+    float* __restrict distance;
+    float* __restrict view_depth;
+    Vec3f* __restrict normal;
+    Vec3f* __restrict geometric_normal;
+    Vec3f* __restrict position;
+    Vec2f* __restrict uv;
+    std::uint32_t* __restrict prim;
+    Vec2f* __restrict barycentric;
+    float* __restrict diffuse;
+    float* __restrict n_dot_l;
+    std::uint32_t* __restrict shadowed;
+
+    Outputs(SurfaceSamples& s, std::size_t offset) {
+        auto at = [offset](auto& v) { return v.empty() ? nullptr : v.data() + offset; };
+        found = at(s.found);
+        object = at(s.object);
+        material = at(s.material);
+        band = at(s.band);
+        accents = at(s.accents);
+        albedo = at(s.albedo);
+        colour = at(s.colour);
+        edge = at(s.edge);
+        distance = at(s.distance);
+        view_depth = at(s.view_depth);
+        normal = at(s.normal);
+        geometric_normal = at(s.geometric_normal);
+        position = at(s.position);
+        uv = at(s.uv);
+        prim = at(s.prim);
+        barycentric = at(s.barycentric);
+        diffuse = at(s.diffuse);
+        n_dot_l = s.n_dot_l.empty() ? nullptr : s.n_dot_l.data() + offset * s.light_count;
+        shadowed = at(s.shadowed);
+    }
+};
+
+// The fields kept (SurfaceFields bits), as a template parameter so that the per-sample loop
+// tests nothing but the hit.
+template <unsigned kFields>
+void shade_run(const ShadingContext& ctx, const LookFrame& look, const ViewPlane& view,
+               const Light* plain, int n, const Vec3f* dirs, const Hit* hits, const bool* found,
+               const Outputs& out, std::size_t lights) {
+    constexpr bool kKeys = (kFields & kSurfaceKeys) != 0;
+    constexpr bool kDistance = (kFields & kSurfaceDistance) != 0;
+    constexpr bool kViewDepth = (kFields & kSurfaceViewDepth) != 0;
+    constexpr bool kAll = (kFields & kSurfaceWhere) != 0;
     HitTriangle triangle;
-    for (int k = 0; k < n; ++k) {
-        const std::size_t i = offset + static_cast<std::size_t>(k);
-        out.found[i] = found[k] ? 1 : 0;
-        if (!found[k]) {
-            out.object[i] = kNoIndex;
-            out.material[i] = kNoIndex;
-            out.band[i] = kNoBand;
-            out.accents[i] = 0;
-            out.albedo[i] = Vec3f(0.0f);
-            if constexpr (kGeometry) {
+    for (int i = 0; i < n; ++i) {
+        out.found[i] = found[i] ? 1 : 0;
+        if (!found[i]) {
+            if constexpr (kKeys) {
+                out.object[i] = kNoIndex;
+                out.material[i] = kNoIndex;
+                out.band[i] = kNoBand;
+                out.accents[i] = 0;
+                out.edge[i] = 0;
+            }
+            if constexpr (kDistance) {
                 out.distance[i] = kInf;
-                out.view_depth[i] = kInf;
                 out.normal[i] = Vec3f(0.0f);
+            }
+            if constexpr (kViewDepth) {
+                out.view_depth[i] = kInf;
                 out.geometric_normal[i] = Vec3f(0.0f);
             }
             if constexpr (kAll) {
+                out.albedo[i] = Vec3f(0.0f);
                 out.position[i] = Vec3f(0.0f);
                 out.uv[i] = {};
                 out.prim[i] = kNoIndex;
@@ -113,29 +170,38 @@ void shade_run(const ShadingContext& ctx, const ViewPlane& view, const Light* pl
                 for (std::size_t l = 0; l < lights; ++l) out.n_dot_l[i * lights + l] = 0.0f;
                 out.shadowed[i] = 0;
             }
+            out.colour[i] = look_miss(look).colour;
             continue;
         }
-        const Hit& hit = hits[k];
-        const Vec3f& dir = dirs[k];
+        const Hit& hit = hits[i];
+        const Vec3f& dir = dirs[i];
         if (hit.prim != triangle.prim) triangle.load(ctx, plain, hit.prim);
         const Vec3f normal = triangle.shading_normal(hit, dir);
-        float* n_dot_l = kAll ? out.n_dot_l.data() + i * lights : nullptr;
+        float* n_dot_l = kAll ? out.n_dot_l + i * lights : nullptr;
         const LightTerms terms =
             triangle.plain
                 ? plain_light_terms(ctx, *plain, triangle.kd, hit, view.eye, dir, normal, n_dot_l)
                 : light_terms(ctx, hit, view.eye, dir, normal, n_dot_l);
-        out.object[i] = triangle.object;
-        out.material[i] = triangle.material;
-        out.band[i] = terms.band;
-        out.accents[i] = terms.accents;
-        out.albedo[i] = terms.albedo;
-        if constexpr (kGeometry) {
+        const LookResult seen =
+            look_hit(look, triangle.material, terms.albedo, terms.band, terms.accents);
+        out.colour[i] = seen.colour;
+        if constexpr (kKeys) {
+            out.object[i] = triangle.object;
+            out.material[i] = triangle.material;
+            out.band[i] = terms.band;
+            out.accents[i] = terms.accents;
+            out.edge[i] = seen.edge;
+        }
+        if constexpr (kDistance) {
             out.distance[i] = hit.t;
-            out.view_depth[i] = hit.t * dot(dir, view.forward);
             out.normal[i] = normal;
+        }
+        if constexpr (kViewDepth) {
+            out.view_depth[i] = hit.t * dot(dir, view.forward);
             out.geometric_normal[i] = triangle.geometric_normal(dir);
         }
         if constexpr (kAll) {
+            out.albedo[i] = terms.albedo;
             out.position[i] = view.eye + dir * hit.t;
             out.uv[i] = triangle.uv(hit);
             out.prim[i] = hit.prim;
@@ -148,19 +214,30 @@ void shade_run(const ShadingContext& ctx, const ViewPlane& view, const Light* pl
 
 }  // namespace
 
-void shade_samples(const ShadingContext& ctx, const ViewPlane& view, int n, const Vec3f* dirs,
-                   const Hit* hits, const bool* found, SurfaceSamples& out, std::size_t offset) {
+void shade_samples(const ShadingContext& ctx, const LookFrame& look, const ViewPlane& view, int n,
+                   const Vec3f* dirs, const Hit* hits, const bool* found, SurfaceSamples& out,
+                   std::size_t offset) {
     const Light* plain = plain_point_light(ctx);
+    const Outputs to(out, offset);
+    const auto lights = static_cast<std::size_t>(out.light_count);
+    // The sets of fields the line modes keep, each its own loop; any other, everything.
     switch (out.fields) {
-        case SurfaceFields::Look:
-            return shade_run<SurfaceFields::Look>(ctx, view, plain, n, dirs, hits, found, out,
-                                                  offset);
-        case SurfaceFields::Geometry:
-            return shade_run<SurfaceFields::Geometry>(ctx, view, plain, n, dirs, hits, found, out,
-                                                      offset);
-        case SurfaceFields::All:
-            return shade_run<SurfaceFields::All>(ctx, view, plain, n, dirs, hits, found, out,
-                                                 offset);
+        case 0: return shade_run<0>(ctx, look, view, plain, n, dirs, hits, found, to, lights);
+        case kSurfaceKeys:
+            return shade_run<kSurfaceKeys>(ctx, look, view, plain, n, dirs, hits, found, to,
+                                           lights);
+        case kSurfaceDistance:
+            return shade_run<kSurfaceDistance>(ctx, look, view, plain, n, dirs, hits, found, to,
+                                               lights);
+        case kSurfaceKeys | kSurfaceViewDepth:
+            return shade_run<kSurfaceKeys | kSurfaceViewDepth>(ctx, look, view, plain, n, dirs,
+                                                               hits, found, to, lights);
+        default: {
+            SurfaceSamples& all = out;
+            if (all.fields != kSurfaceAll)
+                throw Error(fmt::format("shading: no loop for the fields {}", all.fields));
+            return shade_run<kSurfaceAll>(ctx, look, view, plain, n, dirs, hits, found, to, lights);
+        }
     }
 }
 
