@@ -6,6 +6,7 @@
 #include <string>
 
 #include "support/test_support.h"
+#include "toonray/io/file.h"
 
 using namespace toonray;
 
@@ -162,4 +163,15 @@ TEST(Settings, TheInkModeRefusesDepthLinesAskedByName) {
         << message;
     s.render.lines.types = kLineAll;  // all: every type the mode has
     EXPECT_NO_THROW(check_settings(s));
+}
+
+TEST(Settings, TheDocsListEveryKeyWithItsOption) {
+    const std::string doc = read_file(std::string(TOONRAY_DOCS_DIR) + "/settings.md");
+    for (const Setting& s : settings_table()) {
+        EXPECT_NE(doc.find("| `" + std::string(s.key) + "` |"), std::string::npos) << s.key;
+        if (!s.flag.empty()) {
+            const std::string flag(s.flag.substr(0, s.flag.find(',')));
+            EXPECT_NE(doc.find("`" + flag + "`"), std::string::npos) << flag;
+        }
+    }
 }
