@@ -88,9 +88,20 @@ std::vector<std::string> as_list(const SettingValue& v) {
 
 SettingValue number(float v) { return static_cast<double>(v); }
 
-std::optional<SettingValue> limit_value(const std::optional<std::string>& text) {
+// A limit is kept as its text ("4G"), checked when set.
+template <std::optional<std::string> LimitSettings::*kLimit>
+std::optional<SettingValue> get_limit(const Settings& s) {
+    const std::optional<std::string>& text = s.limits.*kLimit;
     if (!text) return std::nullopt;
     return SettingValue(*text);
+}
+
+template <std::optional<std::string> LimitSettings::*kLimit,
+          std::uint64_t (*kParse)(std::string_view)>
+void set_limit(Settings& s, const SettingValue& v) {
+    const std::string text = as_text(v);
+    (void)kParse(text);
+    s.limits.*kLimit = text;
 }
 
 // ---- The table -------------------------------------------------------------------------------
@@ -336,43 +347,20 @@ constexpr Setting kSettings[] = {
      "With --svg: the cel-shaded colours as an embedded PNG under the lines", true,
      [](const Settings& s) -> std::optional<SettingValue> { return s.svg_fill; },
      [](Settings& s, const SettingValue& v) { s.svg_fill = as_bool(v); }},
-    // [limits]
-    {"limits.triangles", "--max-triangles", SettingForm::Option,
-     "Largest scene, in triangles (default 50000000; k, M, G suffixes)", false,
-     [](const Settings& s) { return limit_value(s.limits.triangles); },
-     [](Settings& s, const SettingValue& v) {
-         s.limits.triangles = as_text(v);
-         (void)parse_count(*s.limits.triangles);
-     }},
+    // [limits]: the help given on the command line is limit_help's, with the defaults.
+    {"limits.triangles", "--max-triangles", SettingForm::Option, "Largest scene, in triangles",
+     false, get_limit<&LimitSettings::triangles>,
+     set_limit<&LimitSettings::triangles, parse_count>},
     {"limits.vertices", "--max-vertices", SettingForm::Option,
-     "Most OBJ v, vn and vt statements, each (default 100000000)", false,
-     [](const Settings& s) { return limit_value(s.limits.vertices); },
-     [](Settings& s, const SettingValue& v) {
-         s.limits.vertices = as_text(v);
-         (void)parse_count(*s.limits.vertices);
-     }},
+     "Most OBJ v, vn and vt statements, each", false, get_limit<&LimitSettings::vertices>,
+     set_limit<&LimitSettings::vertices, parse_count>},
     {"limits.image_pixels", "--max-image-pixels", SettingForm::Option,
-     "Largest image, width x height (default 67108864 = 8192x8192)", false,
-     [](const Settings& s) { return limit_value(s.limits.image_pixels); },
-     [](Settings& s, const SettingValue& v) {
-         s.limits.image_pixels = as_text(v);
-         (void)parse_count(*s.limits.image_pixels);
-     }},
-    {"limits.memory", "--max-memory", SettingForm::Option,
-     "Memory the estimate of a run may reach (frame buffers and scenes of all frames in "
-     "flight), e.g. 4G (default: 3/4 of physical memory)",
-     false, [](const Settings& s) { return limit_value(s.limits.memory); },
-     [](Settings& s, const SettingValue& v) {
-         s.limits.memory = as_text(v);
-         (void)parse_bytes(*s.limits.memory);
-     }},
-    {"limits.input_size", "--max-input-size", SettingForm::Option,
-     "Largest input file: OBJ, MTL, score, camera path (default 2 GiB)", false,
-     [](const Settings& s) { return limit_value(s.limits.input_size); },
-     [](Settings& s, const SettingValue& v) {
-         s.limits.input_size = as_text(v);
-         (void)parse_bytes(*s.limits.input_size);
-     }},
+     "Largest image, width x height", false, get_limit<&LimitSettings::image_pixels>,
+     set_limit<&LimitSettings::image_pixels, parse_count>},
+    {"limits.memory", "--max-memory", SettingForm::Option, "Memory the estimate of a run may reach",
+     false, get_limit<&LimitSettings::memory>, set_limit<&LimitSettings::memory, parse_bytes>},
+    {"limits.input_size", "--max-input-size", SettingForm::Option, "Largest input file", false,
+     get_limit<&LimitSettings::input_size>, set_limit<&LimitSettings::input_size, parse_bytes>},
 };
 
 }  // namespace
