@@ -295,6 +295,8 @@ TEST(Renderer, LayersAreFilledOnlyWhenAskedAndChangeNothingElse) {
         // The same renderer, asked and then not: nothing of the earlier frame's layers shows.
         with.render(s, accel, cam, lights, settings);
         EXPECT_EQ(with.layers().distance.size(), 0u);
+        EXPECT_EQ(with.layers().cel.size(), 0u);
+        EXPECT_EQ(with.layers().lines.size(), 0u);
         EXPECT_TRUE(with.layers().line_types.empty());
     }
 }

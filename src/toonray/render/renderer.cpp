@@ -133,6 +133,10 @@ const ImageRgb8& Renderer::render(const Scene& scene, const TriangleAccel& accel
     const ShadingContext shading{scene, accel, settings.shading, lights, textures};
     layers_.mode = settings.lines.mode;
     layers_.line_types.clear();
+    if (!settings.layers) {  // nothing of an earlier frame's layers stays
+        layers_.cel.reshape(0, 0);
+        layers_.lines.reshape(0, 0);
+    }
     if (keeps_strokes(scene, settings)) {
         ink::draw_ink_lines(scene, accel, camera, settings.width, settings.height,
                             ink_settings(settings), settings.threads, ink_);
