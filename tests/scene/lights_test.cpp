@@ -25,10 +25,10 @@ TEST(LightsFile, ParsesPointAndDirectionalLightsWithComments) {
         EXPECT_NE(std::string(e.what()).find("l.txt:2: unknown light 'spot'"), std::string::npos)
             << e.what();
     }
-    EXPECT_THROW(parse_lights("point 1 2\n", "l.txt"), Error);
-    EXPECT_THROW(parse_lights("directional 0 0 0\n", "l.txt"), Error);
-    EXPECT_THROW(parse_lights("point 1 2 3 -1\n", "l.txt"), Error);
-    EXPECT_THROW(parse_lights("# nothing\n", "l.txt"), Error);
+    EXPECT_THROW((void)parse_lights("point 1 2\n", "l.txt"), Error);
+    EXPECT_THROW((void)parse_lights("directional 0 0 0\n", "l.txt"), Error);
+    EXPECT_THROW((void)parse_lights("point 1 2 3 -1\n", "l.txt"), Error);
+    EXPECT_THROW((void)parse_lights("# nothing\n", "l.txt"), Error);
 }
 
 TEST(LightsFile, LoadsAFileAndNamesItInErrors) {
@@ -47,7 +47,7 @@ TEST(LightsFile, LoadsAFileAndNamesItInErrors) {
                   std::string::npos)
             << e.what();
     }
-    EXPECT_THROW(load_lights(dir.path / "missing.lights"), Error);
+    EXPECT_THROW((void)load_lights(dir.path / "missing.lights"), Error);
 }
 
 TEST(LightsFile, ASceneFileHasTheLightsFileOfItsName) {
