@@ -101,6 +101,7 @@ std::vector<std::uint8_t> encode_exr(int width, int height, std::span<const ExrC
         throw Error(fmt::format("EXR encoding failed: {}", e.what()));
     }
 #else
+    static_cast<void>(attributes);
     throw Error(
         "EXR feature images are not available: this toonray was built without OpenEXR "
         "(TOONRAY_WITH_OPENEXR off)");
