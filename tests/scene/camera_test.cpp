@@ -155,3 +155,126 @@ TEST(ParseCameraSpec, MessagesQuoteTheText) {
     EXPECT_EQ(error_of("1,2,x"), "camera '1,2,x': malformed number");
     EXPECT_EQ(error_of("1;2"), "camera '1;2': expected ',' between numbers");
 }
+
+TEST(ViewPlane, LensShiftMovesThePlaneWithinItself) {
+    const CameraSpec straight{{0, 0, 2}, {0, 0, 1}, {0, 1, 0}};
+    CameraSpec shifted = straight;
+    shifted.shift = {0.25f, -0.1f};
+    const ViewPlane a = make_view_plane(straight, 200, 100), b = make_view_plane(shifted, 200, 100);
+    // A quarter of the width (2) right and a tenth of it down; the same plane and directions.
+    expect_near(b.upper_left, a.upper_left + Vec3f(0.5f, -0.2f, 0.0f));
+    expect_near(b.step_x, a.step_x);
+    expect_near(b.step_y, a.step_y);
+    expect_near(b.forward, a.forward);
+    expect_near(b.right, a.right);
+    expect_near(b.up, a.up);
+    EXPECT_EQ(camera_error({{0, 0, 0}, {0, 0, -1}, {0, 1, 0}, {NAN, 0}}),
+              "invalid camera: lens shift nan,0 (finite, at most 100 image widths)");
+    EXPECT_EQ(camera_error({{0, 0, 0}, {0, 0, -1}, {0, 1, 0}, {0, 101}}),
+              "invalid camera: lens shift 0,101 (finite, at most 100 image widths)");
+}
+
+TEST(LensCamera, BlendersFieldOfViewRule) {
+    LensCamera lens;
+    lens.eye = {1, 2, 3};
+    lens.target = {1, 2, -7};  // looking down -Z from 10 units away
+    lens.up = {0, 1, 0.5f};    // not orthogonal to the view: straightened
+    lens.focal_length = 50;
+    lens.sensor_width = 36;
+    lens.sensor_height = 24;
+    auto distance = [](const CameraSpec& c) { return length(c.gaze - c.eye); };
+    // AUTO, landscape: the sensor width spans the width, tan(fov_x / 2) = 36 / 100.
+    CameraSpec c = lens_camera(lens, 1920, 1080);
+    EXPECT_NEAR(distance(c), 100.0f / 36.0f, 1e-5f);
+    expect_near(c.eye, lens.eye);
+    expect_near(c.up, {0, 1, 0});
+    expect_near((c.gaze - c.eye) / distance(c), {0, 0, -1});
+    // AUTO, portrait: the sensor width spans the height.
+    c = lens_camera(lens, 1080, 1920);
+    EXPECT_NEAR(distance(c), 1.0f / (0.36f * 1080.0f / 1920.0f), 1e-4f);
+    // VERTICAL: the sensor height spans the height.
+    lens.fit = SensorFit::Vertical;
+    c = lens_camera(lens, 1920, 1080);
+    EXPECT_NEAR(distance(c), 1.0f / (0.24f * 1920.0f / 1080.0f), 1e-4f);
+    // HORIZONTAL on a portrait frame: still the width.
+    lens.fit = SensorFit::Horizontal;
+    c = lens_camera(lens, 1080, 1920);
+    EXPECT_NEAR(distance(c), 100.0f / 36.0f, 1e-5f);
+    // A vertical field of view of 60 degrees: tan(fov_x / 2) = tan(30) * 16 / 9.
+    lens.vertical_fov = 60.0f;
+    c = lens_camera(lens, 1920, 1080);
+    EXPECT_NEAR(distance(c), 1.0f / (std::tan(3.14159265f / 6) * 16.0f / 9.0f), 1e-5f);
+    // The rendered plane spans the field of view: its top edge is 30 degrees up.
+    const ViewPlane v = make_view_plane(c, 1920, 1080);
+    const Vec3f top = normalize(v.pixel_point(960, 0) - c.eye);
+    EXPECT_NEAR(std::acos(dot(top, v.forward)) * 180.0f / 3.14159265f, 30.0f, 1e-3f);
+}
+
+TEST(LensCamera, ShiftIsInUnitsOfTheFittedSide) {
+    LensCamera lens;
+    lens.eye = {0, 0, 0};
+    lens.target = {0, 0, -1};
+    lens.shift = {0.1f, 0.2f};
+    // Fitted horizontally: units of the width, as the spec's.
+    CameraSpec c = lens_camera(lens, 400, 200);
+    EXPECT_FLOAT_EQ(c.shift.x, 0.1f);
+    EXPECT_FLOAT_EQ(c.shift.y, 0.2f);
+    // Fitted vertically (portrait AUTO): units of the height, twice the width here.
+    c = lens_camera(lens, 200, 400);
+    EXPECT_FLOAT_EQ(c.shift.x, 0.2f);
+    EXPECT_FLOAT_EQ(c.shift.y, 0.4f);
+    // The shifted view's centre pixel looks where the shift says: 0.1 widths right and 0.2
+    // widths up at the plane's distance.
+    c = lens_camera(lens, 400, 200);
+    const ViewPlane v = make_view_plane(c, 400, 200);
+    const Vec3f centre = v.pixel_point(200, 100) - c.eye;
+    const float d = length(c.gaze - c.eye);
+    expect_near(centre, {0.2f, 0.4f, -d});
+}
+
+TEST(LensCamera, PixelAspectStretchesThePlaneVertically) {
+    LensCamera lens;
+    lens.eye = {0, 0, 0};
+    lens.target = {0, 0, -1};
+    lens.pixel_aspect = 2.0f;  // pixels twice as tall as wide: 200x100 shows a 1:1 frame
+    const CameraSpec c = lens_camera(lens, 200, 100);
+    const ViewPlane v = make_view_plane(c, 200, 100);
+    EXPECT_NEAR(length(v.step_y), 2.0f * length(v.step_x), 1e-6f);
+    // The displayed frame is square (AUTO fits horizontally): 36 mm across both ways.
+    EXPECT_NEAR(length(c.gaze - c.eye), 100.0f / 36.0f, 1e-5f);
+}
+
+TEST(LensCamera, InvalidLensesAreErrors) {
+    auto error = [](LensCamera lens, int w = 100, int h = 100) {
+        try {
+            (void)lens_camera(lens, w, h);
+        } catch (const Error& e) {
+            return std::string(e.what());
+        }
+        return std::string("(valid)");
+    };
+    LensCamera lens;
+    lens.eye = {0, 0, 0};
+    lens.target = {0, 0, -1};
+    EXPECT_EQ(error(lens), "(valid)");
+    LensCamera bad = lens;
+    bad.focal_length = 0;
+    EXPECT_EQ(error(bad), "invalid camera: focal length 0 mm (must be positive)");
+    bad = lens;
+    bad.sensor_width = -1;
+    EXPECT_EQ(error(bad), "invalid camera: sensor size -1 mm (must be positive)");
+    bad = lens;
+    bad.vertical_fov = 180.0f;
+    EXPECT_EQ(error(bad),
+              "invalid camera: vertical field of view 180 degrees (must be in (0, 180))");
+    bad = lens;
+    bad.target = bad.eye;
+    EXPECT_EQ(error(bad), "invalid camera: eye and target are the same point");
+    bad = lens;
+    bad.up = {0, 0, 1};
+    EXPECT_EQ(error(bad), "invalid camera: up vector is zero or parallel to the view direction");
+    bad = lens;
+    bad.pixel_aspect = 0;
+    EXPECT_EQ(error(bad), "invalid camera: pixel aspect 0 (must be positive)");
+    EXPECT_EQ(error(lens, 0, 10), "invalid camera: image size 0x10");
+}

@@ -3,6 +3,7 @@
 #include <charconv>
 #include <cmath>
 #include <fmt/format.h>
+#include <numbers>
 #include <vector>
 
 #include "toonray/core/error.h"
@@ -13,6 +14,12 @@ namespace toonray {
 void validate_camera(const CameraSpec& camera) {
     if (!is_finite(camera.eye) || !is_finite(camera.gaze) || !is_finite(camera.up))
         throw Error("invalid camera: eye, gaze and up must be finite");
+    if (!(std::abs(camera.shift.x) <= kMaxCameraShift) ||
+        !(std::abs(camera.shift.y) <= kMaxCameraShift))
+        throw Error(
+            fmt::format("invalid camera: lens shift {:g},{:g} (finite, at most {:g} "
+                        "image widths)",
+                        camera.shift.x, camera.shift.y, kMaxCameraShift));
     // In double precision, so that large values cannot overflow into a camera that passes here
     // and yields NaN rays in make_view_plane's float arithmetic.
     const double vx = double{camera.gaze.x} - camera.eye.x,
@@ -56,6 +63,10 @@ ViewPlane make_view_plane(const CameraSpec& camera, int width, int height) {
     const float ratio = static_cast<float>(height) / static_cast<float>(width);
     Vec3f center = camera.eye + view_dir;
     Vec3f right = normalize(side);
+    // Only a shifted camera moves the centre, so that unshifted views keep the seed's exact
+    // arithmetic.
+    if (camera.shift.x != 0.0f || camera.shift.y != 0.0f)
+        center = center + right * (2.0f * camera.shift.x) + camera.up * (2.0f * camera.shift.y);
     Vec3f up_vec = camera.up * ratio;
     Vec3f ul = center + up_vec - right;
     Vec3f ur = center + up_vec + right;
@@ -110,6 +121,67 @@ CameraSpec auto_camera(std::span<const Vec3f> points, int width, int height) {
     cam.gaze = cam.eye + forward * view_len;
     cam.up = up;
     return cam;
+}
+
+CameraSpec lens_camera(const LensCamera& lens, int width, int height) {
+    if (width <= 0 || height <= 0)
+        throw Error(fmt::format("invalid camera: image size {}x{}", width, height));
+    if (!(lens.pixel_aspect > 0.0f) || !std::isfinite(lens.pixel_aspect))
+        throw Error(
+            fmt::format("invalid camera: pixel aspect {:g} (must be positive)", lens.pixel_aspect));
+    if (!is_finite(lens.eye) || !is_finite(lens.target) || !is_finite(lens.up))
+        throw Error("invalid camera: eye, target and up must be finite");
+    // In double precision: the displayed frame is width x (height * pixel_aspect).
+    const double displayed_w = static_cast<double>(width),
+                 displayed_h = static_cast<double>(height) * lens.pixel_aspect;
+    const double aspect = displayed_w / displayed_h;
+    double tan_x = 0.0;
+    bool fitted_horizontally = true;
+    if (lens.vertical_fov) {
+        const double fov = *lens.vertical_fov;
+        if (!(fov > 0.0 && fov < 180.0))
+            throw Error(fmt::format(
+                "invalid camera: vertical field of view {:g} degrees (must be in (0, 180))", fov));
+        tan_x = std::tan(fov * std::numbers::pi / 360.0) * aspect;
+        fitted_horizontally = aspect >= 1.0;
+    } else {
+        if (!(lens.focal_length > 0.0f) || !std::isfinite(lens.focal_length))
+            throw Error(fmt::format("invalid camera: focal length {:g} mm (must be positive)",
+                                    lens.focal_length));
+        const float sensor =
+            lens.fit == SensorFit::Vertical ? lens.sensor_height : lens.sensor_width;
+        if (!(sensor > 0.0f) || !std::isfinite(sensor))
+            throw Error(
+                fmt::format("invalid camera: sensor size {:g} mm (must be positive)", sensor));
+        fitted_horizontally = lens.fit == SensorFit::Horizontal ||
+                              (lens.fit == SensorFit::Auto && displayed_w >= displayed_h);
+        tan_x = double{sensor} / (2.0 * lens.focal_length);
+        if (!fitted_horizontally) tan_x *= aspect;
+    }
+    if (!(tan_x > 0.0) || !std::isfinite(tan_x))
+        throw Error("invalid camera: the field of view is not finite");
+    const Vec3f view = lens.target - lens.eye;
+    const float view_len = length(view);
+    if (!(view_len > 0.0f) || !std::isfinite(view_len))
+        throw Error("invalid camera: eye and target are the same point");
+    const Vec3f forward = view / view_len;
+    const Vec3f up = lens.up - forward * dot(lens.up, forward);
+    const float up_len = length(up);
+    if (!(up_len > static_cast<float>(kMinUpSine) * length(lens.up)) || !std::isfinite(up_len))
+        throw Error("invalid camera: up vector is zero or parallel to the view direction");
+    CameraSpec camera;
+    camera.eye = lens.eye;
+    camera.gaze = lens.eye + forward * static_cast<float>(1.0 / tan_x);
+    // |up| = pixel aspect: the plane's height is then (height / width) * pixel aspect of its
+    // width, the displayed frame's.
+    camera.up = up * (lens.pixel_aspect / up_len);
+    // The shift is in units of the fitted side; the spec's in units of the displayed width,
+    // its vertical part along `up` as given (of length pixel_aspect).
+    const double side = fitted_horizontally ? 1.0 : 1.0 / aspect;
+    camera.shift = {static_cast<float>(lens.shift.x * side),
+                    static_cast<float>(lens.shift.y * side / lens.pixel_aspect)};
+    validate_camera(camera);
+    return camera;
 }
 
 CameraSpec parse_camera_spec(const std::string& text) {
