@@ -87,3 +87,20 @@ TEST(SceneSource, AutoSmoothGivesNormalsToEveryCorner) {
     for (const auto& corners : frame.scene.tri_normals)
         for (std::uint32_t n : corners) EXPECT_NE(n, kNoIndex);
 }
+
+TEST(SceneSource, ChooseLightsSettingsThenOwnThenDefault) {
+    toonray::Scene scene;
+    scene.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+    scene.add_triangle({0, 1, 2}, 0, 0);
+    const toonray::CameraSpec camera{{0, 0, 5}, {0, 0, 4}, {0, 1, 0}};
+    const toonray::Light own{toonray::Light::Kind::Directional, {0, 0, -1}, 0.5f};
+    const toonray::Light given{toonray::Light::Kind::Point, {1, 2, 3}, 1.0f};
+    toonray::SceneSetup setup;
+    EXPECT_EQ(toonray::choose_lights(scene, camera, {}, setup),
+              std::vector<toonray::Light>{toonray::default_light(scene, camera)});
+    EXPECT_EQ(toonray::choose_lights(scene, camera, {own}, setup),
+              std::vector<toonray::Light>{own});
+    setup.lights = {given};
+    EXPECT_EQ(toonray::choose_lights(scene, camera, {own}, setup),
+              std::vector<toonray::Light>{given});
+}

@@ -16,12 +16,17 @@ CameraSpec choose_camera(const Scene& scene, const SceneSetup& setup) {
     return auto_camera(used, setup.width, setup.height);
 }
 
+std::vector<Light> choose_lights(const Scene& scene, const CameraSpec& camera,
+                                 std::vector<Light> own_lights, const SceneSetup& setup) {
+    if (!setup.lights.empty()) return setup.lights;
+    if (!own_lights.empty()) return own_lights;
+    return {default_light(scene, camera)};
+}
+
 void finish_scene(SceneFrame& frame, std::vector<Light> own_lights, const SceneSetup& setup) {
     if (setup.auto_smooth) auto_smooth(frame.scene, *setup.auto_smooth);
     frame.camera = choose_camera(frame.scene, setup);
-    if (!setup.lights.empty()) frame.lights = setup.lights;
-    else if (!own_lights.empty()) frame.lights = std::move(own_lights);
-    else frame.lights.assign(1, default_light(frame.scene, frame.camera));
+    frame.lights = choose_lights(frame.scene, frame.camera, std::move(own_lights), setup);
 }
 
 ObjFileSource::ObjFileSource(std::filesystem::path path, SceneSetup setup, ObjOptions obj)

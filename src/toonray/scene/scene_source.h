@@ -41,9 +41,15 @@ struct SceneFrame {
 /// automatic camera framing the vertices that triangles and polylines use (auto_camera).
 [[nodiscard]] CameraSpec choose_camera(const Scene& scene, const SceneSetup& setup);
 
+/// The lights a frame is lit by: setup.lights when given, else `own_lights` (the scene's lights
+/// file or glTF lights) when there are any, else the default light (default_light) for
+/// `camera`.
+[[nodiscard]] std::vector<Light> choose_lights(const Scene& scene, const CameraSpec& camera,
+                                               std::vector<Light> own_lights,
+                                               const SceneSetup& setup);
+
 /// The steps after loading or posing, in this order: auto-smooth; the camera (choose_camera);
-/// the lights: setup.lights when given, else `own_lights` (the scene's lights file or glTF
-/// lights) when there are any, else the default light (default_light) for that camera.
+/// the lights (choose_lights).
 void finish_scene(SceneFrame& frame, std::vector<Light> own_lights, const SceneSetup& setup);
 
 /// Frames of a scene, loaded or posed by number.

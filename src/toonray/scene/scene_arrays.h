@@ -1,0 +1,56 @@
+#pragma once
+/// Scenes built from arrays rather than read from files: meshes given as positions, triangles
+/// and optional attributes (the Python module's numpy arrays, the Blender engine's evaluated
+/// meshes), placed in the world by a transform.
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <string_view>
+
+#include "toonray/core/limits.h"
+#include "toonray/core/math.h"
+#include "toonray/scene/scene.h"
+
+namespace toonray {
+
+/// A triangle mesh as arrays, in its own coordinates. Per-corner attributes follow the
+/// triangles: corner k of triangle t is entry 3 t + k.
+struct MeshArrays {
+    std::span<const Vec3f> positions;
+    std::span<const std::array<std::uint32_t, 3>> triangles;  ///< indices into positions
+    std::span<const Vec3f> normals;  ///< none, one per position, or one per corner
+    std::span<const Vec2f> uvs;      ///< none, one per position, or one per corner
+    /// None (every triangle has the default material, 0), or one per triangle: an index into
+    /// the scene's materials.
+    std::span<const std::uint32_t> materials;
+};
+
+/// An affine transform from a mesh's coordinates to the world, 3 rows of a 4x4 matrix whose
+/// last row is 0 0 0 1: p' = M (p, 1).
+using Affine = std::array<std::array<double, 4>, 3>;
+
+inline constexpr Affine kIdentityAffine{{{1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, 1, 0}}};
+
+/// Checks a mesh on its own: every index within the positions, attribute counts of none, one
+/// per position or one per corner, finite values, materials below `material_count`. Throws
+/// Error("mesh 'NAME': what is wrong").
+void check_mesh(const MeshArrays& mesh, std::size_t material_count, std::string_view name);
+
+/// Appends `mesh` (checked with check_mesh) placed by `to_world` as a new object named `name`;
+/// returns the object's index. Positions are transformed in double precision and rounded to
+/// float once (the identity copies them exactly); normals are transformed by the inverse
+/// transpose and normalised. A mirroring transform (negative determinant) reverses each
+/// triangle's corners so that its winding still faces where its normals do. Throws Error for a
+/// transform that is not finite or is singular, and Error or LimitError when the scene would
+/// need more than 32-bit indices.
+std::uint32_t append_mesh(Scene& scene, const MeshArrays& mesh, const Affine& to_world,
+                          std::string name);
+
+/// Throws LimitError when `scene` has more triangles or vertex positions than `limits` allow
+/// (max_triangles, max_vertices), in the words of the loaders: "the scene has N triangles, more
+/// than the limit of M".
+void check_scene_limits(const Scene& scene, const Limits& limits);
+
+}  // namespace toonray
