@@ -224,3 +224,54 @@ TEST(FrameBytes, CountTheRendererAndTheEncodingWithRoomToSpare) {
     o.settings.width = o.settings.height = 2147483647;
     EXPECT_EQ(frame_bytes(o), UINT64_MAX);
 }
+
+TEST(FrameRenderer, InMemoryFramesAreTheFilesItWrites) {
+    // What the Python module and the Blender engine take from render_layers, frame_svg and
+    // frame_png_options is what render writes, byte for byte, in every mode.
+    test_support::TempDir dir("frame_memory");
+    const Scene teapot = load("teapot.obj");
+    FrameOptions files;
+    files.settings.width = 160;
+    files.settings.height = 90;
+    files.svg = dir.path / "frame.svg";
+    files.svg_hidden = true;
+    files.svg_fill = true;
+    files.record = {"toonray test", "settings text"};
+    FrameOptions memory = files;
+    memory.svg.reset();
+    memory.keep_layers = true;
+    memory.keep_strokes = true;
+    for (LineMode mode : {LineMode::Classic, LineMode::Robust, LineMode::Ink}) {
+        files.settings.lines.mode = memory.settings.lines.mode = mode;
+        const SceneFrame frame = frame_of(teapot, files);
+        FrameRenderer writer, keeper;
+        Warnings w;
+        writer.render(frame, dir.path / "frame.png", files, w);
+        const FrameLayers& layers =
+            keeper.render_layers(frame.scene, frame.camera, frame.lights, memory, w);
+        EXPECT_EQ(frame_svg(layers, memory), read_file(dir.path / "frame.svg"));
+        const std::vector<std::uint8_t> png = encode_png(
+            layers.image.width(), layers.image.height(), 3,
+            reinterpret_cast<const std::uint8_t*>(layers.image.data()), frame_png_options(memory));
+        const std::string written = read_file(dir.path / "frame.png");
+        ASSERT_EQ(png.size(), written.size()) << line_mode_name(mode);
+        EXPECT_EQ(0, std::memcmp(png.data(), written.data(), png.size()));
+        // Every layer is kept, and the strokes.
+        EXPECT_EQ(layers.distance.size(), layers.image.size());
+        EXPECT_FALSE(layers.line_types.empty());
+        ASSERT_NE(layers.strokes, nullptr);
+        EXPECT_FALSE(layers.strokes->strokes.empty());
+    }
+    // Without them asked, neither is kept in a mode that does not need them.
+    FrameOptions plain;
+    plain.settings.width = 160;
+    plain.settings.height = 90;
+    plain.settings.lines.mode = LineMode::Robust;
+    const SceneFrame frame = frame_of(teapot, plain);
+    FrameRenderer fr;
+    Warnings w;
+    const FrameLayers& layers = fr.render_layers(frame.scene, frame.camera, frame.lights, plain, w);
+    EXPECT_EQ(layers.distance.size(), 0u);
+    EXPECT_EQ(layers.strokes, nullptr);
+    EXPECT_THROW((void)frame_svg(layers, plain), Error);
+}

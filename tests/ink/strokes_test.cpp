@@ -56,6 +56,18 @@ TEST(ChainPieces, TypesAndVisibilityDoNotMix) {
     EXPECT_FALSE(strokes[2].visible);
 }
 
+TEST(ChainPieces, StrokesNameTheSegmentTheyStartedFrom) {
+    // Segments 7 and 8 chain into one stroke started from the first piece; 9 is of another type.
+    const std::vector<EdgePiece> pieces{piece(7, {0, 0}, {10, 0}, 0, 1),
+                                        piece(8, {10, 0}, {20, 0}, 1, 2),
+                                        piece(9, {20, 0}, {30, 0}, 2, 3, EdgeType::Border)};
+    const auto strokes = ink::chain_pieces(pieces, plain());
+    ASSERT_EQ(strokes.size(), 2u);
+    EXPECT_EQ(strokes[0].segment, 7u);
+    EXPECT_EQ(strokes[1].segment, 9u);
+    EXPECT_EQ(strokes[1].type, EdgeType::Border);
+}
+
 TEST(ChainPieces, JunctionContinuesWithTheStraightestPiece) {
     // A line through vertex 1 with a branch leaving it at 90 degrees.
     const std::vector<EdgePiece> pieces{piece(0, {0, 0}, {10, 0}, 0, 1),

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 #include <string_view>
+#include <thread>
 #include <vector>
 
 #include "toonray/io/png.h"
@@ -422,4 +423,71 @@ TEST(Renderer, InkLinesAreTheCoverageOverTheCelColours) {
     const ImageRgb8 bare =
         one.render(s, accel, cam, test_support::default_lights(s, cam), settings);
     EXPECT_EQ(0, std::memcmp(bare.data(), one.layers().cel.data(), bare.size() * sizeof(Rgb8)));
+}
+
+TEST(Renderer, ProgressCountsEveryBucket) {
+    Scene s = load("teapot.obj");
+    RenderSettings settings;
+    settings.width = 200;
+    settings.height = 100;
+    settings.sampling.tile_size = 32;  // 7 x 4 buckets
+    CameraSpec cam = framing_camera(s, settings);
+    TriangleAccel accel;
+    accel.build(s.positions, s.tri_positions);
+    Renderer with, without;
+    RenderProgress progress;
+    const ImageRgb8 a = with.render(s, accel, cam, test_support::default_lights(s, cam), settings,
+                                    nullptr, &progress);
+    EXPECT_EQ(progress.buckets.load(), 28u);
+    EXPECT_EQ(progress.buckets_done.load(), 28u);
+    // Following a frame changes nothing in it.
+    const ImageRgb8& b =
+        without.render(s, accel, cam, test_support::default_lights(s, cam), settings);
+    ASSERT_EQ(0, std::memcmp(a.data(), b.data(), a.size() * 3));
+}
+
+TEST(Renderer, CancelStopsTheFrameAndTheNextFrameIsWhole) {
+    Scene s = load("teapot.obj");
+    RenderSettings settings;
+    settings.width = 640;
+    settings.height = 360;
+    settings.sampling.tile_size = 8;  // 3600 buckets: the stopper sees the first few done
+    settings.threads = 2;
+    settings.layers = true;
+    CameraSpec cam = framing_camera(s, settings);
+    TriangleAccel accel;
+    accel.build(s.positions, s.tri_positions);
+    const auto lights = test_support::default_lights(s, cam);
+    for (LineMode mode : {LineMode::Classic, LineMode::Robust, LineMode::Ink}) {
+        settings.lines.mode = mode;
+        Renderer r, reference;
+        // Cancelled before it starts: nothing is rendered.
+        RenderProgress cancelled;
+        cancelled.cancel = true;
+        EXPECT_THROW(r.render(s, accel, cam, lights, settings, nullptr, &cancelled),
+                     RenderCancelled);
+        EXPECT_EQ(cancelled.buckets_done.load(), 0u);
+        // Cancelled while its buckets render: a thread stops it once a few are done.
+        RenderProgress progress;
+        std::thread stopper([&] {
+            while (progress.buckets_done.load() < 3) std::this_thread::yield();
+            progress.cancel = true;
+        });
+        bool threw = false;
+        try {
+            r.render(s, accel, cam, lights, settings, nullptr, &progress);
+        } catch (const RenderCancelled& e) {
+            threw = true;
+            EXPECT_STREQ(e.what(), "rendering cancelled");
+        }
+        stopper.join();
+        ASSERT_TRUE(threw) << line_mode_name(mode);
+        EXPECT_EQ(progress.buckets.load(), 3600u);
+        EXPECT_LT(progress.buckets_done.load(), 3600u);
+        // The same renderer renders the next frame whole, as a fresh one does.
+        const ImageRgb8 a = r.render(s, accel, cam, lights, settings);
+        const ImageRgb8& b = reference.render(s, accel, cam, lights, settings);
+        ASSERT_EQ(0, std::memcmp(a.data(), b.data(), a.size() * 3)) << line_mode_name(mode);
+        ASSERT_TRUE(test_support::same_layers(r.layers(), reference.layers()));
+    }
 }

@@ -14,9 +14,9 @@
 namespace toonray {
 RenderSettings FrameOptions::render_settings() const {
     RenderSettings s = settings;
-    const bool svg_asked = svg.has_value() || svg_dir.has_value();
+    const bool svg_asked = svg.has_value() || svg_dir.has_value() || keep_strokes;
     // The SVG's fill is the cel layer.
-    s.layers = aov_dir.has_value() || aov_exr.has_value() || (svg_asked && svg_fill);
+    s.layers = aov_dir.has_value() || aov_exr.has_value() || (svg_asked && svg_fill) || keep_layers;
     s.strokes = svg_asked;
     s.hidden_lines = svg_asked && svg_hidden;
     return s;
@@ -45,11 +45,18 @@ bool frame_complete(const std::filesystem::path& output, const FrameOptions& opt
     }
 }
 
-namespace {
+PngOptions frame_png_options(const FrameOptions& options) {
+    PngOptions png = options.png;
+    if (!options.record.software.empty())
+        png.text.emplace_back("Software", options.record.software);
+    if (!options.record.settings.empty())
+        png.text.emplace_back("toonray settings", options.record.settings);
+    return png;
+}
 
-// The strokes of the frame as SVG, written atomically.
-void write_svg(const FrameLayers& layers, const RenderSettings& settings,
-               const FrameOptions& options, const std::filesystem::path& path) {
+std::string frame_svg(const FrameLayers& layers, const FrameOptions& options) {
+    if (!layers.strokes) throw Error("the frame kept no strokes for an SVG");
+    const RenderSettings settings = options.render_settings();
     const ink::InkLines& lines = *layers.strokes;
     ink::SvgSettings svg;
     svg.width = settings.width;
@@ -66,12 +73,8 @@ void write_svg(const FrameLayers& layers, const RenderSettings& settings,
             encode_png(cel.width(), cel.height(), 3,
                        reinterpret_cast<const std::uint8_t*>(cel.data()), options.png));
     }
-    const std::string text = ink::svg_text(lines.strokes, svg);
-    write_file_atomic(path,
-                      std::span(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()));
+    return ink::svg_text(lines.strokes, svg);
 }
-
-}  // namespace
 
 std::filesystem::path aov_path(const std::filesystem::path& dir,
                                const std::filesystem::path& output, std::string_view name) {
@@ -106,7 +109,7 @@ std::uint64_t frame_bytes(const FrameOptions& options) {
     if (options.aov_dir)  // one feature image at a time, encoded
         total = add_saturated(total, mul_saturated(pixels, feature_image_bytes_per_pixel()));
     if (options.aov_exr) total = add_saturated(total, feature_exr_bytes(pixels));
-    if (options.svg || options.svg_dir) {
+    if (options.svg || options.svg_dir || options.keep_strokes) {
         // The ink line layer of an SVG asked of another mode (coverage and style), and the
         // embedded fill: its PNG and the base64 text, within twice the RGB pixels.
         const std::uint64_t per_pixel =
@@ -117,24 +120,30 @@ std::uint64_t frame_bytes(const FrameOptions& options) {
     return add_saturated(total, total / 5);
 }
 
-void FrameRenderer::render(const SceneFrame& frame, const std::filesystem::path& output,
-                           const FrameOptions& options, Warnings& warnings) {
-    const Scene& scene = frame.scene;
+const FrameLayers& FrameRenderer::render_layers(const Scene& scene, const CameraSpec& camera,
+                                                std::span<const Light> lights,
+                                                const FrameOptions& options, Warnings& warnings,
+                                                RenderProgress* progress) {
     const RenderSettings settings = options.render_settings();
-    // Validate the camera before any work so a bad one fails with nothing written.
-    validate_camera(frame.camera);
-    if (options.aov_exr && !exr_available())
-        throw Error("EXR feature images are not available: this toonray was built without OpenEXR");
+    // Validate the camera before any work so a bad one fails with nothing done.
+    validate_camera(camera);
     const TriangleAccel& accel = accel_.update(scene, options.bvh);
     const TextureSet* textures =
         settings.shading.textures ? &textures_.load(scene, warnings) : nullptr;
-    renderer_.render(scene, accel, frame.camera, frame.lights, settings, textures);
-    const FrameLayers& layers = renderer_.layers();
-    PngOptions png = options.png;
-    if (!options.record.software.empty())
-        png.text.emplace_back("Software", options.record.software);
-    if (!options.record.settings.empty())
-        png.text.emplace_back("toonray settings", options.record.settings);
+    renderer_.render(scene, accel, camera, lights, settings, textures, progress);
+    return renderer_.layers();
+}
+
+void FrameRenderer::render(const SceneFrame& frame, const std::filesystem::path& output,
+                           const FrameOptions& options, Warnings& warnings) {
+    const RenderSettings settings = options.render_settings();
+    // Checked before any work so that a frame that cannot be written fails with nothing written.
+    validate_camera(frame.camera);
+    if (options.aov_exr && !exr_available())
+        throw Error("EXR feature images are not available: this toonray was built without OpenEXR");
+    const FrameLayers& layers =
+        render_layers(frame.scene, frame.camera, frame.lights, options, warnings);
+    const PngOptions png = frame_png_options(options);
     if (options.aov_dir) {
         std::filesystem::create_directories(*options.aov_dir);
         FeatureBytes bytes;
@@ -156,7 +165,9 @@ void FrameRenderer::render(const SceneFrame& frame, const std::filesystem::path&
     }
     if (const auto svg_path = options.svg_path(output)) {
         if (options.svg_dir && !options.svg) std::filesystem::create_directories(*options.svg_dir);
-        write_svg(layers, settings, options, *svg_path);
+        const std::string text = frame_svg(layers, options);
+        write_file_atomic(
+            *svg_path, std::span(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()));
     }
     write_png(output, layers.image, png);
 }

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 
@@ -40,6 +41,11 @@ struct FrameOptions {
     std::optional<std::filesystem::path> svg_dir;
     /// The SVG also holds the cel-shaded picture (without lines) as an embedded PNG under them.
     bool svg_fill = false;
+    /// Outputs kept in memory rather than written (FrameRenderer::render_layers; the Python
+    /// module and the Blender engine): every layer of the frame, and the strokes of its SVG
+    /// (frame_svg), with hidden lines when svg_hidden.
+    bool keep_layers = false;
+    bool keep_strokes = false;
     Bvh::Config bvh;
     PngOptions png;
     /// Recorded in every PNG (tEXt chunks "Software" and "toonray settings"), in the EXR's
@@ -77,6 +83,14 @@ void check_exr_sequence(const std::filesystem::path& aov_exr);
 /// Saturates at UINT64_MAX.
 [[nodiscard]] std::uint64_t frame_bytes(const FrameOptions& options);
 
+/// The PNG options a frame's images are written with: `options.png` with the record's text
+/// chunks ("Software", "toonray settings").
+[[nodiscard]] PngOptions frame_png_options(const FrameOptions& options);
+
+/// The SVG document of a rendered frame's strokes, exactly as FrameRenderer::render writes it.
+/// The frame must have kept its strokes (options.svg, svg_dir or keep_strokes).
+[[nodiscard]] std::string frame_svg(const FrameLayers& layers, const FrameOptions& options);
+
 class FrameRenderer {
 public:
     /// Renders a scene source's frame (scene/scene_source.h) to `output` (and, with
@@ -85,6 +99,15 @@ public:
     /// texture problems are appended to `warnings`.
     void render(const SceneFrame& frame, const std::filesystem::path& output,
                 const FrameOptions& options, Warnings& warnings);
+
+    /// Renders a frame into memory and writes nothing: the BVH (refitted when the triangles
+    /// are those of the last frame), the textures, and the picture with the layers and strokes
+    /// `options` asks for (render_settings()). The result is valid until the next call. Throws
+    /// Error for a bad camera; with `progress`, RenderCancelled when it is cancelled
+    /// (Renderer::render).
+    const FrameLayers& render_layers(const Scene& scene, const CameraSpec& camera,
+                                     std::span<const Light> lights, const FrameOptions& options,
+                                     Warnings& warnings, RenderProgress* progress = nullptr);
 
     [[nodiscard]] const Renderer& renderer() const { return renderer_; }
     [[nodiscard]] const AnimationAccel& accel() const { return accel_; }

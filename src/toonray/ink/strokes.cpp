@@ -50,6 +50,7 @@ struct Link {
     EndpointKey key0, key1;
     std::uint16_t style;
     Vec3f w0, w1;  // the ends in the world
+    std::uint32_t segment;
 };
 
 // Which points Douglas-Peucker keeps, into `keep` (resized to the points).
@@ -164,8 +165,8 @@ std::vector<Stroke> chain_pieces(std::span<const EdgePiece> pieces, const ChainS
             const std::uint16_t style = p.segment < segment_styles.size()
                                             ? segment_styles[p.segment][visible[k] ? 0 : 1]
                                             : 0;
-            links.push_back(
-                {p.type, visible[k] != 0, p.s0, p.s1, p.key0, p.key1, style, p.p0, p.p1});
+            links.push_back({p.type, visible[k] != 0, p.s0, p.s1, p.key0, p.key1, style, p.p0, p.p1,
+                             p.segment});
         }
         i = j;
     }
@@ -261,6 +262,7 @@ std::vector<Stroke> chain_pieces(std::span<const EdgePiece> pieces, const ChainS
         stroke.type = first.type;
         stroke.visible = first.visible;
         stroke.style = first.style;
+        stroke.segment = first.segment;
         stroke.closed = closed;
         simplified(spaced, settings.simplify, keep);
         const auto kept = static_cast<std::size_t>(std::count(keep.begin(), keep.end(), true));

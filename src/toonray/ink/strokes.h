@@ -21,6 +21,9 @@ struct Stroke {
     /// Per point, its distance from the eye (world units) when ChainSettings::eye is set,
     /// else empty: for widths by depth.
     std::vector<float> depth;
+    /// The segment of the piece the stroke was started from: its object and material
+    /// (style_source_triangle, ink.h), which the Python module reports per stroke.
+    std::uint32_t segment = 0;
 };
 
 /// Per segment, the style index of its visible pieces [0] and of its hidden pieces [1].

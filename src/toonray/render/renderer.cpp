@@ -126,7 +126,12 @@ std::uint64_t frame_buffer_bytes(const RenderSettings& settings, int lights) {
 
 const ImageRgb8& Renderer::render(const Scene& scene, const TriangleAccel& accel,
                                   const CameraSpec& camera, std::span<const Light> lights,
-                                  const RenderSettings& settings, const TextureSet* textures) {
+                                  const RenderSettings& settings, const TextureSet* textures,
+                                  RenderProgress* progress) {
+    auto check_cancel = [progress] {
+        if (progress && progress->cancel.load(std::memory_order_relaxed)) throw RenderCancelled();
+    };
+    check_cancel();
     const ViewPlane view = make_view_plane(camera, settings.width, settings.height);
     LineStep& step = step_for(settings.lines.mode, classic_, robust_, ink_lines_);
     const FrameContext frame{scene, accel, camera, view, settings, step.samples_per_side(settings)};
@@ -144,8 +149,10 @@ const ImageRgb8& Renderer::render(const Scene& scene, const TriangleAccel& accel
     } else {
         layers_.strokes = nullptr;
     }
+    check_cancel();
     step.begin(frame, layers_);
-    render_buckets(frame, shading, step);
+    render_buckets(frame, shading, step, progress);
+    check_cancel();
     step.finish(frame, layers_);
     if (settings.lines.mode != LineMode::Ink && !scene.polylines.empty())
         strokes_over_picture(settings);
@@ -153,7 +160,7 @@ const ImageRgb8& Renderer::render(const Scene& scene, const TriangleAccel& accel
 }
 
 void Renderer::render_buckets(const FrameContext& frame, const ShadingContext& shading,
-                              LineStep& step) {
+                              LineStep& step, RenderProgress* progress) {
     const RenderSettings& settings = frame.settings;
     const int w = settings.width, h = settings.height;
     const bool layers = settings.layers;
@@ -192,9 +199,14 @@ void Renderer::render_buckets(const FrameContext& frame, const ShadingContext& s
     const int halo = step.halo(settings);
     const BucketGrid grid{w, h, std::max(settings.sampling.tile_size, 1)};
     std::atomic<std::uint64_t> refined{0};
+    if (progress) {
+        progress->buckets_done = 0;
+        progress->buckets = static_cast<std::uint32_t>(grid.count());
+    }
     parallel_for(grid.count(), 1, settings.threads, [&](int begin, int end) {
         BucketSampler& sampler = buffers_->local().sampler;
         for (int index = begin; index < end; ++index) {
+            if (progress && progress->cancel.load(std::memory_order_relaxed)) return;
             Bucket bucket;
             bucket.pixels = grid.bucket(index);
             bucket.decided = bucket.pixels.grown(halo, w, h);
@@ -224,6 +236,7 @@ void Renderer::render_buckets(const FrameContext& frame, const ShadingContext& s
                     out.refined(x, y) = all ? 1 : 0;
                 }
             refined += count;
+            if (progress) progress->buckets_done.fetch_add(1, std::memory_order_relaxed);
         }
     });
     refined_pixels_ = refined;

@@ -4,11 +4,13 @@
 /// (render/sampler.h), its samples get their surface record and look, and the mode's line step
 /// (render/line_step.h) turns them into pixels.
 
+#include <atomic>
 #include <cstdint>
 #include <memory>
 #include <span>
 
 #include "toonray/accel/triangle_accel.h"
+#include "toonray/core/error.h"
 #include "toonray/core/image.h"
 #include "toonray/core/parallel.h"
 #include "toonray/ink/ink.h"
@@ -42,6 +44,22 @@ class LineStep;
 /// only polylines are drawn.
 [[nodiscard]] ink::InkSettings ink_settings(const RenderSettings& settings);
 
+/// Lets another thread follow a frame while it renders, and stop it (the Python module and the
+/// Blender engine poll it). Progress counts the frame's buckets, most of its work.
+struct RenderProgress {
+    std::atomic<std::uint32_t> buckets{0};       ///< of the frame, set when they start
+    std::atomic<std::uint32_t> buckets_done{0};  ///< finished so far
+    /// Set to stop the frame: buckets not yet started are skipped and render throws
+    /// RenderCancelled. Render leaves it set.
+    std::atomic<bool> cancel{false};
+};
+
+/// What Renderer::render throws when its RenderProgress::cancel was set.
+class RenderCancelled : public Error {
+public:
+    RenderCancelled() : Error("rendering cancelled") {}
+};
+
 /// Renders frames, keeping its buffers between calls so an animation allocates once.
 class Renderer {
 public:
@@ -54,10 +72,12 @@ public:
     /// scene/scene_source.h), and its layers as settings asks. `textures` are the decoded
     /// textures of the scene's materials (null: none). Never throws for a valid scene, camera
     /// and settings; the camera must already have been validated (make_view_plane throws on a
-    /// bad one).
+    /// bad one). With `progress`, counts its buckets there and throws RenderCancelled, leaving
+    /// the layers incomplete, when its cancel flag is set before the frame is done.
     const ImageRgb8& render(const Scene& scene, const TriangleAccel& accel,
                             const CameraSpec& camera, std::span<const Light> lights,
-                            const RenderSettings& settings, const TextureSet* textures = nullptr);
+                            const RenderSettings& settings, const TextureSet* textures = nullptr,
+                            RenderProgress* progress = nullptr);
 
     /// The last frame's picture, layers and strokes.
     [[nodiscard]] const FrameLayers& layers() const { return layers_; }
@@ -74,7 +94,7 @@ public:
 private:
     struct Buffers;
     void render_buckets(const struct FrameContext& frame, const ShadingContext& shading,
-                        LineStep& step);
+                        LineStep& step, RenderProgress* progress);
     void strokes_over_picture(const RenderSettings& settings);
 
     FrameLayers layers_;
