@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Formats the C++ sources (src, apps, tests, bench, fuzz) with clang-format-14 and the
+# Formats the C++ sources (src, apps, python, tests, bench, fuzz) with clang-format-14 and the
 # repository's .clang-format, in place.
 #
 #   bash scripts/format.sh           format every file in place
@@ -27,7 +27,7 @@ case "${1:-}" in
     ;;
 esac
 
-mapfile -t files < <(git ls-files -- src apps tests bench fuzz | grep -E '\.(cpp|h|inl)$')
+mapfile -t files < <(git ls-files --cached --others --exclude-standard -- src apps python tests bench fuzz | grep -E '\.(cpp|h|inl)$')
 
 if [ "$check" = 0 ]; then
   "$clang_format" -i --style=file "${files[@]}"
