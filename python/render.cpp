@@ -242,6 +242,27 @@ void bind_render(py::module_& m) {
             },
             "The picture, (height, width, 4) uint8, rows from the top, alpha 255.")
         .def_property_readonly(
+            "layer_names",
+            [](const FrameData& f) {
+                std::vector<std::string> names;
+                for (const FeatureLayers::Layer& layer : f.layers.channels)
+                    names.push_back(layer.name);
+                return names;
+            },
+            "The names of the frame's layers (render(layers=True)), in the EXR's order.")
+        .def(
+            "layer",
+            [](const FrameData& f, const std::string& name) {
+                const FeatureLayers::Layer* layer = f.layers.find(name);
+                if (!layer)
+                    throw py::key_error(
+                        fmt::format("the frame has no layer '{}' (frame.layer_names lists them; "
+                                    "render(layers=True) keeps them)",
+                                    name));
+                return image_array(layer->values.data(), f.width, f.height);
+            },
+            py::arg("name"), "One layer as a (height, width) float32 array (frame.layers[name]).")
+        .def_property_readonly(
             "layers",
             [](const FrameData& f) {
                 py::dict out;

@@ -60,6 +60,10 @@ class Frames(unittest.TestCase):
         for line_type in toonray.line_layers("ink"):
             self.assertIn("lines." + line_type, layers)
         self.assertEqual(layers["Z"].shape, (80, 120))
+        self.assertEqual(frame.layer_names, list(layers))
+        self.assertTrue((frame.layer("lines.all") == layers["lines.all"]).all())
+        with self.assertRaises(KeyError):
+            frame.layer("no such layer")
         self.assertEqual(layers["Z"].dtype, np.float32)
         ids = frame.object_ids
         self.assertEqual(ids.dtype, np.uint32)
@@ -164,7 +168,7 @@ class ProgressAndCancel(unittest.TestCase):
         seen = []
         settings = {"sampling.samples": 16, "sampling.adaptive": False, "sampling.tile_size": 8,
                     "render.threads": 1}
-        toonray.render(scene, 640, 480, settings, progress=lambda f: seen.append(f))
+        toonray.render(scene, 1280, 960, settings, progress=lambda f: seen.append(f))
         self.assertEqual(seen[-1], 1.0)
         self.assertEqual(seen, sorted(seen))
         self.assertGreater(len(seen), 2, "the callback is called while the frame renders")
