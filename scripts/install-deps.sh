@@ -22,6 +22,9 @@ demo_packages=(
   libtinygltf-dev nlohmann-json3-dev libstb-dev libopenexr-dev
   # the settings document (TOML), read with toml++ as a header-only library
   libtomlplusplus-dev
+  # the Python module (python/, docs/python.md) and so the Blender render engine: the system
+  # Python's headers, pybind11, and numpy, which the module's arrays are
+  python3-dev pybind11-dev python3-numpy
   # media: video encoding and the piano sound
   ffmpeg fluid-soundfont-gm
 )
@@ -40,6 +43,9 @@ test_packages=(
   librsvg2-bin
   # Blender's glTF exporter needs numpy; EXR files are read back by a second tool (oiiotool)
   python3-numpy openimageio-tools
+  # the render engine's viewport in a real Blender window without a display: a virtual X
+  # server and Mesa's software OpenGL
+  xvfb xauth libgl1-mesa-dri
 )
 # Cross building for 64-bit ARM: the libraries toonray and its unit tests link, for arm64.
 aarch64_packages=(

@@ -1,5 +1,10 @@
 """toonray add-on for Blender 3.4 and newer (docs/blender.md).
 
+The toonray render engine (``bl_idname`` "TOONRAY", engine.py): F12, animations and the viewport
+render in process through the toonray Python module (module.py finds it), with Blender's passes,
+line sets and an SVG per frame. Registered when the module loads; the tools below work without
+it.
+
 Two operators:
 
 - File > Export > toonray OBJ sequence: ``bpy.ops.export_scene.toonray_obj_sequence`` writes
@@ -19,23 +24,25 @@ bl_info = {
     "author": "toonray",
     "version": (1, 0, 0),
     "blender": (3, 4, 0),
-    "location": "File > Export > toonray OBJ sequence; Object > Animation > Animate Piano Keys",
-    "description": "Export OBJ sequences with toonray's camera block; animate piano keys from "
-                   "a toonray note script",
-    "category": "Import-Export",
+    "location": "Render Engine > toonray; File > Export > toonray OBJ sequence; "
+                "Object > Animation > Animate Piano Keys",
+    "description": "The toonray render engine (toon shading, ink lines, SVG); OBJ sequences "
+                   "with toonray's camera block; piano keys from a toonray note script",
+    "category": "Render",
 }
 
 if "bpy" in locals():  # reload (F3 > Reload Scripts)
     import importlib
 
-    for _m in (note_script, camera, lights, exporter, keys):  # noqa: F821
+    for _m in (note_script, camera, lights, exporter, keys, module, sync,  # noqa: F821
+               properties, engine, preview, ui):  # noqa: F821
         importlib.reload(_m)
 
 import bpy
 from bpy.props import (BoolProperty, EnumProperty, FloatProperty, IntProperty, StringProperty)
 from bpy.types import Operator
 
-from . import camera, exporter, keys, lights, note_script  # noqa: F401
+from . import camera, exporter, keys, lights, module, note_script  # noqa: F401
 
 
 class TOONRAY_OT_export_obj_sequence(Operator):
@@ -183,14 +190,34 @@ def _menu_animation(self, context):
 _classes = (TOONRAY_OT_export_obj_sequence, TOONRAY_OT_keys_from_notes)
 
 
+_engine_registered = False
+
+
 def register():
+    global _engine_registered
     for c in _classes:
         bpy.utils.register_class(c)
     bpy.types.TOPBAR_MT_file_export.append(_menu_export)
     bpy.types.VIEW3D_MT_object_animation.append(_menu_animation)
+    tr = module.load()
+    if tr is None:
+        print("toonray: the render engine is not available: %s" % module.import_error)
+        return
+    from . import engine, properties, ui
+    properties.register(tr)
+    bpy.utils.register_class(engine.ToonrayRenderEngine)
+    ui.register()
+    _engine_registered = True
 
 
 def unregister():
+    global _engine_registered
+    if _engine_registered:
+        from . import engine, properties, ui
+        ui.unregister()
+        bpy.utils.unregister_class(engine.ToonrayRenderEngine)
+        properties.unregister()
+        _engine_registered = False
     bpy.types.VIEW3D_MT_object_animation.remove(_menu_animation)
     bpy.types.TOPBAR_MT_file_export.remove(_menu_export)
     for c in reversed(_classes):

@@ -57,12 +57,15 @@ def light_weight(kind, energy, position, axis, centre):
 def scene_lights(objects, centre, global_scale=1.0):
     """[(kind, vector, intensity, name)] in OBJ coordinates for the evaluated light objects
     (those that render), with intensities as the module docstring says."""
+    return light_entries(((obj.name, obj.data, obj.matrix_world) for obj in objects
+                          if obj.type == "LIGHT"), centre, _obj_axes, global_scale)
+
+
+def light_entries(lights, centre, axes=lambda v: tuple(v), global_scale=1.0):
+    """scene_lights for (name, light data, world matrix) triples: the render engine's instanced
+    lights in Blender coordinates (axes: identity), the exporter's in OBJ coordinates."""
     found = []
-    for obj in objects:
-        if obj.type != "LIGHT":
-            continue
-        data = obj.data
-        m = obj.matrix_world
+    for name, data, m in lights:
         position = [m[i][3] for i in range(3)]
         axis = [-m[i][2] for i in range(3)]
         n = math.sqrt(sum(c * c for c in axis))
@@ -71,12 +74,12 @@ def scene_lights(objects, centre, global_scale=1.0):
         axis = [c / n for c in axis]
         weight = light_weight(data.type, data.energy, position, axis, centre)
         if data.type == "SUN":
-            vector = _obj_axes(axis)
+            vector = axes(axis)
             kind = "directional"
         else:
-            vector = tuple(c * global_scale for c in _obj_axes(position))
+            vector = tuple(c * global_scale for c in axes(position))
             kind = "point"
-        found.append([kind, vector, weight, obj.name, data.type])
+        found.append([kind, vector, weight, name, data.type])
     brightest = max((f[2] for f in found), default=0.0)
     for f in found:
         f[2] = f[2] / brightest if brightest > 0 else 0.0
