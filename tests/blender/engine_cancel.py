@@ -1,7 +1,8 @@
 """Cancel and errors in a real Blender render (engine_test.sh): the engine's render stops within
 a second of Blender's break (Esc: RenderEngine.test_break, which the engine asks through
 _stop_requested, replaced here), the result is ended and Blender goes on rendering; a render
-that fails (a settings limit) is reported and Blender goes on.
+that fails (a settings limit) is reported and Blender goes on; the settings document exported
+and imported gives the same properties and line sets.
 
     blender -b WORK/parity.blend --python engine_cancel.py
 """
@@ -85,6 +86,36 @@ check(len(reports) == 1 and "more than the limit of 10 (limits.triangles raises 
 scene.toonray.use_limits__triangles = False
 bpy.ops.render.render()
 check(True, "Blender rendered again after the failed frame")
+
+# The settings document out and back in: the Render properties and the line sets.
+import os
+import tempfile
+
+with tempfile.TemporaryDirectory() as folder:
+    path = os.path.join(folder, "look.toml")
+    settings = scene.toonray
+    settings.lines__width = 3.5
+    settings.lines__mode = "robust"
+    line_set = bpy.context.view_layer.toonray.line_sets.add()
+    line_set.objects = "Box,Sphere"
+    line_set.visibility = "HIDDEN"
+    line_set.use_dash = True
+    line_set.dash = "4,2"
+    bpy.ops.toonray.settings_export(filepath=path)
+    with open(path) as f:
+        text = f.read()
+    check("width = 3.5" in text and 'mode = "robust"' in text and 'dash = "4,2"' in text
+          and 'size = "160x120"' in text, "the exported document has the settings and the rule")
+    settings.lines__width = 1.0
+    settings.lines__mode = "ink"
+    bpy.context.view_layer.toonray.line_sets.clear()
+    bpy.ops.toonray.settings_import(filepath=path)
+    sets = bpy.context.view_layer.toonray.line_sets
+    check(settings.lines__width == 3.5 and settings.lines__mode == "robust",
+          "importing it sets the properties back")
+    check(len(sets) == 1 and sets[0].objects == "Box,Sphere" and sets[0].visibility == "HIDDEN"
+          and sets[0].use_dash and sets[0].dash == "4,2" and not sets[0].use_taper,
+          "and its rule becomes the line set again")
 
 if failures:
     sys.exit(1)

@@ -7,7 +7,8 @@
   both show as surfaces, and every colour either shows is one the other shows too (the same
   bands of the same objects);
 - complex: the IndexOB pass of complex.blend (copied to an EXR of its own by oiiotool) shows every
-  object's pass index, each instanced object's too;
+  object's pass index, each instanced object's too, and not those of an object hidden for the
+  render or excluded; a holdout object's pixels have alpha 0 in Combined;
 - anim: -a wrote three frames and three SVGs with visible and hidden layers.
 
     blender -b --factory-startup --python engine_check.py -- WORK
@@ -101,10 +102,16 @@ def complex_scene():
     scene_file = os.path.join(work, "complex_indices.json")
     with open(scene_file) as f:
         wanted = json.load(f)
-    index = exr_channel(os.path.join(work, "complex_index.exr"))
-    seen = set(np.unique(np.rint(index)).astype(int).tolist())
-    for name, value in sorted(wanted.items(), key=lambda kv: kv[1]):
+    index = np.rint(exr_channel(os.path.join(work, "complex_index.exr"))).astype(int)
+    alpha = exr_channel(os.path.join(work, "complex_alpha.exr"))
+    seen = set(np.unique(index).tolist())
+    for name, value in sorted(wanted["seen"].items(), key=lambda kv: kv[1]):
         check(value in seen, "object %s (pass index %d) is in the IndexOB pass" % (name, value))
+    for name, value in sorted(wanted["left_out"].items()):
+        check(value not in seen, "object %s (pass index %d) is not rendered" % (name, value))
+    holdout = index == wanted["seen"]["Holdout"]
+    check(holdout.any() and (alpha[holdout] == 0).all() and (alpha[index == 1] == 1).all(),
+          "the holdout's pixels are transparent in Combined, the others opaque")
 
 
 def anim():

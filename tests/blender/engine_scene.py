@@ -5,8 +5,9 @@
   Standard view transform and no dither, so that the engine's PNG holds toonray's bytes. Its
   settings are exported as look.toml for the command line.
 - complex.blend: a subdivided cube (modifier), a text object, two linked duplicates of one mesh,
-  a collection of a cone and a bevelled curve instanced twice by empties, a metaball; each
-  object has its own pass index; 200x150.
+  a collection of a cone and a bevelled curve instanced twice by empties, a metaball; a cube
+  hidden for the render, one whose toonray usage is Exclude and a holdout cube; each object has
+  its own pass index; 200x150.
 
     blender -b --python engine_scene.py -- WORK
 """
@@ -140,13 +141,27 @@ def build_complex():
         scene.collection.objects.link(empty)
     bpy.ops.object.metaball_add(type="BALL", radius=0.5, location=(-2.0, 1.6, 0.5))
     tag(bpy.context.object, "Meta")
+    # Objects the render must leave out, or make transparent.
+    left_out = {}
+    for name, location in (("Hidden", (0.0, -1.0, 1.5)), ("Excluded", (-1.0, 1.0, 1.5)),
+                           ("Holdout", (1.2, 0.2, 1.4))):
+        bpy.ops.mesh.primitive_cube_add(size=0.5, location=location)
+        obj = bpy.context.object
+        obj.name = name
+        obj.pass_index = 20 + len(left_out)
+        left_out[name] = obj.pass_index
+    bpy.data.objects["Hidden"].hide_render = True
+    bpy.data.objects["Excluded"].toonray.usage = "EXCLUDE"
+    bpy.data.objects["Holdout"].is_holdout = True
+    index["Holdout"] = left_out["Holdout"]
     bpy.ops.object.light_add(type="SUN", rotation=(0.5, 0.2, 0.4))
     camera(scene, (6.0, -7.0, 5.0), (0.0, 0.2, 0.3), lens=30.0)
     scene.view_layers[0].use_pass_object_index = True
     scene.render.image_settings.file_format = "OPEN_EXR_MULTILAYER"
     import json
     with open(os.path.join(work, "complex_indices.json"), "w") as f:
-        json.dump(index, f)
+        json.dump({"seen": index, "left_out": {k: v for k, v in left_out.items()
+                                                if k != "Holdout"}}, f)
     bpy.ops.wm.save_as_mainfile(filepath=os.path.join(work, "complex.blend"))
 
 

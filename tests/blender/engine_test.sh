@@ -78,6 +78,7 @@ s.toonray.output__svg_hidden = True
 # Every object of the complex scene in the IndexOB pass.
 run_blender complex.log -b complex.blend -E TOONRAY -o "$work/engine/complex_####" -f 1
 oiiotool engine/complex_0001.exr --ch "ViewLayer.IndexOB.X" --chnames Y -d float -o complex_index.exr
+oiiotool engine/complex_0001.exr --ch "ViewLayer.Combined.A" --chnames Y -d float -o complex_alpha.exr
 
 # A frame that fails from the command line: reported with the library's message, and Blender
 # ends normally with exit status 1 (a failed render; no crash, which would be a signal).
