@@ -1,9 +1,10 @@
 """A Blender scene as a toonray scene, in process (docs/blender.md, "Scene data").
 
-- Geometry: every entry of ``depsgraph.object_instances`` (modifiers evaluated; linked
-  duplicates, collection instances and particles included) whose object has a surface: meshes
-  directly, text, curves, surfaces and metaballs through their evaluated meshes
-  (``Object.to_mesh``).
+- Geometry: every mesh entry of ``depsgraph.object_instances`` (modifiers evaluated; linked
+  duplicates, collection instances and particles included). Text, curves, surfaces and
+  metaballs come as mesh entries too: Blender (3.0 and newer) lists such an object once as
+  itself and once as the mesh it evaluates to, whose ``original`` is the object; only the mesh
+  is read, so nothing is read twice.
 - Each unique mesh is uploaded once (``calc_loop_triangles`` and ``foreach_get`` into numpy) and
   placed by its instances' world matrices (``Scene.add_instance``).
 - Materials: the Principled BSDF's base colour, else the viewport display colour, else toonray's
@@ -25,7 +26,6 @@ import numpy as np
 
 from . import lights as lights_rules
 
-GEOMETRY_TYPES = {"MESH", "CURVE", "SURFACE", "FONT", "META"}
 DEFAULT_KD = (0.8, 0.8, 0.8)
 
 
@@ -97,26 +97,14 @@ class MeshCache:
         self.meshes = {}
 
     def mesh_for(self, obj):
-        """The toonray mesh of an evaluated object and the corners of its bounds in its own
+        """The toonray mesh of an evaluated mesh object and the corners of its bounds in its own
         coordinates, (8, 3); None when it has no triangles."""
-        if obj.type == "MESH":
-            # The evaluated mesh (modifiers applied) is shared by the object's instances and by
-            # objects sharing both the mesh and no modifiers.
-            key = ("mesh", obj.data.as_pointer(), self._slots_key(obj))
-        else:
-            key = ("object", obj.as_pointer(), self._slots_key(obj))
-        if key in self.meshes:
-            return self.meshes[key]
-        if obj.type == "MESH":
-            mesh = self._upload(obj, obj.data)
-        else:
-            data = obj.to_mesh()
-            try:
-                mesh = self._upload(obj, data) if data is not None else None
-            finally:
-                obj.to_mesh_clear()
-        self.meshes[key] = mesh
-        return mesh
+        # The evaluated mesh (modifiers applied) is shared by the object's instances and by
+        # objects sharing both the mesh and no modifiers.
+        key = (obj.data.as_pointer(), self._slots_key(obj))
+        if key not in self.meshes:
+            self.meshes[key] = self._upload(obj, obj.data)
+        return self.meshes[key]
 
     @staticmethod
     def _slots_key(obj):
@@ -237,6 +225,7 @@ class SyncedScene:
         self.excluded = 0
         self.clipped = 0
         self.triangles = 0
+        self.meshes = 0  # meshes uploaded: one per geometry, whatever its instances
 
 
 def usage_of(obj):
@@ -265,7 +254,7 @@ def sync_depsgraph(tr, depsgraph, camera=None, clip=None):
         if obj.type == "LIGHT":
             lights.append((obj.name, obj.data, inst.matrix_world.copy()))
             continue
-        if obj.type not in GEOMETRY_TYPES:
+        if obj.type != "MESH":
             continue
         usage = usage_of(obj)
         if usage == "EXCLUDE":
@@ -284,7 +273,7 @@ def sync_depsgraph(tr, depsgraph, camera=None, clip=None):
                 continue
         index = scene.add_instance(mesh, matrix, name=obj.name)
         geometry_bounds.append(bounds)
-        out.object_pass_index.append(obj.pass_index)
+        out.object_pass_index.append(obj.original.pass_index)
         out.object_names.append(obj.name)
         holdout = obj.original.holdout_get(view_layer=view_layer) \
             if hasattr(obj, "holdout_get") else getattr(obj, "is_holdout", False)
@@ -295,6 +284,7 @@ def sync_depsgraph(tr, depsgraph, camera=None, clip=None):
     out.material_pass_index = materials.pass_index
     out.material_names = materials.names
     out.triangles = scene.triangle_count
+    out.meshes = sum(1 for m in meshes.meshes.values() if m is not None)
     if geometry_bounds:
         allb = np.concatenate(geometry_bounds)
         centre = tuple(0.5 * (allb.min(axis=0) + allb.max(axis=0)))

@@ -10,7 +10,8 @@
 #    frames with SVGs; complex.blend's IndexOB pass.
 # 4. A frame over the triangle limit from the command line is reported, and Blender quits
 #    normally; engine_check.py compares and checks the frames; engine_cancel.py breaks a render
-#    and fails one; preview_test.py checks the cameras and the viewport preview's renderer.
+#    and fails one; sync_test.py checks that each mesh is uploaded once; preview_test.py checks
+#    the cameras and the viewport preview's renderer.
 # 5. viewport_test.py: the viewport in a real Blender window under Xvfb (skipped, with a note,
 #    without xvfb-run).
 # Exits 77 (skipped) only when Blender is not installed.
@@ -98,6 +99,8 @@ run_blender check.log -b --factory-startup --python "$here/engine_check.py" -- "
 grep "^engine_check" check.log
 run_blender cancel.log -b parity.blend --python "$here/engine_cancel.py"
 grep "^engine_cancel" cancel.log
+run_blender sync.log -b complex.blend --python "$here/sync_test.py"
+grep "^sync_test" sync.log
 run_blender preview.log -b parity.blend --python "$here/preview_test.py"
 grep "^preview_test" preview.log
 
