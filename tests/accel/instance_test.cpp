@@ -52,9 +52,9 @@ Ray object_ray(const Affine3& to_world, const Ray& ray) {
         for (int k = 0; k < 4; ++k) m[i][k] = static_cast<float>(inv.m[i][k]);
     Ray o = ray;
     for (int i = 0; i < 3; ++i) {
-        o.origin[i] = static_cast<float>(double(m[i][0]) * ray.origin.x +
-                                         double(m[i][1]) * ray.origin.y +
-                                         double(m[i][2]) * ray.origin.z + double(m[i][3]));
+        o.origin[i] =
+            static_cast<float>(double(m[i][0]) * ray.origin.x + double(m[i][1]) * ray.origin.y +
+                               double(m[i][2]) * ray.origin.z + double(m[i][3]));
         o.dir[i] = static_cast<float>(double(m[i][0]) * ray.dir.x + double(m[i][1]) * ray.dir.y +
                                       double(m[i][2]) * ray.dir.z);
     }
@@ -144,9 +144,9 @@ void check_view(const TriangleAccel& accel, const Soup* own, const std::vector<P
                 std::vector<Vec3f> dirs;
                 for (int y = 0; y < h; ++y)
                     for (int x = 0; x < w; ++x)
-                        dirs.push_back(normalize(view.pixel_point(float(x0 + x) + 0.5f,
-                                                                  float(y0 + y) + 0.5f) -
-                                                 view.eye));
+                        dirs.push_back(
+                            normalize(view.pixel_point(float(x0 + x) + 0.5f, float(y0 + y) + 0.5f) -
+                                      view.eye));
                 std::vector<Hit> tile(dirs.size());
                 std::unique_ptr<bool[]> found(new bool[dirs.size()]);
                 accel.intersect_tile(view.eye, dirs.data(), w, h, tile.data(), found.get(), tmax);
@@ -222,8 +222,8 @@ TEST(Instances, TiesGoToTheOwnTrianglesThenTheLowestInstance) {
     // Instances 0 and 1 at the same place (every hit at the same distance in both), instance 2
     // elsewhere; the own triangles are the mesh itself, where the identity puts instance 3.
     const Affine3 moved = placement(Vec3f(1, 1, 0), 0.7, Vec3f(1.0f), Vec3f(0.5f, 0, 0));
-    std::vector<AccelInstance> instances{{a, moved}, {a, moved}, {a, Affine3::translation({9, 9, 9})},
-                                         {a, Affine3{}}};
+    std::vector<AccelInstance> instances{
+        {a, moved}, {a, moved}, {a, Affine3::translation({9, 9, 9})}, {a, Affine3{}}};
     TriangleAccel accel;
     accel.build(grid.positions, grid.tris);
     accel.set_instances(instances);
@@ -265,8 +265,7 @@ TEST(Instances, MovingInstancesEqualsPlacingThemAgain) {
     TriangleAccel moved;
     moved.set_instances(accel_instances(before, a, pot, b));
     std::vector<Affine3> transforms;
-    for (std::size_t i = 0; i < after.size(); ++i)
-        transforms.push_back(after[i].to_world);
+    for (std::size_t i = 0; i < after.size(); ++i) transforms.push_back(after[i].to_world);
     // The meshes stay those of `before`: place the same meshes by `after`'s transforms.
     std::vector<Placed> expected = before;
     for (std::size_t i = 0; i < expected.size(); ++i) expected[i].to_world = transforms[i];

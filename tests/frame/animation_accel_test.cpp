@@ -20,7 +20,8 @@ void expect_same_hits(const TriangleAccel& a, const TriangleAccel& b) {
     int hits = 0;
     for (int y = 0; y < 40; ++y)
         for (int x = 0; x < 40; ++x) {
-            const Ray ray{Vec3f(0, 20, 0), Vec3f(float(x - 20) * 0.03f, -1.0f, float(y - 20) * 0.03f)};
+            const Ray ray{Vec3f(0, 20, 0),
+                          Vec3f(float(x - 20) * 0.03f, -1.0f, float(y - 20) * 0.03f)};
             Hit ha, hb;
             const bool fa = a.intersect(ray, ha), fb = b.intersect(ray, hb);
             ASSERT_EQ(fa, fb);

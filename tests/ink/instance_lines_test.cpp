@@ -23,7 +23,9 @@ using namespace toonray::ink;
 
 namespace {
 
-std::array<std::uint32_t, 3> bits(const Vec3f& v) { return std::bit_cast<std::array<std::uint32_t, 3>>(v); }
+std::array<std::uint32_t, 3> bits(const Vec3f& v) {
+    return std::bit_cast<std::array<std::uint32_t, 3>>(v);
+}
 
 bool same_segment(const FeatureSegment& a, const FeatureSegment& b) {
     return bits(a.p0) == bits(b.p0) && bits(a.p1) == bits(b.p1) && a.key0 == b.key0 &&
@@ -67,9 +69,8 @@ TEST(InstanceLines, CullingChangesNoSegment) {
                 VisibilitySettings visibility;
                 visibility.max_invisibility = 1;
                 std::vector<std::uint8_t> shows(all.size(), 0);
-                for (const EdgePiece& piece :
-                     split_by_visibility(all, VisibilityContext{scene, own, accel, view, &b},
-                                         visibility, 2))
+                for (const EdgePiece& piece : split_by_visibility(
+                         all, VisibilityContext{scene, own, accel, view, &b}, visibility, 2))
                     shows[piece.segment] = 1;
                 for (std::size_t i = 0; i < all.size(); ++i)
                     if (shows[i]) kept.push_back(all[i]);
@@ -78,11 +79,12 @@ TEST(InstanceLines, CullingChangesNoSegment) {
                 std::size_t j = 0;
                 for (const FeatureSegment& s : kept) {
                     while (j < culled.size() && !same_segment(culled[j], s)) ++j;
-                    ASSERT_LT(j, culled.size()) << "a segment in view was culled (turn " << turn
-                                                << ")";
+                    ASSERT_LT(j, culled.size())
+                        << "a segment in view was culled (turn " << turn << ")";
                 }
                 // And the cones never drop a segment of an instance in full view.
-                const auto no_cones = instance_lines(scene, accel, camera, c, {false, true}, settings);
+                const auto no_cones =
+                    instance_lines(scene, accel, camera, c, {false, true}, settings);
                 ASSERT_EQ(no_cones.size(), culled.size());
                 for (std::size_t i = 0; i < culled.size(); ++i)
                     ASSERT_TRUE(same_segment(no_cones[i], culled[i])) << i;
@@ -150,7 +152,7 @@ TEST(InstanceLines, IntersectionsAreTheFlattenedScenes) {
         if (s.type == EdgeType::Intersection)
             b.insert({bits(s.p0), bits(s.p1),
                       flat.tri_object[s.faces[0]] != flat.tri_object[s.faces[1]]});
-    EXPECT_GT(between, 20);  // pot.1 and pot.2 cross
+    EXPECT_GT(between, 20);      // pot.1 and pot.2 cross
     EXPECT_GT(a.size(), 1000u);  // and the teapot's spout and handle cross its body
     std::vector<Ends> only_a, only_b;
     std::set_difference(a.begin(), a.end(), b.begin(), b.end(), std::back_inserter(only_a));

@@ -93,8 +93,8 @@ TEST(InstanceRender, SameBytesForAnyThreadCountAndInstructionSet) {
         test_support::IsaGuard guard(isa);
         for (const int threads : {1, 2, 3}) {
             const Frame f = render(scene, accel, LineMode::Ink, threads, true);
-            EXPECT_TRUE(std::equal(f.image.data(), f.image.data() + f.image.size(),
-                                   reference.image.data()))
+            EXPECT_TRUE(
+                std::equal(f.image.data(), f.image.data() + f.image.size(), reference.image.data()))
                 << isa << ", " << threads << " threads";
         }
     }

@@ -47,12 +47,12 @@ std::string grid_gltf(int side, const std::string& nodes, const std::string& roo
             put<std::uint32_t>(bin, {a, b, d, a, d, c});
         }
     const std::size_t end = bin.size();
-    std::string views = "{\"buffer\": 0, \"byteOffset\": 0, \"byteLength\": " +
-                        std::to_string(normals_at) + "}, {\"buffer\": 0, \"byteOffset\": " +
-                        std::to_string(normals_at) + ", \"byteLength\": " +
-                        std::to_string(indices_at - normals_at) +
-                        "}, {\"buffer\": 0, \"byteOffset\": " + std::to_string(indices_at) +
-                        ", \"byteLength\": " + std::to_string(end - indices_at) + "}";
+    std::string views =
+        "{\"buffer\": 0, \"byteOffset\": 0, \"byteLength\": " + std::to_string(normals_at) +
+        "}, {\"buffer\": 0, \"byteOffset\": " + std::to_string(normals_at) +
+        ", \"byteLength\": " + std::to_string(indices_at - normals_at) +
+        "}, {\"buffer\": 0, \"byteOffset\": " + std::to_string(indices_at) +
+        ", \"byteLength\": " + std::to_string(end - indices_at) + "}";
     const int vertices = n * n, indices = 6 * side * side;
     std::string accessors =
         "{\"bufferView\": 0, \"componentType\": 5126, \"count\": " + std::to_string(vertices) +
@@ -91,10 +91,11 @@ std::string grid_gltf(int side, const std::string& nodes, const std::string& roo
         for (int i = 0; i < vertices; ++i) put<float>(bin, {0.0f, 0.0f, 0.0f});
         add_view(m0, bin.size());
         if (!gpu)
-            accessors += ", {\"bufferView\": 3, \"componentType\": 5126, \"count\": 0, "
-                         "\"type\": \"VEC3\"}, {\"bufferView\": 3, \"componentType\": 5126, "
-                         "\"count\": 0, \"type\": \"VEC4\"}, {\"bufferView\": 3, "
-                         "\"componentType\": 5126, \"count\": 0, \"type\": \"VEC3\"}";
+            accessors +=
+                ", {\"bufferView\": 3, \"componentType\": 5126, \"count\": 0, "
+                "\"type\": \"VEC3\"}, {\"bufferView\": 3, \"componentType\": 5126, "
+                "\"count\": 0, \"type\": \"VEC4\"}, {\"bufferView\": 3, "
+                "\"componentType\": 5126, \"count\": 0, \"type\": \"VEC3\"}";
         accessors += ", {\"bufferView\": " + std::to_string(view_count) +
                      ", \"componentType\": 5126, \"count\": " + std::to_string(vertices) +
                      ", \"type\": \"VEC3\"}";
@@ -105,8 +106,8 @@ std::string grid_gltf(int side, const std::string& nodes, const std::string& roo
            roots + "}], \"nodes\": " + nodes +
            ", \"meshes\": [{\"name\": \"grid\", \"primitives\": [{\"attributes\": {\"POSITION\": "
            "0, \"NORMAL\": 1}, \"indices\": 2" +
-           targets + "}]" + (morph ? ", \"weights\": [0]" : "") +
-           "}], \"accessors\": [" + accessors + "], \"bufferViews\": [" + views +
+           targets + "}]" + (morph ? ", \"weights\": [0]" : "") + "}], \"accessors\": [" +
+           accessors + "], \"bufferViews\": [" + views +
            "], \"buffers\": [{\"byteLength\": " + std::to_string(bin.size()) + ", \"uri\": \"" +
            gltf_test::data_uri(bin) + "\"}]}";
 }
@@ -150,8 +151,8 @@ TEST(GltfInstances, NodesThatShareAMeshAreInstances) {
     EXPECT_NEAR(b.x, 0.0f, 1e-6f);
     EXPECT_NEAR(b.y, 1.0f, 1e-6f);
     // A mesh used once is flattened as before.
-    const Scene single = pose(write_temp("instances_single.gltf",
-                                         grid_gltf(2, R"([{"name": "a", "mesh": 0}])", "[0]")));
+    const Scene single = pose(
+        write_temp("instances_single.gltf", grid_gltf(2, R"([{"name": "a", "mesh": 0}])", "[0]")));
     EXPECT_TRUE(single.instances.empty());
     EXPECT_EQ(single.triangle_count(), 8u);
 }
@@ -165,8 +166,8 @@ TEST(GltfInstances, GpuInstancingPlacesEachEntry) {
         "extensions": {"EXT_mesh_gpu_instancing": {"attributes":
             {"TRANSLATION": 3, "ROTATION": 4, "SCALE": 5}}}}])";
     GltfDocument doc;
-    const Scene scene = pose(write_temp("instances_gpu.gltf", grid_gltf(1, nodes, "[0]", &gpu)),
-                             &doc);
+    const Scene scene =
+        pose(write_temp("instances_gpu.gltf", grid_gltf(1, nodes, "[0]", &gpu)), &doc);
     EXPECT_EQ(doc.instances, 3u);
     EXPECT_EQ(doc.triangles, 2u);
     ASSERT_EQ(scene.instances.size(), 3u);
@@ -209,11 +210,11 @@ TEST(GltfInstances, LimitsCountStoredTrianglesAndInstances) {
     roots += "]";
     try {
         (void)load_gltf(
-            write_temp("instances_flat.gltf", grid_gltf(188, many, roots, nullptr, true)), warnings);
+            write_temp("instances_flat.gltf", grid_gltf(188, many, roots, nullptr, true)),
+            warnings);
         FAIL() << "a flattened scene of 707 million triangles was accepted";
     } catch (const LimitError& e) {
-        EXPECT_NE(std::string(e.what()).find("706880000 triangles"), std::string::npos)
-            << e.what();
+        EXPECT_NE(std::string(e.what()).find("706880000 triangles"), std::string::npos) << e.what();
     }
 }
 

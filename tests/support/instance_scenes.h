@@ -74,16 +74,17 @@ inline Scene instanced_test_scene() {
     std::fill(pot->tri_material.begin(), pot->tri_material.end(), 1u);
     const std::uint32_t pot_mesh = scene.add_mesh(pot);
     const std::uint32_t ball_mesh = scene.add_mesh(sphere_mesh(12, 24, 2));
-    const Vec3f turns[6][2] = {{{0, 1, 0}, {-6, 0, -3}},   {{0.2f, 1, 0}, {0, 0, 0}},
-                               {{0, 1, 0.3f}, {1.2f, 0.4f, 0.5f}}, {{1, 1, 0}, {6, 0, -2}},
-                               {{0, 1, 0}, {-4, 0, 5}},    {{0, 1, 0.1f}, {4, 0, 6}}};
+    const Vec3f turns[6][2] = {
+        {{0, 1, 0}, {-6, 0, -3}}, {{0.2f, 1, 0}, {0, 0, 0}}, {{0, 1, 0.3f}, {1.2f, 0.4f, 0.5f}},
+        {{1, 1, 0}, {6, 0, -2}},  {{0, 1, 0}, {-4, 0, 5}},   {{0, 1, 0.1f}, {4, 0, 6}}};
     for (int i = 0; i < 6; ++i) {
-        Vec3f scale(0.9f + 0.1f * static_cast<float>(i % 3), 1.0f, 1.1f - 0.05f * static_cast<float>(i));
+        Vec3f scale(0.9f + 0.1f * static_cast<float>(i % 3), 1.0f,
+                    1.1f - 0.05f * static_cast<float>(i));
         if (i == 3) scale.x = -scale.x;  // mirrored
-        scene.add_instance(pot_mesh,
-                           placed(turns[i][0].x, turns[i][0].y, turns[i][0].z, 0.7 * i, scale,
-                                  turns[i][1]),
-                           "pot." + std::to_string(i));
+        scene.add_instance(
+            pot_mesh,
+            placed(turns[i][0].x, turns[i][0].y, turns[i][0].z, 0.7 * i, scale, turns[i][1]),
+            "pot." + std::to_string(i));
     }
     for (int i = 0; i < 3; ++i)
         scene.add_instance(ball_mesh,

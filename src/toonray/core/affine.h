@@ -119,8 +119,8 @@ struct Affine3 {
         BBox out;
         if (b.empty()) return out;
         for (int c = 0; c < 8; ++c)
-            out.extend(point({(c & 1) ? b.hi.x : b.lo.x, (c & 2) ? b.hi.y : b.lo.y,
-                              (c & 4) ? b.hi.z : b.lo.z}));
+            out.extend(point(
+                {(c & 1) ? b.hi.x : b.lo.x, (c & 2) ? b.hi.y : b.lo.y, (c & 4) ? b.hi.z : b.lo.z}));
         return out;
     }
     bool operator==(const Affine3&) const = default;

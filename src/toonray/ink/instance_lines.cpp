@@ -220,8 +220,7 @@ Vec3f face_normal(const std::array<Vec3f, 3>& p) {
 }
 
 std::shared_ptr<const MeshLines> make_mesh_lines(std::shared_ptr<const TriangleMesh> source,
-                                                 const FeatureEdgeSettings& settings,
-                                                 int threads) {
+                                                 const FeatureEdgeSettings& settings, int threads) {
     auto out = std::make_shared<MeshLines>();
     MeshLines& ml = *out;
     const TriangleMesh& mesh = *source;
@@ -274,8 +273,9 @@ std::shared_ptr<const MeshLines> make_mesh_lines(std::shared_ptr<const TriangleM
     for (std::size_t e = 0; e < edge_count; ++e) {
         const std::uint32_t i = topology.edge_first[e], j = topology.edge_first[e + 1];
         const Side& s0 = topology.sides[i];
-        MeshLines::Edge edge{s0.lo,      s0.hi,      s0.tri, j - i > 1 ? topology.sides[i + 1].tri : kNoIndex,
-                             Vec3f(0.0f), Vec3f(0.0f), 0,      static_cast<std::uint32_t>(ml.edges.size())};
+        MeshLines::Edge edge{
+            s0.lo,       s0.hi,       s0.tri, j - i > 1 ? topology.sides[i + 1].tri : kNoIndex,
+            Vec3f(0.0f), Vec3f(0.0f), 0,      static_cast<std::uint32_t>(ml.edges.size())};
         if (j - i != 2) {
             if (!settings.borders) continue;
             edge.flags = MeshLines::kBorder;
@@ -394,7 +394,7 @@ struct Placement {
     std::uint32_t instance = kNoIndex;
     const MeshLines* ml = nullptr;
     const Affine3* to_world = nullptr;
-    Vec3f eye;     ///< in object space
+    Vec3f eye;        ///< in object space
     int outward = 0;  ///< certainly-hidden rule: +1 / -1 outward normals, 0 none
 
     [[nodiscard]] bool turned_away(std::uint32_t t) const {
@@ -548,8 +548,7 @@ void instance_segments(const Placement& pl, const ViewVolume* volume,
         };
         TriangleCrossing c;
         if (!intersect_triangles(world(pc.t), world(pc.u), c)) continue;
-        out.push_back(
-            crossing_segment(c, pc.t, pc.u, inst, inst, ml.welded, ml.welded, hidden));
+        out.push_back(crossing_segment(c, pc.t, pc.u, inst, inst, ml.welded, ml.welded, hidden));
     }
 }
 
@@ -579,9 +578,10 @@ void triangles_in(const MeshLines& ml, const Affine3& m, const BBox& region,
         for (std::uint32_t k = b.first; k < b.first + b.count; ++k) {
             const std::uint32_t t = ml.tree.prim_indices[k];
             if (!ml.usable(t)) continue;
-            WorldTriangle w{t, {m.point(ml.corners[t][0]), m.point(ml.corners[t][1]),
-                                m.point(ml.corners[t][2])},
-                            {}};
+            WorldTriangle w{
+                t,
+                {m.point(ml.corners[t][0]), m.point(ml.corners[t][1]), m.point(ml.corners[t][2])},
+                {}};
             for (const Vec3f& q : w.p) w.box.extend(q);
             if (overlap(w.box, region)) out.push_back(w);
         }
@@ -607,8 +607,8 @@ void own_triangles_in(const Scene& scene, const Bvh& bvh, const BBox& region,
         for (std::uint32_t k = b.first; k < b.first + b.count; ++k) {
             const std::uint32_t t = bvh.prim_indices[k];
             const auto& v = scene.tri_positions[t];
-            WorldTriangle w{t, {scene.positions[v[0]], scene.positions[v[1]], scene.positions[v[2]]},
-                            {}};
+            WorldTriangle w{
+                t, {scene.positions[v[0]], scene.positions[v[1]], scene.positions[v[2]]}, {}};
             if (face_normal(w.p) == Vec3f(0.0f)) continue;
             for (const Vec3f& q : w.p) w.box.extend(q);
             if (overlap(w.box, region)) out.push_back(w);
@@ -690,7 +690,8 @@ void add_instance_segments(const Scene& scene, const TriangleAccel& accel, const
     // Per instance, in chunks of instances joined in order.
     const Vec3f eye = view.eye();
     std::vector<FeatureSegment> lines = gather_chunks<FeatureSegment>(
-        static_cast<int>(count), 16, threads, [&](int i0, int i1, std::vector<FeatureSegment>& out) {
+        static_cast<int>(count), 16, threads,
+        [&](int i0, int i1, std::vector<FeatureSegment>& out) {
             std::vector<FeatureSegment> smooth;
             std::vector<std::pair<std::uint32_t, FeatureSegment>> edges_found;
             for (int i = i0; i < i1; ++i) {
@@ -747,9 +748,9 @@ void add_instance_segments(const Scene& scene, const TriangleAccel& accel, const
                 [](const InstanceLineCache::Pair& x, const InstanceLineCache::Pair& y) {
                     return std::tie(x.a, x.b) < std::tie(y.a, y.b);
                 });
-            if (it != cache.pairs.end() && it->a == a && it->b == b &&
-                it->mesh_a == pair.mesh_a && it->mesh_b == pair.mesh_b &&
-                it->to_world_a == pair.to_world_a && it->to_world_b == pair.to_world_b) {
+            if (it != cache.pairs.end() && it->a == a && it->b == b && it->mesh_a == pair.mesh_a &&
+                it->mesh_b == pair.mesh_b && it->to_world_a == pair.to_world_a &&
+                it->to_world_b == pair.to_world_b) {
                 pair.crossings = it->crossings;
                 continue;
             }
@@ -794,9 +795,9 @@ void add_instance_segments(const Scene& scene, const TriangleAccel& accel, const
             for (const PairCrossing& pc : crossings) {
                 const bool hidden = pb.turned_away(pc.u);
                 if (hidden && !settings.certainly_hidden) continue;
-                own_pairs[static_cast<std::size_t>(i)].push_back(crossing_segment(
-                    pc.crossing, pc.t, pc.u, kNoIndex, b, own, cache.of_instance[b]->welded,
-                    hidden));
+                own_pairs[static_cast<std::size_t>(i)].push_back(
+                    crossing_segment(pc.crossing, pc.t, pc.u, kNoIndex, b, own,
+                                     cache.of_instance[b]->welded, hidden));
             }
         }
     });
