@@ -19,6 +19,7 @@ struct PianoCommandArgs {
     SettingsArgs render;
     SvgArgs svg;
     std::string output;
+    bool instanced_keys = false;
 };
 
 PianoMovieReport run_piano_movie(const Score& score, const PianoArgs& args,
@@ -53,6 +54,7 @@ int run_piano(const PianoCommandArgs& args, const CLI::App& command) {
     PianoMovieOptions options;
     options.name = piano.name;
     options.output_dir = args.output;
+    options.instanced_keys = args.instanced_keys;
     if (!piano.export_obj.empty()) options.export_obj_dir = piano.export_obj;
     if (piano.seconds > 0) options.seconds = piano.seconds;
     const Settings settings = args.render.apply();
@@ -94,6 +96,10 @@ Subcommand add_piano_command(CLI::App& app) {
     piano->add_option("--name", piano_args.name, "Frame file name prefix")->capture_default_str();
     piano->add_option("--audio", piano_args.audio,
                       "Also write the soundtrack of the same stretch to this WAV");
+    piano->add_flag("--instanced-keys", args->instanced_keys,
+                    "The 88 keys as instances of their shapes: posing moves 88 transforms (a "
+                    "two-level BVH) instead of the keys' vertices; the frames differ only along "
+                    "edges");
     piano_args.add_common(*piano);
     args->render.add_to(*piano);
     args->svg.add_to(*piano, true);

@@ -27,7 +27,8 @@ void load_gltf_frame(const RenderCommandArgs& args, const SceneSetup& setup, Sce
                      Warnings& warnings) {
     GltfDocument document = load_gltf(args.input, warnings);
     check_memory(
-        add_saturated(limits().reserved_memory, scene_bytes(document.vertices, document.triangles)),
+        add_saturated(limits().reserved_memory,
+                      scene_bytes(document.vertices, document.triangles, document.instances)),
         args.input);
     const GltfSource source(std::move(document), args.gltf.pose(), args.gltf.fps, setup);
     if (auto w = source.animator().aspect_warning(setup.width, setup.height))

@@ -170,7 +170,7 @@ put("png", "rgba.png", png(1, 1, 6, [bytes([1, 2, 3, 4])]))
 # wraps that in a GLB header) and one real GLB ---
 import base64, json as json_module
 
-for name in ("Box", "BoxAnimated", "RiggedSimple", "SimpleMorph", "SimpleSkin"):
+for name in ("Box", "BoxAnimated", "RiggedSimple", "SimpleMorph", "SimpleSkin", "instances"):
     text = read("tests", "data", "gltf", name + ".gltf")
     put("gltf", name + ".gltf", text)
     doc = json_module.loads(text)

@@ -3,9 +3,9 @@
 # byte for byte (docs/cluster.md, "Mixed clusters"): the x86-64 build with each accelerator
 # kernel the CPU runs (TOONRAY_ACCEL_ISA = sse4.2, avx2, avx512) and, when given, the aarch64
 # build under qemu-aarch64. Scenes: the teapot, spot, tests/data/scene/mixed.obj (several
-# materials) and a piano frame exported by each build itself (so its OBJ, which piano posing
-# computes, is compared too), in the three line modes (classic, robust, ink), and with shadows
-# and the specular band.
+# materials), a piano frame exported by each build itself (so its OBJ, which piano posing
+# computes, is compared too) and tests/data/gltf/instances.gltf (instances through the two-level
+# BVH), in the three line modes (classic, robust, ink), and with shadows and the specular band.
 #
 # Usage: scripts/compare-frames.sh [X86_BUILD_DIR [AARCH64_BUILD_DIR]]   (default: build, none)
 # Environment: TOONRAY_COMPARE_DIR, where the frames go (default: a temporary directory, removed
@@ -51,6 +51,9 @@ renders=(
   "piano_classic|piano|--edges classic"
   "teapot_ink|tests/data/teapot.obj|--edges ink"
   "piano_ink|piano|--edges ink --shadows"
+  "instances_ink|tests/data/gltf/instances.gltf|--edges ink --shadows"
+  "instances_robust|tests/data/gltf/instances.gltf|--edges robust --specular"
+  "instances_classic|tests/data/gltf/instances.gltf|--edges classic --shadows"
 )
 
 for i in "${!configs[@]}"; do

@@ -76,3 +76,22 @@ TEST(GltfCli, BatchRendersTheAnimationTheSameForAnyJobs) {
 }
 
 }  // namespace
+
+TEST(GltfCli, InstancesRenderWithTheirNamesInTheSvg) {
+    // instances.gltf: a ball mesh on seven placements, a box mesh on three nodes.
+    TempDir dir("gltf_cli");
+    const std::string scene = kSamples + "instances.gltf";
+    auto r = run_toonray("render " + scene + " --size 160x90 --threads 2 --shadows -o " +
+                         (dir / "a.png").string() + " --line-style " +
+                         dir.write("red.style", "match object=box.c color=#ff0000\n").string() +
+                         " --svg " + (dir / "a.svg").string());
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    const std::string svg = bytes_of(dir / "a.svg");
+    EXPECT_NE(svg.find("#ff0000"), std::string::npos);  // box.c's strokes, styled by its name
+    // The same frame on one thread.
+    auto one =
+        run_toonray("render " + scene + " --size 160x90 --threads 1 --shadows -o " +
+                    (dir / "b.png").string() + " --line-style " + (dir / "red.style").string());
+    ASSERT_EQ(one.exit_code, 0) << one.output;
+    EXPECT_EQ(bytes_of(dir / "a.png"), bytes_of(dir / "b.png"));
+}

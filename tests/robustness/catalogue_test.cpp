@@ -129,7 +129,7 @@ std::vector<BadInput> catalogue() {
          "frame range 0 2000000000: 2000000001 frames is more than the limit of 10000000"},
         {"TooManyJobsForMemory",
          "batch keys 1 4 --input {data} --output {out} --size 1024x1024 --jobs 4 --max-memory 64M",
-         "4 frames at once (a 1024x1024 frame each) needs about 123 MiB of memory, more than the limit of 64 MiB "
+         "4 frames at once (a 1024x1024 frame each) needs about 124 MiB of memory, more than the limit of 64 MiB "
          "(--max-memory raises it, or render fewer frames at once with --jobs)"},
         // --- glTF ---
         {"GltfCountPastBufferView", kRender + "gltf_huge_count.gltf" + kTo,

@@ -345,15 +345,15 @@ TR_INLINE std::uint64_t stack_key(float tnear, std::uint32_t ref) {
            ref;  // tnear >= +0: bits order like floats
 }
 
-bool intersect1(const WideBvh& w, const Ray& ray, Hit& hit, std::uint64_t* stack) {
-    if (w.root == kEmptyChild) return false;
-    // The shear is set up at the first leaf: many rays (those that miss) never need it.
-    LeafRay lr;
-    bool have_lr = false;
-    const RayBoxes boxes(ray);
-    BestHit best{ray.tmax};
-    float cull = best.t * kBoxSlack;  // boxes entered beyond this cannot hold a hit
-    vf8 tmax8 = set1(best.t);
+// Nearest-first traversal of one ray through a wide tree: `leaf(ref)` tests a leaf and returns
+// the best distance after it, which culls what is left (boxes entered beyond it cannot hold a
+// nearer hit). `t` is the best distance to start from. `stack` holds w.max_stack entries.
+template <class Leaf>
+TR_INLINE void nearest_loop(const WideBvh& w, const RayBoxes& boxes, float t, Leaf&& leaf,
+                            std::uint64_t* stack) {
+    if (w.root == kEmptyChild) return;
+    float cull = t * kBoxSlack;  // boxes entered beyond this cannot hold a hit
+    vf8 tmax8 = set1(t);
     std::uint32_t ref = w.root;
     std::size_t sp = 0;
     while (true) {
@@ -400,21 +400,16 @@ bool intersect1(const WideBvh& w, const Ray& ray, Hit& hit, std::uint64_t* stack
             ref = static_cast<std::uint32_t>(stack[--sp]);
         }
         {
-            const std::uint32_t before = best.prim;
-            const float before_t = best.t;
-            if (!have_lr) {
-                lr = leaf_ray(ray);
-                have_lr = true;
-            }
-            leaf1(w, ref, lr, best);
-            if (best.prim != before || best.t != before_t) {
-                cull = best.t * kBoxSlack;
-                tmax8 = set1(best.t);
+            const float after = leaf(ref);
+            if (after != t) {
+                t = after;
+                cull = t * kBoxSlack;
+                tmax8 = set1(t);
             }
         }
     pop:
         while (true) {
-            if (sp == 0) goto done;
+            if (sp == 0) return;
             const std::uint64_t e = stack[--sp];
             if (as_float(static_cast<std::uint32_t>(e >> 32)) <= cull) {
                 ref = static_cast<std::uint32_t>(e);
@@ -422,7 +417,30 @@ bool intersect1(const WideBvh& w, const Ray& ray, Hit& hit, std::uint64_t* stack
             }
         }
     }
-done:
+}
+
+// The closest hit of one ray by BestHit's rule, starting from `best` (its distance bounds the
+// search; its prim decides ties at that distance, see kTieWins).
+TR_INLINE void nearest1(const WideBvh& w, const Ray& ray, BestHit& best, std::uint64_t* stack) {
+    // The shear is set up at the first leaf: many rays (those that miss) never need it.
+    LeafRay lr;
+    bool have_lr = false;
+    nearest_loop(
+        w, RayBoxes(ray), best.t,
+        [&](std::uint32_t ref) {
+            if (!have_lr) {
+                lr = leaf_ray(ray);
+                have_lr = true;
+            }
+            leaf1(w, ref, lr, best);
+            return best.t;
+        },
+        stack);
+}
+
+bool intersect1(const WideBvh& w, const Ray& ray, Hit& hit, std::uint64_t* stack) {
+    BestHit best{ray.tmax};
+    nearest1(w, ray, best, stack);
     if (best.prim == kNoIndex) return false;
     hit.t = best.t;
     hit.prim = best.prim;
@@ -431,16 +449,14 @@ done:
     return true;
 }
 
-// Occlusion of one ray: intersect1's traversal with tmax fixed, stopping at the first leaf
-// with a hit. Children are visited in slot order: when any hit will do, nearest-first costs
-// more than it finds (measured on shadow rays: 2-4% more instructions). `stack` holds
-// WideBvh::max_stack entries.
-bool occluded1(const WideBvh& w, const Ray& ray, std::uint64_t* stack) {
+// Occlusion traversal of one ray: children in slot order (when any hit will do, nearest-first
+// costs more than it finds: measured on shadow rays, 2-4% more instructions), stopping when
+// `leaf(ref)` returns true.
+template <class Leaf>
+TR_INLINE bool any_loop(const WideBvh& w, const RayBoxes& boxes, float tmax, Leaf&& leaf,
+                        std::uint64_t* stack) {
     if (w.root == kEmptyChild) return false;
-    LeafRay lr;
-    bool have_lr = false;
-    const RayBoxes boxes(ray);
-    const vf8 tmax8 = set1(ray.tmax);
+    const vf8 tmax8 = set1(tmax);
     std::uint32_t ref = w.root;
     std::size_t sp = 0;
     while (true) {
@@ -453,15 +469,129 @@ bool occluded1(const WideBvh& w, const Ray& ray, std::uint64_t* stack) {
             for (mask &= mask - 1; mask; mask &= mask - 1)
                 stack[sp++] = node.child[__builtin_ctz(mask)];
         }
-        if (!have_lr) {
-            lr = leaf_ray(ray);
-            have_lr = true;
-        }
-        if (leaf_occluded(w, ref, lr, ray.tmax)) return true;
+        if (leaf(ref)) return true;
     pop:
         if (sp == 0) return false;
         ref = static_cast<std::uint32_t>(stack[--sp]);
     }
+}
+
+// Occlusion of one ray: intersect1's traversal with tmax fixed, stopping at the first leaf
+// with a hit. `stack` holds WideBvh::max_stack entries.
+bool occluded1(const WideBvh& w, const Ray& ray, std::uint64_t* stack) {
+    LeafRay lr;
+    bool have_lr = false;
+    return any_loop(
+        w, RayBoxes(ray), ray.tmax,
+        [&](std::uint32_t ref) {
+            if (!have_lr) {
+                lr = leaf_ray(ray);
+                have_lr = true;
+            }
+            return leaf_occluded(w, ref, lr, ray.tmax);
+        },
+        stack);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Instances: a top-level tree over instance boxes whose leaves list instance records; each
+// record's tree is traversed with the ray taken into its object space. Hit distances are the
+// same in both spaces (the direction is transformed with the origin), so the best distance
+// carries over from instance to instance. Ties at one distance go to the lower rank (the own
+// triangles, then instances by index), then the lower triangle index: the result is the lowest
+// (t, rank, triangle) whatever order instances and triangles are visited in.
+
+// The ray in a record's object space: each coordinate summed in double and rounded once, so
+// that it is the same on every CPU.
+TR_INLINE Ray object_ray(const InstanceRecord& r, const Ray& ray) {
+    if (r.identity) return ray;
+    const auto& m = r.from_world;
+    Ray o;
+    for (int i = 0; i < 3; ++i) {
+        o.origin[i] =
+            static_cast<float>(double(m[i][0]) * ray.origin.x + double(m[i][1]) * ray.origin.y +
+                               double(m[i][2]) * ray.origin.z + double(m[i][3]));
+        o.dir[i] = static_cast<float>(double(m[i][0]) * ray.dir.x + double(m[i][1]) * ray.dir.y +
+                                      double(m[i][2]) * ray.dir.z);
+    }
+    o.tmax = ray.tmax;
+    return o;
+}
+
+// A direction in a record's object space, as object_ray transforms it.
+TR_INLINE Vec3f object_dir(const InstanceRecord& r, const Vec3f& d) {
+    if (r.identity) return d;
+    const auto& m = r.from_world;
+    Vec3f o;
+    for (int i = 0; i < 3; ++i)
+        o[i] = static_cast<float>(double(m[i][0]) * d.x + double(m[i][1]) * d.y +
+                                  double(m[i][2]) * d.z);
+    return o;
+}
+
+// The best hit over instances: BestHit plus the rank of the instance hit.
+struct RankedHit {
+    BestHit hit;
+    std::uint32_t rank = 0;
+
+    // The start of a search in a record of rank `rank`: below the best distance, and at the
+    // same distance only when its rank is lower than the best hit's.
+    [[nodiscard]] BestHit start(std::uint32_t r) const {
+        BestHit b{hit.t};
+        if (hit.prim != kNoIndex && r < rank) b.prim = kTieWins;
+        return b;
+    }
+    void merge(const BestHit& b, std::uint32_t r) {
+        if (b.prim >= kTieWins) return;  // nothing better in that record
+        hit = b;
+        rank = r;
+    }
+};
+
+// The records a top-level leaf lists: f(record) for each.
+template <class F>
+TR_INLINE bool for_each_record(const InstanceLevel& lv, std::uint32_t ref, F&& f) {
+    for (std::uint32_t slot = leaf_first(ref);; ++slot) {
+        const std::uint32_t s = lv.slots[slot];
+        if (f(lv.records[s & kPrimMask])) return true;
+        if (s & kLeafEnd) return false;
+    }
+}
+
+bool intersect1_instances(const InstanceLevel& lv, const Ray& ray, Hit& hit, std::uint64_t* stack,
+                          std::uint64_t* bottom) {
+    RankedHit best{BestHit{ray.tmax}, 0};
+    nearest_loop(
+        lv.tree, RayBoxes(ray), ray.tmax,
+        [&](std::uint32_t ref) {
+            for_each_record(lv, ref, [&](const InstanceRecord& r) {
+                BestHit b = best.start(r.rank);
+                nearest1(*r.tree, object_ray(r, ray), b, bottom);
+                best.merge(b, r.rank);
+                return false;
+            });
+            return best.hit.t;
+        },
+        stack);
+    if (best.hit.prim == kNoIndex) return false;
+    hit.t = best.hit.t;
+    hit.prim = best.hit.prim;
+    hit.u = best.hit.u;
+    hit.v = best.hit.v;
+    hit.instance = best.rank - 1;  // the own triangles' rank 0 gives kNoIndex
+    return true;
+}
+
+bool occluded1_instances(const InstanceLevel& lv, const Ray& ray, std::uint64_t* stack,
+                         std::uint64_t* bottom) {
+    return any_loop(
+        lv.tree, RayBoxes(ray), ray.tmax,
+        [&](std::uint32_t ref) {
+            return for_each_record(lv, ref, [&](const InstanceRecord& r) {
+                return occluded1(*r.tree, object_ray(r, ray), bottom);
+            });
+        },
+        stack);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -568,19 +698,179 @@ TR_INLINE void leaf_groups(const WideBvh& w, std::uint32_t ref, TileState& s, st
     }
 }
 
-void intersect_tile(const WideBvh& w, const Vec3f& origin, const Vec3f* dirs, int width, int height,
-                    float tmax_in, Hit* hits, bool* found, TileEntry* stack,
-                    std::uint64_t* stack1) {
-    const int gw = (width + 3) / 4, gh = (height + 1) / 2, ng = gw * gh;
-    TileState s;
-    std::uint32_t regular = 0, irregular = 0;
+// Which signs the regular groups' directions have, per axis (any lane of any group).
+struct TileSigns {
+    int pos[3] = {0, 0, 0}, neg[3] = {0, 0, 0};
+};
+
+// Leaves every group of `s` empty: no interval bound, nothing to find (gtmax -inf).
+TR_INLINE void clear_groups(TileState& s) {
     const float inf = std::numeric_limits<float>::infinity();
-    int sign_pos[3] = {0, 0, 0}, sign_neg[3] = {0, 0, 0};
     for (int g = 0; g < kMaxGroups; ++g) {
         for (int a = 0; a < 3; ++a) s.ilo[a][g] = s.ihi[a][g] = 1.0f;
         s.gtmax[g] = -inf;
     }
-    // Set up the groups.
+}
+
+// Group g's shear and inverse-direction intervals from its 8 directions d[axis][lane]; false
+// when its rays must be traced one by one (no common shear permutation, or a zero, infinite or
+// sign-changing direction component).
+TR_INLINE bool setup_group(TileState& s, int g, const float (&d)[3][8], TileSigns& signs) {
+    const float inf = std::numeric_limits<float>::infinity();
+    const vf8 dv[3] = {load8(d[0]), load8(d[1]), load8(d[2])};
+    const vf8 adx = vabs(dv[0]), ady = vabs(dv[1]), adz = vabs(dv[2]);
+    // kz = ax > ay ? (ax > az ? 0 : 2) : (ay > az ? 1 : 2), as ShearedRay does per ray.
+    const vm8 xy = adx > ady;
+    const int m0 = movemask(xy & (adx > adz)), m1 = movemask(andnot(xy, ady > adz));
+    int kz = m0 == 0xff ? 0 : m1 == 0xff ? 1 : (m0 | m1) == 0 ? 2 : -1;
+    bool ok = kz >= 0;
+    vf8 iv[3];
+    int neg[3];
+    for (int a = 0; a < 3 && ok; ++a) {
+        iv[a] = set1(1.0f) / dv[a];
+        neg[a] = movemask(iv[a] < set1(0.0f));
+        ok = movemask(vabs(iv[a]) < set1(inf)) == 0xff && (neg[a] == 0 || neg[a] == 0xff);
+    }
+    if (!ok) return false;
+    int kx = (kz + 1) % 3, ky = (kx + 1) % 3;
+    if (neg[kz]) std::swap(kx, ky);  // dir[kz] < 0 on every lane
+    s.k[g][0] = kx;
+    s.k[g][1] = ky;
+    s.k[g][2] = kz;
+    s.cls[g] = kz * 2 + (neg[kz] ? 1 : 0);
+    store8(s.sx[g], dv[kx] / dv[kz]);
+    store8(s.sy[g], dv[ky] / dv[kz]);
+    store8(s.sz[g], set1(1.0f) / dv[kz]);
+    for (int a = 0; a < 3; ++a) {
+        s.ilo[a][g] = hmin(iv[a]);
+        s.ihi[a][g] = hmax(iv[a]);
+        (neg[a] ? signs.neg : signs.pos)[a] = 1;
+    }
+    return true;
+}
+
+// Traverses a tile's regular groups through a wide tree, nearest child first, culling for the
+// whole tile and then per group; `leaf(ref, groups)` tests a leaf against the groups that
+// reach it and updates their lanes' best hits and s.gtmax. `stack` holds w.max_stack entries.
+template <class Leaf>
+TR_INLINE void tile_loop(const WideBvh& w, TileState& s, int ng, std::uint32_t regular,
+                         const TileSigns& signs, const Vec3f& origin, Leaf&& leaf,
+                         TileEntry* stack) {
+    if (!regular || w.root == kEmptyChild) return;
+    const float inf = std::numeric_limits<float>::infinity();
+    const int* sign_pos = signs.pos;
+    const int* sign_neg = signs.neg;
+    // The tile's interval per axis, over its regular groups; an axis on which the groups'
+    // signs differ gives no bound ("free").
+    float tlo[3] = {inf, inf, inf}, thi[3] = {-inf, -inf, -inf};
+    bool free_axis[3];
+    int tn_off[3], tf_off[3];
+    for (int a = 0; a < 3; ++a) {
+        for (int g = 0; g < ng; ++g)
+            if (regular >> g & 1) {
+                tlo[a] = std::min(tlo[a], s.ilo[a][g]);
+                thi[a] = std::max(thi[a], s.ihi[a][g]);
+            }
+        free_axis[a] = sign_pos[a] && sign_neg[a];
+        tn_off[a] = sign_neg[a] ? kNearHi[a] : kNearLo[a];
+        tf_off[a] = sign_neg[a] ? kNearLo[a] : kNearHi[a];
+    }
+    const float o[3] = {origin.x, origin.y, origin.z};
+    const vf8 zero = set1(0.0f), slack = set1(kBoxSlack);
+    auto tile_tmax = [&] {
+        vf8 m = vmax(load8(s.gtmax), load8(s.gtmax + 8));
+        m = vmax(m, vmax(load8(s.gtmax + 16), load8(s.gtmax + 24)));
+        return hmax(m);
+    };
+    float ttmax = tile_tmax();
+
+    std::uint32_t ref = w.root, groups = regular;
+    std::size_t sp = 0;
+    while (true) {
+        while (!is_leaf(ref)) {
+            const WideNode& n = w.nodes[ref];
+            const float* b = &n.lo[0][0];
+            // Whole tile against the 8 children.
+            vf8 tn = zero, tf = set1(ttmax);
+            for (int a = 0; a < 3; ++a) {
+                if (free_axis[a]) continue;
+                const vf8 lo = set1(tlo[a]), hi = set1(thi[a]), oa = set1(o[a]);
+                const vf8 dn = load8(b + tn_off[a]) - oa, df = load8(b + tf_off[a]) - oa;
+                tn = vmax(vmin(dn * lo, dn * hi), tn);
+                tf = vmin(vmax(df * lo, df * hi), tf);
+            }
+            int cmask = movemask(tn <= tf * slack) & static_cast<int>(n.pad[0]);
+            if (cmask == 0) goto pop;
+            alignas(32) float tns[8], dlo[3][8], dhi[3][8];
+            store8(tns, tn);
+            for (int a = 0; a < 3; ++a) {
+                store8(dlo[a], load8(b + kNearLo[a]) - set1(o[a]));
+                store8(dhi[a], load8(b + kNearHi[a]) - set1(o[a]));
+            }
+            // Each child against the groups.
+            std::size_t base = sp;
+            do {
+                int c = __builtin_ctz(static_cast<unsigned>(cmask));
+                cmask &= cmask - 1;
+                std::uint32_t gm = 0;
+                for (int q = 0; q < 4; ++q) {
+                    const std::uint32_t qm = (groups >> (8 * q)) & 0xff;
+                    if (!qm) continue;
+                    vf8 gtn = zero, gtf = load8(s.gtmax + 8 * q);
+                    for (int a = 0; a < 3; ++a) {
+                        const vf8 il = load8(s.ilo[a] + 8 * q), ih = load8(s.ihi[a] + 8 * q);
+                        const vf8 l = bcast(&dlo[a][c]), h = bcast(&dhi[a][c]);
+                        if (free_axis[a]) {
+                            const vf8 p1 = l * il, p2 = l * ih, p3 = h * il, p4 = h * ih;
+                            gtn = vmax(vmin(vmin(p1, p2), vmin(p3, p4)), gtn);
+                            gtf = vmin(vmax(vmax(p1, p2), vmax(p3, p4)), gtf);
+                        } else {
+                            const vf8 nn = sign_neg[a] ? h : l, ff = sign_neg[a] ? l : h;
+                            gtn = vmax(vmin(nn * il, nn * ih), gtn);
+                            gtf = vmin(vmax(ff * il, ff * ih), gtf);
+                        }
+                    }
+                    gm |= static_cast<std::uint32_t>(movemask(gtn <= gtf * slack) &
+                                                     static_cast<int>(qm))
+                          << (8 * q);
+                }
+                if (!gm) continue;
+                TileEntry e{n.child[c], gm, tns[c]};
+                std::size_t j = sp++;
+                while (j > base && stack[j - 1].tnear < e.tnear) {
+                    stack[j] = stack[j - 1];
+                    --j;
+                }
+                stack[j] = e;
+            } while (cmask);
+            if (sp == base) goto pop;
+            --sp;
+            ref = stack[sp].ref;
+            groups = stack[sp].groups;
+        }
+        leaf(ref, groups);
+        ttmax = tile_tmax();
+    pop:
+        while (true) {
+            if (sp == 0) return;
+            const TileEntry& e = stack[--sp];
+            if (e.tnear <= ttmax * kBoxSlack) {
+                ref = e.ref;
+                groups = e.groups;
+                break;
+            }
+        }
+    }
+}
+
+// The groups of a width x height tile (4 x 2 rays each): each lane's pixel and direction, which
+// lanes are real rays (the others repeat the group's first), and whether the group is regular.
+// Regular groups start with no hit below tmax_in.
+TR_INLINE int setup_tile(TileState& s, const Vec3f* dirs, int width, int height, float tmax_in,
+                         std::uint32_t& regular, std::uint32_t& irregular, TileSigns& signs) {
+    const int gw = (width + 3) / 4, gh = (height + 1) / 2, ng = gw * gh;
+    regular = irregular = 0;
+    clear_groups(s);
     for (int g = 0; g < ng; ++g) {
         const int gx = (g % gw) * 4, gy = (g / gw) * 2;
         alignas(32) float d[3][8];
@@ -600,151 +890,31 @@ void intersect_tile(const WideBvh& w, const Vec3f& origin, const Vec3f* dirs, in
             d[2][l] = dirs[p].z;
         }
         s.lanes[g] = lanes;
-        const vf8 dv[3] = {load8(d[0]), load8(d[1]), load8(d[2])};
-        const vf8 adx = vabs(dv[0]), ady = vabs(dv[1]), adz = vabs(dv[2]);
-        // kz = ax > ay ? (ax > az ? 0 : 2) : (ay > az ? 1 : 2), as ShearedRay does per ray.
-        const vm8 xy = adx > ady;
-        const int m0 = movemask(xy & (adx > adz)), m1 = movemask(andnot(xy, ady > adz));
-        int kz = m0 == 0xff ? 0 : m1 == 0xff ? 1 : (m0 | m1) == 0 ? 2 : -1;
-        bool ok = kz >= 0;
-        vf8 iv[3];
-        int neg[3];
-        for (int a = 0; a < 3 && ok; ++a) {
-            iv[a] = set1(1.0f) / dv[a];
-            neg[a] = movemask(iv[a] < set1(0.0f));
-            ok = movemask(vabs(iv[a]) < set1(inf)) == 0xff && (neg[a] == 0 || neg[a] == 0xff);
-        }
-        if (!ok) {
+        if (!setup_group(s, g, d, signs)) {
             irregular |= 1u << g;
             continue;
         }
-        int kx = (kz + 1) % 3, ky = (kx + 1) % 3;
-        if (neg[kz]) std::swap(kx, ky);  // dir[kz] < 0 on every lane
-        s.k[g][0] = kx;
-        s.k[g][1] = ky;
-        s.k[g][2] = kz;
-        s.cls[g] = kz * 2 + (neg[kz] ? 1 : 0);
-        store8(s.sx[g], dv[kx] / dv[kz]);
-        store8(s.sy[g], dv[ky] / dv[kz]);
-        store8(s.sz[g], set1(1.0f) / dv[kz]);
         store8(s.tmax[g], set1(tmax_in));
         store8(s.u[g], set1(0.0f));
         store8(s.v[g], set1(0.0f));
         storei8(s.prim[g], seti1(kNoIndex));
         s.gtmax[g] = tmax_in;
-        for (int a = 0; a < 3; ++a) {
-            s.ilo[a][g] = hmin(iv[a]);
-            s.ihi[a][g] = hmax(iv[a]);
-            (neg[a] ? sign_neg : sign_pos)[a] = 1;
-        }
         regular |= 1u << g;
     }
+    return ng;
+}
 
-    if (regular && w.root != kEmptyChild) {
-        // The tile's interval per axis, over its regular groups; an axis on which the groups'
-        // signs differ gives no bound ("free").
-        float tlo[3] = {inf, inf, inf}, thi[3] = {-inf, -inf, -inf};
-        bool free_axis[3];
-        int tn_off[3], tf_off[3];
-        for (int a = 0; a < 3; ++a) {
-            for (int g = 0; g < ng; ++g)
-                if (regular >> g & 1) {
-                    tlo[a] = std::min(tlo[a], s.ilo[a][g]);
-                    thi[a] = std::max(thi[a], s.ihi[a][g]);
-                }
-            free_axis[a] = sign_pos[a] && sign_neg[a];
-            tn_off[a] = sign_neg[a] ? kNearHi[a] : kNearLo[a];
-            tf_off[a] = sign_neg[a] ? kNearLo[a] : kNearHi[a];
-        }
-        const float o[3] = {origin.x, origin.y, origin.z};
-        const vf8 zero = set1(0.0f), slack = set1(kBoxSlack);
-        auto tile_tmax = [&] {
-            vf8 m = vmax(load8(s.gtmax), load8(s.gtmax + 8));
-            m = vmax(m, vmax(load8(s.gtmax + 16), load8(s.gtmax + 24)));
-            return hmax(m);
-        };
-        float ttmax = tile_tmax();
-
-        std::uint32_t ref = w.root, groups = regular;
-        std::size_t sp = 0;
-        while (true) {
-            while (!is_leaf(ref)) {
-                const WideNode& n = w.nodes[ref];
-                const float* b = &n.lo[0][0];
-                // Whole tile against the 8 children.
-                vf8 tn = zero, tf = set1(ttmax);
-                for (int a = 0; a < 3; ++a) {
-                    if (free_axis[a]) continue;
-                    const vf8 lo = set1(tlo[a]), hi = set1(thi[a]), oa = set1(o[a]);
-                    const vf8 dn = load8(b + tn_off[a]) - oa, df = load8(b + tf_off[a]) - oa;
-                    tn = vmax(vmin(dn * lo, dn * hi), tn);
-                    tf = vmin(vmax(df * lo, df * hi), tf);
-                }
-                int cmask = movemask(tn <= tf * slack) & static_cast<int>(n.pad[0]);
-                if (cmask == 0) goto pop;
-                alignas(32) float tns[8], dlo[3][8], dhi[3][8];
-                store8(tns, tn);
-                for (int a = 0; a < 3; ++a) {
-                    store8(dlo[a], load8(b + kNearLo[a]) - set1(o[a]));
-                    store8(dhi[a], load8(b + kNearHi[a]) - set1(o[a]));
-                }
-                // Each child against the groups.
-                std::size_t base = sp;
-                do {
-                    int c = __builtin_ctz(static_cast<unsigned>(cmask));
-                    cmask &= cmask - 1;
-                    std::uint32_t gm = 0;
-                    for (int q = 0; q < 4; ++q) {
-                        const std::uint32_t qm = (groups >> (8 * q)) & 0xff;
-                        if (!qm) continue;
-                        vf8 gtn = zero, gtf = load8(s.gtmax + 8 * q);
-                        for (int a = 0; a < 3; ++a) {
-                            const vf8 il = load8(s.ilo[a] + 8 * q), ih = load8(s.ihi[a] + 8 * q);
-                            const vf8 l = bcast(&dlo[a][c]), h = bcast(&dhi[a][c]);
-                            if (free_axis[a]) {
-                                const vf8 p1 = l * il, p2 = l * ih, p3 = h * il, p4 = h * ih;
-                                gtn = vmax(vmin(vmin(p1, p2), vmin(p3, p4)), gtn);
-                                gtf = vmin(vmax(vmax(p1, p2), vmax(p3, p4)), gtf);
-                            } else {
-                                const vf8 nn = sign_neg[a] ? h : l, ff = sign_neg[a] ? l : h;
-                                gtn = vmax(vmin(nn * il, nn * ih), gtn);
-                                gtf = vmin(vmax(ff * il, ff * ih), gtf);
-                            }
-                        }
-                        gm |= static_cast<std::uint32_t>(movemask(gtn <= gtf * slack) &
-                                                         static_cast<int>(qm))
-                              << (8 * q);
-                    }
-                    if (!gm) continue;
-                    TileEntry e{n.child[c], gm, tns[c]};
-                    std::size_t j = sp++;
-                    while (j > base && stack[j - 1].tnear < e.tnear) {
-                        stack[j] = stack[j - 1];
-                        --j;
-                    }
-                    stack[j] = e;
-                } while (cmask);
-                if (sp == base) goto pop;
-                --sp;
-                ref = stack[sp].ref;
-                groups = stack[sp].groups;
-            }
-            // Leaf: its triangles against the groups.
-            leaf_groups(w, ref, s, groups, origin);
-            ttmax = tile_tmax();
-        pop:
-            while (true) {
-                if (sp == 0) goto done;
-                const TileEntry& e = stack[--sp];
-                if (e.tnear <= ttmax * kBoxSlack) {
-                    ref = e.ref;
-                    groups = e.groups;
-                    break;
-                }
-            }
-        }
-    done:;
-    }
+void intersect_tile(const WideBvh& w, const Vec3f& origin, const Vec3f* dirs, int width, int height,
+                    float tmax_in, Hit* hits, bool* found, TileEntry* stack,
+                    std::uint64_t* stack1) {
+    TileState s;
+    std::uint32_t regular, irregular;
+    TileSigns signs;
+    const int ng = setup_tile(s, dirs, width, height, tmax_in, regular, irregular, signs);
+    tile_loop(
+        w, s, ng, regular, signs, origin,
+        [&](std::uint32_t ref, std::uint32_t groups) { leaf_groups(w, ref, s, groups, origin); },
+        stack);
 
     // Write the results.
     for (int g = 0; g < ng; ++g) {
@@ -766,6 +936,129 @@ void intersect_tile(const WideBvh& w, const Vec3f& origin, const Vec3f* dirs, in
             const bool f = s.prim[g][l] != kNoIndex;
             found[p] = f;
             hits[p] = f ? Hit{s.tmax[g][l], s.prim[g][l], s.u[g][l], s.v[g][l]} : Hit{};
+        } while (lanes);
+    }
+}
+
+// A tile through the instance level: the top tree is traversed with the tile's groups as
+// intersect_tile does; at each record the groups that reach it are taken into its object space
+// (each lane's direction, as object_ray does) and traced through its tree with their best hits
+// so far, ties going to the lower rank (RankedHit). Groups that are irregular in object space
+// are traced there ray by ray.
+void intersect_tile_instances(const InstanceLevel& lv, const Vec3f& origin, const Vec3f* dirs,
+                              int width, int height, float tmax_in, Hit* hits, bool* found,
+                              TileEntry* stack, std::uint64_t* stack1, TileEntry* bottom,
+                              std::uint64_t* bottom1) {
+    TileState s;
+    std::uint32_t regular, irregular;
+    TileSigns signs;
+    const int ng = setup_tile(s, dirs, width, height, tmax_in, regular, irregular, signs);
+    alignas(32) std::uint32_t rank[kMaxGroups][8];
+    TileState so;  // the groups in a record's object space
+    tile_loop(
+        lv.tree, s, ng, regular, signs, origin,
+        [&](std::uint32_t ref, std::uint32_t groups) {
+            for_each_record(lv, ref, [&](const InstanceRecord& r) {
+                const Ray oray = object_ray(r, Ray{origin, Vec3f(0.0f), tmax_in});
+                clear_groups(so);
+                TileSigns osigns;
+                std::uint32_t oregular = 0;
+                std::uint32_t gm = groups;
+                do {
+                    const int g = __builtin_ctz(gm);
+                    gm &= gm - 1;
+                    alignas(32) float d[3][8];
+                    for (int l = 0; l < 8; ++l) {
+                        const Vec3f dir = object_dir(r, dirs[s.pix[g][l]]);
+                        d[0][l] = dir.x;
+                        d[1][l] = dir.y;
+                        d[2][l] = dir.z;
+                        so.pix[g][l] = s.pix[g][l];
+                        const bool tie = s.prim[g][l] != kNoIndex && r.rank < rank[g][l];
+                        so.prim[g][l] = tie ? kTieWins : kNoIndex;
+                    }
+                    so.lanes[g] = s.lanes[g];
+                    if (setup_group(so, g, d, osigns)) {
+                        store8(so.tmax[g], load8(s.tmax[g]));
+                        store8(so.u[g], load8(s.u[g]));
+                        store8(so.v[g], load8(s.v[g]));
+                        so.gtmax[g] = s.gtmax[g];
+                        oregular |= 1u << g;
+                        continue;
+                    }
+                    // Ray by ray.
+                    int lanes = s.lanes[g];
+                    do {
+                        const int l = __builtin_ctz(static_cast<unsigned>(lanes));
+                        lanes &= lanes - 1;
+                        BestHit b{s.tmax[g][l], so.prim[g][l], s.u[g][l], s.v[g][l]};
+                        nearest1(*r.tree, Ray{oray.origin, Vec3f(d[0][l], d[1][l], d[2][l])}, b,
+                                 bottom1);
+                        if (b.prim >= kTieWins) continue;
+                        s.tmax[g][l] = b.t;
+                        s.prim[g][l] = b.prim;
+                        s.u[g][l] = b.u;
+                        s.v[g][l] = b.v;
+                        rank[g][l] = r.rank;
+                    } while (lanes);
+                    // Lanes that are not rays repeat the first (lane 0 always is one).
+                    for (int l = 1; l < 8; ++l) {
+                        if (s.lanes[g] >> l & 1) continue;
+                        s.tmax[g][l] = s.tmax[g][0];
+                        s.prim[g][l] = s.prim[g][0];
+                        s.u[g][l] = s.u[g][0];
+                        s.v[g][l] = s.v[g][0];
+                        rank[g][l] = rank[g][0];
+                    }
+                    s.gtmax[g] = hmax(load8(s.tmax[g]));
+                } while (gm);
+                tile_loop(
+                    *r.tree, so, ng, oregular, osigns, oray.origin,
+                    [&](std::uint32_t leaf, std::uint32_t og) {
+                        leaf_groups(*r.tree, leaf, so, og, oray.origin);
+                    },
+                    bottom);
+                for (std::uint32_t om = oregular; om;) {
+                    const int g = __builtin_ctz(om);
+                    om &= om - 1;
+                    bool changed = false;
+                    for (int l = 0; l < 8; ++l) {
+                        if (so.prim[g][l] >= kTieWins) continue;
+                        s.tmax[g][l] = so.tmax[g][l];
+                        s.prim[g][l] = so.prim[g][l];
+                        s.u[g][l] = so.u[g][l];
+                        s.v[g][l] = so.v[g][l];
+                        rank[g][l] = r.rank;
+                        changed = true;
+                    }
+                    if (changed) s.gtmax[g] = hmax(load8(s.tmax[g]));
+                }
+                return false;
+            });
+        },
+        stack);
+
+    for (int g = 0; g < ng; ++g) {
+        int lanes = s.lanes[g];
+        if (irregular >> g & 1) {
+            do {
+                int l = __builtin_ctz(static_cast<unsigned>(lanes));
+                lanes &= lanes - 1;
+                const int p = s.pix[g][l];
+                hits[p] = Hit{};
+                found[p] = intersect1_instances(lv, Ray{origin, dirs[p], tmax_in}, hits[p], stack1,
+                                                bottom1);
+            } while (lanes);
+            continue;
+        }
+        do {
+            int l = __builtin_ctz(static_cast<unsigned>(lanes));
+            lanes &= lanes - 1;
+            const int p = s.pix[g][l];
+            const bool f = s.prim[g][l] != kNoIndex;
+            found[p] = f;
+            hits[p] =
+                f ? Hit{s.tmax[g][l], s.prim[g][l], s.u[g][l], s.v[g][l], rank[g][l] - 1} : Hit{};
         } while (lanes);
     }
 }

@@ -41,8 +41,13 @@ namespace toonray::accel {
 
 const KernelTable* kernels_avx2() {
 #ifdef TOONRAY_ACCEL_HAVE_AVX2
-    static const KernelTable table{"avx2", &avx2::intersect1, &avx2::occluded1,
-                                   &avx2::intersect_tile};
+    static const KernelTable table{"avx2",
+                                   &avx2::intersect1,
+                                   &avx2::occluded1,
+                                   &avx2::intersect_tile,
+                                   &avx2::intersect1_instances,
+                                   &avx2::occluded1_instances,
+                                   &avx2::intersect_tile_instances};
     return &table;
 #else
     return nullptr;

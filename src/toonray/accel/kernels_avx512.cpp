@@ -42,8 +42,13 @@ namespace toonray::accel {
 
 const KernelTable* kernels_avx512() {
 #ifdef TOONRAY_ACCEL_HAVE_AVX512
-    static const KernelTable table{"avx512", &avx512::intersect1, &avx512::occluded1,
-                                   &avx512::intersect_tile};
+    static const KernelTable table{"avx512",
+                                   &avx512::intersect1,
+                                   &avx512::occluded1,
+                                   &avx512::intersect_tile,
+                                   &avx512::intersect1_instances,
+                                   &avx512::occluded1_instances,
+                                   &avx512::intersect_tile_instances};
     return &table;
 #else
     return nullptr;

@@ -18,8 +18,13 @@ namespace {  // internal linkage: the instruction sets' copies must never be mer
 }  // namespace sse
 
 const KernelTable& kernels_sse() {
-    static const KernelTable table{"sse4.2", &sse::intersect1, &sse::occluded1,
-                                   &sse::intersect_tile};
+    static const KernelTable table{"sse4.2",
+                                   &sse::intersect1,
+                                   &sse::occluded1,
+                                   &sse::intersect_tile,
+                                   &sse::intersect1_instances,
+                                   &sse::occluded1_instances,
+                                   &sse::intersect_tile_instances};
     return table;
 }
 

@@ -33,37 +33,18 @@ void best_in_slots(const std::array<float, 8>& cl, const std::array<float, 8>& c
     split[I - 1] = static_cast<std::int8_t>(s);
 }
 
-}  // namespace
-
-void WideBvh::build(const Bvh& bvh, std::span<const float> leaf_areas,
-                    std::span<const Vec3f> positions,
-                    std::span<const std::array<std::uint32_t, 3>> tris,
-                    const CollapseCosts& costs) {
-    nodes.clear();
-    blocks.clear();
-    root = kEmptyChild;
-    depth = 0;
-    max_stack = 8;
-    if (bvh.nodes.empty()) return;
-
-    std::size_t leaves = 0;
-    for (const BvhNode& n : bvh.nodes) leaves += n.is_leaf();
-    const std::size_t tri_count = bvh.prim_indices.size();
-    if (tri_count >= kMaxSlots) throw Error("too many triangles for the BVH (at most 134,217,727)");
-    blocks.clear();
-    reserve_huge(blocks, (tri_count + 3) / 4 + 2);
-    reserve_huge(nodes, leaves / 4 + 1);
-    TriBlock empty;
-    {
-        const float nan = std::numeric_limits<float>::quiet_NaN();
-        for (auto& corner : empty.v)
-            for (auto& axis : corner) std::fill(std::begin(axis), std::end(axis), nan);
-        std::fill(std::begin(empty.prim), std::end(empty.prim), kNoIndex);
-    }
-    // Leaves take their slots in the order they are made (depth-first through the wide tree);
-    // the triangles are copied into the blocks afterwards, block by block in parallel: reading
-    // their corners is the slow part (gathers through the index buffer).
-    auto slot_prim = make_huge_array<std::uint32_t>(tri_count);
+// Collapses `bvh` into w.nodes (root, depth, max_stack set) and writes the leaves' primitives
+// into slot_prim in the order leaves are made, the last of each leaf or'ed with kLeafEnd;
+// returns how many slots were used. prim_box(p) is primitive p's box (for leaves spread one
+// primitive per slot).
+template <class PrimBox>
+std::uint32_t collapse(WideBvh& w, const Bvh& bvh, std::span<const float> leaf_areas,
+                       const WideBvh::CollapseCosts& costs, PrimBox&& prim_box,
+                       std::uint32_t* slot_prim) {
+    auto& nodes = w.nodes;
+    auto& root = w.root;
+    auto& depth = w.depth;
+    auto& max_stack = w.max_stack;
     std::uint32_t next_slot = 0;
     auto make_leaf = [&](const BvhNode& leaf) {
         const std::uint32_t first = next_slot;
@@ -72,39 +53,10 @@ void WideBvh::build(const Bvh& bvh, std::span<const float> leaf_areas,
                 bvh.prim_indices[leaf.first + i] | (i + 1 == leaf.count ? kLeafEnd : 0u);
         return kLeafBit | ((leaf.count <= 15 ? leaf.count : 0u) << kLeafCountShift) | first;
     };
-    // Fills the blocks, plus two empty ones after the last (8-wide loads may read up to two
-    // blocks past a leaf).
-    auto pack = [&] {
-        const std::size_t used = (next_slot + 3) / 4;
-        blocks.resize(used + 2);
-        blocks[used] = empty;
-        blocks[used + 1] = empty;
-        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, used, 2048), [&](const auto& r) {
-            for (std::size_t b = r.begin(); b != r.end(); ++b) {
-                TriBlock block = empty;
-                const std::size_t lanes = std::min<std::size_t>(4, next_slot - 4 * b);
-                for (std::size_t l = 0; l < lanes; ++l) {
-                    const std::uint32_t slot = slot_prim[4 * b + l];
-                    const std::uint32_t p = slot & ~kLeafEnd;
-                    for (int c = 0; c < 3; ++c) {
-                        const Vec3f& v = positions[tris[p][c]];
-                        block.v[c][0][l] = v.x;
-                        block.v[c][1][l] = v.y;
-                        block.v[c][2][l] = v.z;
-                    }
-                    block.prim[l] = slot;
-                }
-                blocks[b] = block;
-            }
-        });
-    };
-
     if (bvh.nodes[0].is_leaf()) {
         root = make_leaf(bvh.nodes[0]);
-        pack();
-        return;
+        return next_slot;
     }
-
     // Collapse by dynamic programming over the binary tree (Ylitie, Karras and Laine 2017):
     // cost[n][i - 1] is the least SAH cost of representing binary node n's subtree as at most
     // i subtrees side by side (i slots of a wide node), where a wide node costs `node_cost`
@@ -122,13 +74,6 @@ void WideBvh::build(const Bvh& bvh, std::span<const float> leaf_areas,
     constexpr std::uint8_t kAsLeaf = 1, kSpread = 2;
     auto range = [&](std::uint32_t n) {
         return BvhNode{bvh.nodes[n].bounds, first_prim[n], prim_count[n]};
-    };
-    // A triangle's box from its corners: only spread leaves need it (one slot per triangle), so
-    // it is computed here rather than kept for every triangle.
-    auto tri_box = [&](std::uint32_t p) {
-        BBox box;
-        for (std::uint32_t v : tris[p]) box.extend(positions[v]);
-        return box;
     };
     for (std::size_t n = count; n-- > 0;) {
         const BvhNode& b = bvh.nodes[n];
@@ -194,7 +139,7 @@ void WideBvh::build(const Bvh& bvh, std::span<const float> leaf_areas,
         if (b.is_leaf()) {
             if ((flags[n] & kSpread) && static_cast<std::uint32_t>(i) >= b.count) {
                 for (std::uint32_t k = 0; k < b.count; ++k)
-                    out[len++] = {BvhNode{tri_box(bvh.prim_indices[b.first + k]), b.first + k, 1},
+                    out[len++] = {BvhNode{prim_box(bvh.prim_indices[b.first + k]), b.first + k, 1},
                                   kNoIndex};
             } else {
                 out[len++] = {b, kNoIndex};
@@ -213,8 +158,7 @@ void WideBvh::build(const Bvh& bvh, std::span<const float> leaf_areas,
 
     if (flags[0] & kAsLeaf) {
         root = make_leaf(range(0));
-        pack();
-        return;
+        return next_slot;
     }
     struct Item {
         std::uint32_t binary, wide;
@@ -259,9 +203,90 @@ void WideBvh::build(const Bvh& bvh, std::span<const float> leaf_areas,
         }
         nodes[item.wide] = w;
     }
-    pack();
     // Traversal pushes at most 7 entries per level.
     max_stack = 8 * static_cast<std::size_t>(depth) + 8;
+    return next_slot;
+}
+
+}  // namespace
+
+void WideBvh::build(const Bvh& bvh, std::span<const float> leaf_areas,
+                    std::span<const Vec3f> positions,
+                    std::span<const std::array<std::uint32_t, 3>> tris,
+                    const CollapseCosts& costs) {
+    nodes.clear();
+    blocks.clear();
+    root = kEmptyChild;
+    depth = 0;
+    max_stack = 8;
+    if (bvh.nodes.empty()) return;
+
+    std::size_t leaves = 0;
+    for (const BvhNode& n : bvh.nodes) leaves += n.is_leaf();
+    const std::size_t tri_count = bvh.prim_indices.size();
+    if (tri_count >= kMaxSlots) throw Error("too many triangles for the BVH (at most 134,217,727)");
+    blocks.clear();
+    reserve_huge(blocks, (tri_count + 3) / 4 + 2);
+    reserve_huge(nodes, leaves / 4 + 1);
+    TriBlock empty;
+    {
+        const float nan = std::numeric_limits<float>::quiet_NaN();
+        for (auto& corner : empty.v)
+            for (auto& axis : corner) std::fill(std::begin(axis), std::end(axis), nan);
+        std::fill(std::begin(empty.prim), std::end(empty.prim), kNoIndex);
+    }
+    // Leaves take their slots in the order they are made (depth-first through the wide tree);
+    // the triangles are copied into the blocks afterwards, block by block in parallel: reading
+    // their corners is the slow part (gathers through the index buffer).
+    auto slot_prim = make_huge_array<std::uint32_t>(tri_count);
+    // A triangle's box from its corners: only spread leaves need it (one slot per triangle), so
+    // it is computed here rather than kept for every triangle.
+    auto tri_box = [&](std::uint32_t p) {
+        BBox box;
+        for (std::uint32_t v : tris[p]) box.extend(positions[v]);
+        return box;
+    };
+    const std::uint32_t next_slot = collapse(*this, bvh, leaf_areas, costs, tri_box, &slot_prim[0]);
+    // Fills the blocks, plus two empty ones after the last (8-wide loads may read up to two
+    // blocks past a leaf).
+    const std::size_t used = (next_slot + 3) / 4;
+    blocks.resize(used + 2);
+    blocks[used] = empty;
+    blocks[used + 1] = empty;
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, used, 2048), [&](const auto& r) {
+        for (std::size_t b = r.begin(); b != r.end(); ++b) {
+            TriBlock block = empty;
+            const std::size_t lanes = std::min<std::size_t>(4, next_slot - 4 * b);
+            for (std::size_t l = 0; l < lanes; ++l) {
+                const std::uint32_t slot = slot_prim[4 * b + l];
+                const std::uint32_t p = slot & ~kLeafEnd;
+                for (int c = 0; c < 3; ++c) {
+                    const Vec3f& v = positions[tris[p][c]];
+                    block.v[c][0][l] = v.x;
+                    block.v[c][1][l] = v.y;
+                    block.v[c][2][l] = v.z;
+                }
+                block.prim[l] = slot;
+            }
+            blocks[b] = block;
+        }
+    });
+}
+
+void WideBvh::build_over_boxes(const Bvh& bvh, std::span<const float> leaf_areas,
+                               std::span<const BBox> boxes, const CollapseCosts& costs,
+                               std::vector<std::uint32_t>& slots) {
+    nodes.clear();
+    blocks.clear();
+    root = kEmptyChild;
+    depth = 0;
+    max_stack = 8;
+    slots.clear();
+    if (bvh.nodes.empty()) return;
+    if (bvh.prim_indices.size() >= kMaxSlots) throw Error("too many boxes for the BVH");
+    slots.resize(bvh.prim_indices.size());
+    slots.resize(collapse(
+        *this, bvh, leaf_areas, costs, [&](std::uint32_t p) { return boxes[p]; }, slots.data()));
 }
 
 }  // namespace toonray::accel

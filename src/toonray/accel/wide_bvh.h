@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "toonray/accel/bvh.h"
+#include "toonray/core/bbox.h"
 #include "toonray/core/index.h"
 #include "toonray/core/math.h"
 
@@ -71,6 +72,38 @@ struct WideBvh {
     /// area of the box of triangle bvh.prim_indices[i] (read in leaf order, not gathered).
     void build(const Bvh& bvh, std::span<const float> leaf_areas, std::span<const Vec3f> positions,
                std::span<const std::array<std::uint32_t, 3>> tris, const CollapseCosts& costs);
+    /// The same collapse over primitives that are boxes (`bvh` built over `boxes`), without
+    /// triangle blocks: the leaves' slots index `slots`, which receives the primitive ids in
+    /// leaf order, the last of each leaf or'ed with kLeafEnd (the instance level's tree).
+    void build_over_boxes(const Bvh& bvh, std::span<const float> leaf_areas,
+                          std::span<const BBox> boxes, const CollapseCosts& costs,
+                          std::vector<std::uint32_t>& slots);
 };
+
+/// What traversal reads of one instance (TriangleAccel::set_instances), 64 bytes: the ray is
+/// taken into object space by `from_world` (summed in double, rounded once: the same bits on
+/// every CPU) and traced through the mesh's tree.
+struct alignas(64) InstanceRecord {
+    float from_world[3][4];  ///< world to object, row-major; unused when `identity`
+    const WideBvh* tree = nullptr;
+    /// Ties between instances go to the lower rank: 0 for the accelerator's own triangles,
+    /// i + 1 for instance i.
+    std::uint32_t rank = 0;
+    std::uint32_t identity = 0;  ///< 1: object space is world space (the own triangles)
+};
+static_assert(sizeof(InstanceRecord) == 64);
+
+/// The top level of a two-level BVH: a wide tree over the instances' world boxes whose leaves'
+/// slots index `slots`, each the index of a record.
+struct InstanceLevel {
+    WideBvh tree;  ///< nodes only (no blocks)
+    std::vector<std::uint32_t> slots;
+    std::vector<InstanceRecord> records;
+    std::size_t bottom_stack = 8;  ///< the largest max_stack of the records' trees
+};
+
+/// BestHit's "no hit yet, but a hit at the same distance wins" (see kernels.inl): above every
+/// triangle index, and positive as a signed number.
+inline constexpr std::uint32_t kTieWins = 0x7ffffffeu;
 
 }  // namespace toonray::accel

@@ -187,8 +187,9 @@ BatchReport run_batch(const BatchOptions& options, BatchObserver* observer) {
         Warnings warnings;
         GltfDocument document = load_gltf(file, warnings, gltf);
         // Each job poses its own scene.
-        check_memory(plan.bytes(scene_bytes(document.vertices, document.triangles)),
-                     fmt::format("{} frames of {} at once", plan.jobs, file.string()));
+        check_memory(
+            plan.bytes(scene_bytes(document.vertices, document.triangles, document.instances)),
+            fmt::format("{} frames of {} at once", plan.jobs, file.string()));
         GltfSource scenes(std::move(document), options.gltf, options.gltf_fps, setup);
         if (auto w = scenes.animator().aspect_warning(setup.width, setup.height))
             warnings.push_back(*w);

@@ -81,16 +81,20 @@ public:
         PianoOptions piano;
         piano.hole_capacity = std::max<std::uint32_t>(playback_.hole_capacity(), 1);
         model_ = build_piano(piano);
+        if (options_.instanced_keys) keyed_ = instance_keys(model_);
     }
 
     void load(int frame, SceneFrame& out, Warnings&) const override {
         const double t = options_.start + (frame - 1) / options_.fps;
         // A job poses its own copy in place; auto-smooth adds normals that posing would not
         // move, so then every frame starts from the model.
-        if (out.scene.triangle_count() != model_.scene.triangle_count() || setup_.auto_smooth)
-            out.scene = model_.scene;
-        const PoseStats stats =
-            pose_piano(model_, playback_.pose_at(t), &playback_.roll(), out.scene);
+        const Scene& start = options_.instanced_keys ? keyed_ : model_.scene;
+        if (out.scene.triangle_count() != start.triangle_count() ||
+            out.scene.instances.size() != start.instances.size() || setup_.auto_smooth)
+            out.scene = start;
+        const PianoPose pose = playback_.pose_at(t);
+        const PoseStats stats = pose_piano(model_, pose, &playback_.roll(), out.scene);
+        if (options_.instanced_keys) pose_key_instances(model_, pose, out.scene);
         dropped_holes_ += stats.dropped_holes;
         out.scene.camera = path_.camera(t);
         finish_scene(out, {}, setup_);
@@ -102,6 +106,7 @@ public:
 private:
     PianoPlayback playback_;
     PianoModel model_;
+    Scene keyed_;  ///< with instanced keys: the model's scene with the keys as instances
     const CameraPath& path_;
     const PianoMovieOptions& options_;
     SceneSetup setup_;
@@ -126,7 +131,14 @@ private:
         void produce(int frame, std::optional<int>, Warnings& warnings) override {
             frames_.scenes_.load(frame, scene_, warnings);
             scene_.scene.camera = scene_.camera;
-            writer_.write(frames_.output(frame), scene_.scene);
+            if (scene_.scene.instances.empty()) {
+                writer_.write(frames_.output(frame), scene_.scene);
+            } else {
+                // OBJ has no instances: the keys are written flattened.
+                Scene flat = flatten_instances(scene_.scene);
+                flat.camera = scene_.camera;
+                writer_.write(frames_.output(frame), flat);
+            }
         }
 
     private:
@@ -181,6 +193,8 @@ PianoMovieReport render_piano_movie(const Score& score, const CameraPath& camera
     } else {
         plan = plan_frame_jobs(options.render, options.jobs, static_cast<std::size_t>(frames));
     }
+    // The flat model's estimate: with instanced keys the scene holds less (the keys' shapes
+    // once and 88 instances).
     const std::uint64_t scene = scene_bytes(piano.positions.size(), piano.triangle_count());
     if (options.jobs <= 0)  // one per core, as many as fit
         while (plan.jobs > 1 && plan.bytes(scene) > limits().max_memory) --plan.jobs;

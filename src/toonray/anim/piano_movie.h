@@ -38,6 +38,11 @@ struct PianoMovieOptions {
     FrameOptions render;  ///< size, lines, AOVs, PNG level
     SceneSetup scene;     ///< auto-smooth, lights; a camera here replaces the camera path
     int jobs = 0;         ///< frames at once; 0 = one per core
+    /// The 88 keys as instances of their shapes (instance_keys, piano/piano_pose.h): posing a
+    /// frame moves 88 transforms and rebuilds the BVH's top level instead of refitting the
+    /// keys' vertices. The pictures differ from the flattened keys' only along edges (hits and
+    /// lines found in the keys' frames). Exported OBJ files hold the keys flattened.
+    bool instanced_keys = false;
     bool resume = false;  ///< skip frames whose PNG is already valid
     const std::atomic<bool>* cancel = nullptr;
 };

@@ -3,6 +3,7 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "toonray/accel/triangle_accel.h"
@@ -16,6 +17,11 @@ namespace toonray {
 /// build, but the tree loosens as vertices travel, so it is rebuilt now and then. Images do
 /// not depend on it: among hits at the same distance the lowest triangle index wins, whatever
 /// the tree.
+///
+/// Instances (Scene::instances): each distinct mesh's tree is built once and kept while frames
+/// keep using the same mesh object (meshes are immutable, so the same object means the same
+/// triangles); a frame that only moves instances rebuilds the small top level alone
+/// (TriangleAccel::move_instances).
 class AnimationAccel {
 public:
     static constexpr int kMaxRefitsInARow = 15;
@@ -26,8 +32,25 @@ public:
 
     /// Whether the last update refitted rather than built.
     [[nodiscard]] bool refitted() const { return refits_in_a_row_ > 0; }
+    /// How many mesh trees were built for instances so far.
+    [[nodiscard]] std::size_t mesh_builds() const { return mesh_builds_; }
 
 private:
+    struct MeshEntry {
+        std::shared_ptr<const TriangleMesh> mesh;  ///< held: its address stays its identity
+        std::shared_ptr<const TriangleAccel> accel;
+        Bvh::Config config;
+        bool used = false;
+    };
+    std::shared_ptr<const TriangleAccel> mesh_accel(const std::shared_ptr<const TriangleMesh>& mesh,
+                                                    const Bvh::Config& config);
+    void update_instances(const Scene& scene, const Bvh::Config& config);
+
+    std::vector<MeshEntry> meshes_;
+    std::vector<const TriangleAccel*> instance_meshes_;  ///< the tree of each instance
+    Bvh::Config instance_config_;
+    std::size_t mesh_builds_ = 0;
+
     TriangleAccel accel_;
     std::vector<std::array<std::uint32_t, 3>> triangles_;  ///< the triangles accel_ was built for
     Bvh::Config config_;

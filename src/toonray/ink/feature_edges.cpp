@@ -13,6 +13,7 @@
 #include "toonray/core/simd_sse.h"
 #include "toonray/ink/chunks.h"
 #include "toonray/ink/hash.h"
+#include "toonray/ink/mesh_topology.h"
 
 namespace toonray::ink {
 
@@ -60,7 +61,9 @@ std::array<Vec3f, 3> corners(const Scene& scene, std::size_t t) {
 
 }  // namespace
 
-WeldedMesh weld_vertices(const Scene& scene) {
+WeldedMesh weld_vertices(const TriangleMesh& scene) { return weld_vertices(scene, false); }
+
+WeldedMesh weld_vertices(const TriangleMesh& scene, bool one_object) {
     const std::size_t n = scene.triangle_count();
     // Positions with the same bits share a canonical index, the lowest among them: each
     // position, in index order, looks its bits up in an open-addressing table (linear probing,
@@ -104,7 +107,7 @@ WeldedMesh weld_vertices(const Scene& scene) {
     for (std::size_t t = 0; t < n; ++t)
         for (int k = 0; k < 3; ++k) {
             const std::uint32_t c = canonical[scene.tri_positions[t][k]],
-                                object = scene.tri_object[t];
+                                object = one_object ? 0u : scene.tri_object[t];
             std::uint32_t& id = mesh.tri_vertices[t][k];
             if (id_of[c] == kNoIndex) {
                 id = id_of[c] = new_id(c);
@@ -246,9 +249,9 @@ int candidate_mask(const Slots& slots, std::uint32_t i, std::uint32_t j) {
     return overlap & _mm_movemask_ps(_mm_castsi128_ps(_mm_andnot_si128(shared, stale)));
 }
 
-// Every pair of triangles that take part (`live`) and cross, as intersect_triangles finds them,
-// with (when `stale` is given) at least one stale triangle; in no particular order. Candidate
-// pairs are those whose boxes overlap, from a traversal of the BVH against itself: a pair of
+}  // namespace
+
+// Candidate pairs are those whose boxes overlap, from a traversal of the BVH against itself: a pair of
 // nodes is opened only when the boxes of their live triangles overlap, and a node is paired with
 // itself once, so each triangle pair is met once, in the leaf pair that holds it. The node pairs
 // are first expanded breadth-first into enough independent tasks for the threads. Triangles
@@ -410,103 +413,6 @@ std::vector<PairCrossing> find_crossings(const Bvh& bvh,
     return found;
 }
 
-}  // namespace
-
-namespace {
-
-// A side of a usable triangle: from welded vertex lo to hi (lo < hi).
-struct Side {
-    std::uint32_t lo, hi, tri;
-    bool forward;  // lo -> hi in the triangle's winding
-};
-
-}  // namespace
-
-struct MeshTopology {
-    // What it was made from.
-    std::vector<std::array<std::uint32_t, 3>> tri_vertices;
-    std::vector<std::uint32_t> tri_object;
-    std::vector<std::uint8_t> usable;
-    std::size_t objects = 0;
-    /// Every side of a usable triangle, in order of (lo, hi, triangle, corner), so that the
-    /// sides of one edge are adjacent: edge e is sides [edge_first[e], edge_first[e + 1]).
-    std::unique_ptr<Side[]> sides;  // every one written: not cleared first
-    std::vector<std::uint32_t> edge_first;
-    /// Per object: not closed, for an edge without exactly two sides in opposite directions,
-    /// or a triangle that is not usable or has two corners welded together.
-    std::vector<std::uint8_t> open;
-
-    MeshTopology(const Scene& scene, const WeldedMesh& mesh, std::span<const std::uint8_t> usable_,
-                 std::size_t objects_)
-        : tri_vertices(mesh.tri_vertices),
-          tri_object(scene.tri_object.begin(), scene.tri_object.begin() + scene.triangle_count()),
-          usable(usable_.begin(), usable_.end()),
-          objects(objects_),
-          open(objects_, 0) {
-        const std::size_t n = usable.size(), vertices = mesh.vertex_count();
-        // A counting sort by lo over the triangles in order puts each vertex's sides in
-        // (triangle, corner) order; a stable sort by hi within each vertex then gives the
-        // whole order.
-        std::vector<std::uint32_t> offsets(vertices + 1, 0);
-        for (std::size_t t = 0; t < n; ++t) {
-            const auto& w = tri_vertices[t];
-            if (!usable[t] || w[0] == w[1] || w[1] == w[2] || w[2] == w[0]) open[tri_object[t]] = 1;
-            if (!usable[t]) continue;
-            for (int k = 0; k < 3; ++k)
-                if (w[k] != w[(k + 1) % 3]) ++offsets[std::min(w[k], w[(k + 1) % 3]) + 1];
-        }
-        for (std::size_t v = 0; v < vertices; ++v) offsets[v + 1] += offsets[v];
-        const std::size_t side_count = offsets[vertices];
-        sides = std::make_unique_for_overwrite<Side[]>(side_count);
-        {
-            std::vector<std::uint32_t> fill(offsets.begin(), offsets.end() - 1);
-            for (std::size_t t = 0; t < n; ++t) {
-                if (!usable[t]) continue;
-                const auto& w = tri_vertices[t];
-                for (int k = 0; k < 3; ++k) {
-                    const std::uint32_t u = w[k], v = w[(k + 1) % 3];
-                    if (u == v) continue;
-                    const std::uint32_t lo = std::min(u, v);
-                    sides[fill[lo]++] = {lo, std::max(u, v), static_cast<std::uint32_t>(t), u < v};
-                }
-            }
-        }
-        edge_first.reserve(side_count / 2 + 1);
-        for (std::size_t v = 0; v < vertices; ++v) {
-            Side* const first = sides.get() + offsets[v];
-            Side* const last = sides.get() + offsets[v + 1];
-            // By insertion, as a vertex has few sides (but not at the centre of a large fan).
-            if (last - first > 32) {
-                std::stable_sort(first, last,
-                                 [](const Side& a, const Side& b) { return a.hi < b.hi; });
-            } else {
-                for (Side* i = first + 1; i < last; ++i) {
-                    const Side side = *i;
-                    Side* j = i;
-                    for (; j > first && (j - 1)->hi > side.hi; --j) *j = *(j - 1);
-                    *j = side;
-                }
-            }
-            for (const Side* i = first; i < last;) {
-                const Side* j = i + 1;
-                while (j < last && j->hi == i->hi) ++j;
-                edge_first.push_back(static_cast<std::uint32_t>(i - sides.get()));
-                if (j - i != 2 || i[0].forward == i[1].forward) open[tri_object[i->tri]] = 1;
-                i = j;
-            }
-        }
-        edge_first.push_back(static_cast<std::uint32_t>(side_count));
-    }
-
-    [[nodiscard]] bool same(const Scene& scene, const WeldedMesh& mesh,
-                            std::span<const std::uint8_t> usable_, std::size_t objects_) const {
-        return objects_ == objects && usable_.size() == usable.size() &&
-               std::equal(usable.begin(), usable.end(), usable_.begin()) &&
-               mesh.tri_vertices == tri_vertices &&
-               std::equal(tri_object.begin(), tri_object.end(), scene.tri_object.begin());
-    }
-};
-
 std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedMesh& mesh,
                                                const Bvh& bvh, const Vec3f& eye,
                                                const FeatureEdgeSettings& settings, int threads,
@@ -548,7 +454,8 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
     // usability did not change.
     std::shared_ptr<const MeshTopology> kept = cache ? cache->topology : nullptr;
     if (!kept || !kept->same(scene, mesh, usable_triangle, objects))
-        kept = std::make_shared<const MeshTopology>(scene, mesh, usable_triangle, objects);
+        kept =
+            std::make_shared<const MeshTopology>(scene.tri_object, mesh, usable_triangle, objects);
     if (cache) cache->topology = kept;
     const MeshTopology& topology = *kept;
     const Side* const sides = topology.sides.get();

@@ -30,9 +30,13 @@ const char* edge_type_name(EdgeType type);
 /// Identifies a segment's endpoint so that segments meeting there can be chained without
 /// comparing floats: a welded vertex {v, kNoIndex, kNoIndex}; a point on the welded edge
 /// (a < b) {a, b, kNoIndex} (smooth contours); a point where the welded edge (a < b) of one
-/// triangle crosses triangle t {a, b, t} (intersection lines).
+/// triangle crosses triangle t {a, b, t} (intersection lines). With instances, `instance` is
+/// the instance whose mesh's welded vertices a and b are and `c_instance` the instance of
+/// triangle c (kNoIndex: the scene's own triangles), so that instances of one mesh never
+/// share a key.
 struct EndpointKey {
     std::uint32_t a = kNoIndex, b = kNoIndex, c = kNoIndex;
+    std::uint32_t instance = kNoIndex, c_instance = kNoIndex;
     auto operator<=>(const EndpointKey&) const = default;
 };
 
@@ -42,6 +46,8 @@ struct FeatureSegment {
     EdgeType type = EdgeType::Silhouette;
     /// Triangles the segment lies on (kNoIndex for none): their own surface must not hide it.
     std::array<std::uint32_t, 2> faces{kNoIndex, kNoIndex};
+    /// The instance whose mesh each face is of (kNoIndex: the scene's own triangles).
+    std::array<std::uint32_t, 2> face_instance{kNoIndex, kNoIndex};
     /// Smooth contours lie inside a triangle of a polygonal approximation of a smooth surface,
     /// where the facets around it may graze the line of sight: the triangles sharing a vertex
     /// with `faces[0]` are ignored as occluders too (see visibility.h).
@@ -83,7 +89,10 @@ struct WeldedMesh {
     [[nodiscard]] std::size_t vertex_count() const { return vertex_position.size(); }
 };
 
-[[nodiscard]] WeldedMesh weld_vertices(const Scene& scene);
+[[nodiscard]] WeldedMesh weld_vertices(const TriangleMesh& scene);
+/// The same with every triangle taken as one object (an instanced mesh, whose instance is
+/// the object) when `one_object`.
+[[nodiscard]] WeldedMesh weld_vertices(const TriangleMesh& scene, bool one_object);
 
 /// The segment where triangles (a0, a1, a2) and (b0, b1, b2) cross, if they do properly (each
 /// has corners strictly on both sides of the other's plane; coplanar or touching pairs give

@@ -41,9 +41,7 @@ std::vector<SegmentStyles> resolve_segment_styles(const Scene& scene,
     };
     std::map<std::tuple<std::uint32_t, std::uint32_t, EdgeType>, SegmentStyles> known;
     for (std::size_t i = 0; i < segments.size(); ++i) {
-        const std::uint32_t tri = style_source_triangle(scene, segments[i]);
-        const std::uint32_t object = tri == kNoIndex ? 0 : scene.tri_object[tri];
-        const std::uint32_t material = tri == kNoIndex ? 0 : scene.tri_material[tri];
+        const auto [object, material] = style_source(scene, segments[i]);
         const auto key = std::make_tuple(object, material, segments[i].type);
         auto it = known.find(key);
         if (it == known.end()) {
@@ -73,6 +71,27 @@ std::uint32_t style_source_triangle(const Scene& scene, const FeatureSegment& se
     return best;
 }
 
+std::pair<std::uint32_t, std::uint32_t> style_source(const Scene& scene,
+                                                     const FeatureSegment& segment) {
+    if (segment.face_instance[0] == kNoIndex && segment.face_instance[1] == kNoIndex) {
+        const std::uint32_t tri = style_source_triangle(scene, segment);
+        if (tri == kNoIndex) return {0, 0};
+        return {scene.tri_object[tri], scene.tri_material[tri]};
+    }
+    std::pair<std::uint32_t, std::uint32_t> best{kNoIndex, kNoIndex};
+    for (int k = 0; k < 2; ++k) {
+        const std::uint32_t f = segment.faces[k], instance = segment.face_instance[k];
+        if (f == kNoIndex) continue;
+        const TriangleMesh& mesh = scene.mesh_of(instance);
+        if (f >= mesh.triangle_count()) continue;
+        const std::pair<std::uint32_t, std::uint32_t> source{
+            instance == kNoIndex ? mesh.tri_object[f] : scene.instances[instance].object,
+            mesh.tri_material[f]};
+        if (best.first == kNoIndex || source < best) best = source;
+    }
+    return best.first == kNoIndex ? std::pair<std::uint32_t, std::uint32_t>{0, 0} : best;
+}
+
 void draw_ink_lines(const Scene& scene, const TriangleAccel& accel, const CameraSpec& camera,
                     int width, int height, const InkSettings& settings, int threads,
                     InkLines& out) {
@@ -85,6 +104,8 @@ void draw_ink_lines(const Scene& scene, const TriangleAccel& accel, const Camera
     if (!settings.chain.hidden) edges.certainly_hidden = false;  // chaining would drop them
     out.segments = find_feature_edges(scene, out.mesh, accel.bvh(), plane.eye, edges, threads,
                                       &out.intersections);
+    add_instance_segments(scene, accel, out.mesh, plane, view, settings.visibility.margin, edges,
+                          threads, out.instances, out.segments);
     add_polyline_segments(scene, out.segments);
     out.timings.edges = seconds_since(start);
 
@@ -96,8 +117,9 @@ void draw_ink_lines(const Scene& scene, const TriangleAccel& accel, const Camera
     VisibilitySettings visibility = settings.visibility;
     if (!settings.chain.hidden)
         visibility.max_invisibility = std::min(visibility.max_invisibility, 1);
-    out.pieces = split_by_visibility(out.segments, VisibilityContext{scene, out.mesh, accel, view},
-                                     visibility, threads);
+    out.pieces = split_by_visibility(
+        out.segments, VisibilityContext{scene, out.mesh, accel, view, &out.instances}, visibility,
+        threads);
     out.timings.visibility = seconds_since(start);
 
     start = std::chrono::steady_clock::now();

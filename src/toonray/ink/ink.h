@@ -9,6 +9,7 @@
 #include "toonray/core/image.h"
 #include "toonray/ink/draw.h"
 #include "toonray/ink/feature_edges.h"
+#include "toonray/ink/instance_lines.h"
 #include "toonray/ink/line_style.h"
 #include "toonray/ink/strokes.h"
 #include "toonray/ink/visibility.h"
@@ -54,6 +55,7 @@ struct InkLines {
     ImageF coverage;  ///< drawn strokes, 0 = no line, 1 = covered (the largest per pixel)
     Image<std::uint16_t> style;       ///< per pixel, the style of the stroke that gave the coverage
     IntersectionCache intersections;  ///< for the next frame's unmoved triangles
+    InstanceLineCache instances;      ///< for the next frame's meshes and unmoved instances
     InkTimings timings;
 };
 
@@ -62,6 +64,11 @@ struct InkLines {
 /// objects is styled as the object listed first). kNoIndex without faces.
 [[nodiscard]] std::uint32_t style_source_triangle(const Scene& scene,
                                                   const FeatureSegment& segment);
+
+/// The object and material a segment is styled as (style_source_triangle's rule, with an
+/// instance's triangles of its object and its mesh's material); (0, 0) without faces.
+[[nodiscard]] std::pair<std::uint32_t, std::uint32_t> style_source(const Scene& scene,
+                                                                   const FeatureSegment& segment);
 
 /// Runs every stage for one view of the scene. `accel` holds the scene's triangles in their
 /// order. Without hidden strokes (settings.chain.hidden false) visibility only tells visible

@@ -89,7 +89,9 @@ EndGroups group_ends(const std::vector<Link>& links) {
         const Link& link = links[e / 2];
         const EndpointKey& key = e % 2 ? link.key1 : link.key0;
         if (!has_key(key)) continue;
-        std::size_t slot = hash_words(key.a, key.b, key.c) & (table_size - 1);
+        std::size_t slot = hash_words(key.a ^ ((key.instance + 1) * 0x9e3779b9u), key.b,
+                                      key.c ^ ((key.c_instance + 1) * 0x85ebca6bu)) &
+                           (table_size - 1);
         while (table[slot] != kNoIndex && keys[table[slot]] != key)
             slot = (slot + 1) & (table_size - 1);
         if (table[slot] == kNoIndex) {

@@ -6,36 +6,36 @@
 
 #include "toonray/core/portable_math.h"
 #include "toonray/ink/chunks.h"
+#include "toonray/ink/instance_lines.h"
 
 namespace toonray::ink {
 
 namespace {
 
-// ignored_triangles into a buffer kept across segments.
+// ignored_triangle_keys into a buffer kept across segments.
 void gather_ignored(const FeatureSegment& segment, const WeldedMesh& mesh,
-                    std::vector<std::uint32_t>& out) {
+                    const InstanceLineCache* instances, std::vector<TriangleKey>& out) {
     out.clear();
-    for (std::uint32_t f : segment.faces)
-        if (f != kNoIndex) out.push_back(f);
-    if (segment.smooth && segment.faces[0] != kNoIndex)
-        for (std::uint32_t v : mesh.tri_vertices[segment.faces[0]])
-            out.insert(out.end(), mesh.ring_triangles.begin() + mesh.ring_offsets[v],
-                       mesh.ring_triangles.begin() + mesh.ring_offsets[v + 1]);
+    for (int k = 0; k < 2; ++k)
+        if (segment.faces[k] != kNoIndex)
+            out.push_back(triangle_key(segment.face_instance[k], segment.faces[k]));
+    if (segment.smooth && segment.faces[0] != kNoIndex) {
+        const std::uint32_t instance = segment.face_instance[0];
+        const WeldedMesh& ring =
+            instance == kNoIndex ? mesh : instance_welded_mesh(*instances, instance);
+        for (std::uint32_t v : ring.tri_vertices[segment.faces[0]])
+            for (std::uint32_t i = ring.ring_offsets[v]; i < ring.ring_offsets[v + 1]; ++i)
+                out.push_back(triangle_key(instance, ring.ring_triangles[i]));
+    }
     std::sort(out.begin(), out.end());
     out.erase(std::unique(out.begin(), out.end()), out.end());
 }
 
-}  // namespace
-
-std::vector<std::uint32_t> ignored_triangles(const FeatureSegment& segment,
-                                             const WeldedMesh& mesh) {
-    std::vector<std::uint32_t> out;
-    gather_ignored(segment, mesh, out);
-    return out;
-}
-
-int count_occluders(const TriangleAccel& accel, const Vec3f& point, const Vec3f& eye,
-                    std::span<const std::uint32_t> ignored, const VisibilitySettings& settings) {
+// Surfaces between the point and the eye (count_occluders), with `ignored(hit)` telling the
+// hits that do not count.
+template <class Ignored>
+int count_occluders_with(const TriangleAccel& accel, const Vec3f& point, const Vec3f& eye,
+                         Ignored&& ignored, const VisibilitySettings& settings) {
     // The ray runs from the point (t = 0) to the eye (t = 1); after each hit it starts again
     // just past it, so every surface on the way is met once. Only the count reaching
     // max_invisibility ends the walk early: however many ignored surfaces come first, the
@@ -48,12 +48,53 @@ int count_occluders(const TriangleAccel& accel, const Vec3f& point, const Vec3f&
     while (t < t_end) {
         Hit hit;
         if (!accel.intersect(Ray{point + dir * t, dir, t_end - t}, hit)) break;
-        if (!std::binary_search(ignored.begin(), ignored.end(), hit.prim))
+        if (!ignored(hit))
             if (++count >= settings.max_invisibility) break;
         // At least to the next float, so that the walk ends even with no skip.
         t = std::max(t + hit.t + skip, std::nextafter(t, t_end));
     }
     return count;
+}
+
+}  // namespace
+
+std::vector<std::uint32_t> ignored_triangles(const FeatureSegment& segment,
+                                             const WeldedMesh& mesh) {
+    std::vector<TriangleKey> keys;
+    gather_ignored(segment, mesh, nullptr, keys);
+    std::vector<std::uint32_t> out;
+    for (TriangleKey k : keys) out.push_back(static_cast<std::uint32_t>(k));
+    return out;
+}
+
+std::vector<TriangleKey> ignored_triangle_keys(const FeatureSegment& segment,
+                                               const WeldedMesh& mesh,
+                                               const InstanceLineCache* instances) {
+    std::vector<TriangleKey> out;
+    gather_ignored(segment, mesh, instances, out);
+    return out;
+}
+
+int count_occluders(const TriangleAccel& accel, const Vec3f& point, const Vec3f& eye,
+                    std::span<const std::uint32_t> ignored, const VisibilitySettings& settings) {
+    return count_occluders_with(
+        accel, point, eye,
+        [&](const Hit& hit) {
+            return hit.instance == kNoIndex &&
+                   std::binary_search(ignored.begin(), ignored.end(), hit.prim);
+        },
+        settings);
+}
+
+int count_occluders(const TriangleAccel& accel, const Vec3f& point, const Vec3f& eye,
+                    std::span<const TriangleKey> ignored, const VisibilitySettings& settings) {
+    return count_occluders_with(
+        accel, point, eye,
+        [&](const Hit& hit) {
+            return std::binary_search(ignored.begin(), ignored.end(),
+                                      triangle_key(hit.instance, hit.prim));
+        },
+        settings);
 }
 
 namespace {
@@ -128,7 +169,7 @@ std::vector<EdgePiece> split_by_visibility(std::span<const FeatureSegment> segme
             std::vector<int> states, sample_states;
             std::vector<Vec3f> dirs, points;
             std::vector<Hit> hits;
-            std::vector<std::uint32_t> ignored;
+            std::vector<TriangleKey> ignored;
             std::unique_ptr<bool[]> found;
             std::size_t found_size = 0;
             for (int i = i0; i < i1; ++i) {
@@ -153,7 +194,7 @@ std::vector<EdgePiece> split_by_visibility(std::span<const FeatureSegment> segme
                     out.push_back(piece);
                     continue;
                 }
-                gather_ignored(seg, context.mesh, ignored);
+                gather_ignored(seg, context.mesh, context.instances, ignored);
                 auto state_at = [&](float s) {
                     const float t = c.t_of(s);
                     return count_occluders(context.accel, seg.p0 + (seg.p1 - seg.p0) * t,
@@ -212,7 +253,8 @@ std::vector<EdgePiece> split_by_visibility(std::span<const FeatureSegment> segme
                         const Hit& hit = hits[static_cast<std::size_t>(k)];
                         if (!found[k]) sample_states[static_cast<std::size_t>(k)] = 0;
                         else if (hit.t >= settings.self_epsilon &&
-                                 !std::binary_search(ignored.begin(), ignored.end(), hit.prim))
+                                 !std::binary_search(ignored.begin(), ignored.end(),
+                                                     triangle_key(hit.instance, hit.prim)))
                             sample_states[static_cast<std::size_t>(k)] = 1;
                         else
                             sample_states[static_cast<std::size_t>(k)] =

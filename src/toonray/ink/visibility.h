@@ -43,19 +43,34 @@ struct EdgePiece {
     [[nodiscard]] bool visible() const { return invisibility == 0; }
 };
 
+struct InstanceLineCache;
+
 /// Everything a visibility query needs: the scene's triangles in an accelerator, the welded
-/// mesh (for the rings ignored around smooth contours) and the view.
+/// mesh (for the rings ignored around smooth contours) and the view; with instances, the welded
+/// meshes of their meshes (instance_lines.h).
 struct VisibilityContext {
     const Scene& scene;
     const WeldedMesh& mesh;
     const TriangleAccel& accel;
     const ScreenProjection& view;
+    const InstanceLineCache* instances = nullptr;
 };
+
+/// A triangle of the scene as hits name it: (instance + 1) << 32 | triangle, so that the own
+/// triangles' keys are their indices.
+using TriangleKey = std::uint64_t;
+[[nodiscard]] inline TriangleKey triangle_key(std::uint32_t instance, std::uint32_t triangle) {
+    return (static_cast<TriangleKey>(instance + 1u) << 32) | triangle;
+}
 
 /// Triangles whose hits do not count against `segment`: its faces, and for a smooth contour
 /// every triangle sharing a vertex with its face. Sorted.
 [[nodiscard]] std::vector<std::uint32_t> ignored_triangles(const FeatureSegment& segment,
                                                            const WeldedMesh& mesh);
+/// The same as keys, for segments on instances too (their rings from `instances`).
+[[nodiscard]] std::vector<TriangleKey> ignored_triangle_keys(const FeatureSegment& segment,
+                                                             const WeldedMesh& mesh,
+                                                             const InstanceLineCache* instances);
 
 /// Surfaces between `point` and the eye: hits of the segment from point to eye with parameter
 /// in (self_epsilon, 1 - self_epsilon), not on an `ignored` triangle (sorted), exactly up to
@@ -63,6 +78,10 @@ struct VisibilityContext {
 /// Hits closer together than a hundredth of self_epsilon count once.
 [[nodiscard]] int count_occluders(const TriangleAccel& accel, const Vec3f& point, const Vec3f& eye,
                                   std::span<const std::uint32_t> ignored,
+                                  const VisibilitySettings& settings);
+/// The same with the ignored triangles as keys (any instance's).
+[[nodiscard]] int count_occluders(const TriangleAccel& accel, const Vec3f& point, const Vec3f& eye,
+                                  std::span<const TriangleKey> ignored,
                                   const VisibilitySettings& settings);
 
 /// The segments cut into pieces of constant visibility, in segment order and along each

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fmt/format.h>
+#include <memory>
 #include <utility>
 #include <vector>
 
@@ -152,6 +153,102 @@ PoseStats pose_piano(const PianoModel& model, const PianoPose& pose, const Punch
     }
     std::fill(holes + 4 * stats.visible_holes, holes + 4 * pool.capacity, pool.park);
     return stats;
+}
+
+namespace {
+
+// A key's triangles as a mesh in its own frame (positions less its pivot).
+std::shared_ptr<TriangleMesh> key_shape(const Scene& rest, const PianoKey& key) {
+    auto mesh = std::make_shared<TriangleMesh>();
+    std::vector<std::uint32_t> position(rest.positions.size(), kNoIndex),
+        normal(rest.normals.size(), kNoIndex), texcoord(rest.texcoords.size(), kNoIndex);
+    auto map = [](std::vector<std::uint32_t>& seen, std::uint32_t i, auto& out, const auto& value) {
+        if (i == kNoIndex) return kNoIndex;
+        if (seen[i] == kNoIndex) {
+            seen[i] = static_cast<std::uint32_t>(out.size());
+            out.push_back(value);
+        }
+        return seen[i];
+    };
+    for (std::size_t t = 0; t < rest.triangle_count(); ++t) {
+        if (rest.tri_object[t] != key.object) continue;
+        std::array<std::uint32_t, 3> p, n, uv;
+        for (int k = 0; k < 3; ++k) {
+            const std::uint32_t pi = rest.tri_positions[t][k], ni = rest.tri_normals[t][k],
+                                ti = rest.tri_texcoords[t][k];
+            p[k] = map(position, pi, mesh->positions, rest.positions[pi] - key.pivot);
+            n[k] = ni == kNoIndex ? kNoIndex : map(normal, ni, mesh->normals, rest.normals[ni]);
+            uv[k] =
+                ti == kNoIndex ? kNoIndex : map(texcoord, ti, mesh->texcoords, rest.texcoords[ti]);
+        }
+        mesh->add_triangle(p, rest.tri_material[t], 0, n, uv);
+    }
+    return mesh;
+}
+
+// Whether two key shapes are the same within a micrometre: keys of one kind differ only by
+// where float arithmetic put their corners.
+bool same_shape(const TriangleMesh& a, const TriangleMesh& b) {
+    if (a.tri_positions != b.tri_positions || a.tri_normals != b.tri_normals ||
+        a.tri_material != b.tri_material || a.positions.size() != b.positions.size() ||
+        a.normals != b.normals)
+        return false;
+    for (std::size_t i = 0; i < a.positions.size(); ++i) {
+        const Vec3f d = a.positions[i] - b.positions[i];
+        if (std::abs(d.x) > 1e-6f || std::abs(d.y) > 1e-6f || std::abs(d.z) > 1e-6f) return false;
+    }
+    return true;
+}
+
+}  // namespace
+
+Scene instance_keys(const PianoModel& model) {
+    const Scene& rest = model.scene;
+    Scene out = rest;
+    // Without the keys' triangles.
+    std::vector<std::uint8_t> is_key(rest.objects.size(), 0);
+    for (const PianoKey& key : model.keys) is_key[key.object] = 1;
+    out.clear_triangles();
+    out.positions = rest.positions;
+    out.normals = rest.normals;
+    out.texcoords = rest.texcoords;
+    out.colours = rest.colours;
+    for (std::size_t t = 0; t < rest.triangle_count(); ++t)
+        if (!is_key[rest.tri_object[t]])
+            out.add_triangle(rest.tri_positions[t], rest.tri_material[t], rest.tri_object[t],
+                             rest.tri_normals[t], rest.tri_texcoords[t]);
+    std::vector<std::uint32_t> shape_of(model.keys.size());
+    std::vector<std::shared_ptr<TriangleMesh>> shapes;
+    for (std::size_t k = 0; k < model.keys.size(); ++k) {
+        auto shape = key_shape(rest, model.keys[k]);
+        std::size_t found = 0;
+        while (found < shapes.size() && !same_shape(*shapes[found], *shape)) ++found;
+        if (found == shapes.size()) shapes.push_back(shape);
+        shape_of[k] = static_cast<std::uint32_t>(found);
+    }
+    for (auto& shape : shapes) out.add_mesh(shape);
+    for (std::size_t k = 0; k < model.keys.size(); ++k)
+        out.add_instance(shape_of[k], Affine3::translation(model.keys[k].pivot),
+                         model.keys[k].object);
+    return out;
+}
+
+void pose_key_instances(const PianoModel& model, const PianoPose& pose, Scene& scene) {
+    if (scene.instances.size() != model.keys.size())
+        throw Error(fmt::format("pose_key_instances: {} instances for {} keys",
+                                scene.instances.size(), model.keys.size()));
+    for (std::size_t k = 0; k < model.keys.size(); ++k) {
+        const PianoKey& key = model.keys[k];
+        Affine3 m = Affine3::translation(key.pivot);
+        if (pose.key_angle[k] != 0.0f) {
+            // pose_piano's rotation, in the same float entries.
+            const Rotation rot(key.axis, pose.key_angle[k]);
+            const Vec3f rows[3] = {rot.r0, rot.r1, rot.r2};
+            for (int i = 0; i < 3; ++i)
+                for (int j = 0; j < 3; ++j) m.m[i][j] = rows[i][j];
+        }
+        scene.instances[k].to_world = m;
+    }
 }
 
 }  // namespace toonray

@@ -87,6 +87,18 @@ struct PoseStats {
     std::uint32_t dropped_holes = 0;  ///< visible slots left out because the pool was full
 };
 
+/// The piano with its 88 keys as instances of their shapes (Scene::instances): the keys' own
+/// triangles are left out of model.scene's copy (their vertices stay, unused, so that
+/// pose_piano still fits it); each distinct key shape (every black key; the white keys by the
+/// notches their black neighbours cut) is one mesh in the key's own frame, its pivot at the
+/// origin, and the key is an instance of it at its pivot, of the key's object (`w1`..`b36`).
+/// Posing then changes 88 transforms (pose_key_instances) instead of the keys' vertices.
+[[nodiscard]] Scene instance_keys(const PianoModel& model);
+
+/// Sets the transforms of a scene from instance_keys (instance i = key i) for the key angles
+/// of `pose`: each key turned about its pivot as pose_piano turns its vertices.
+void pose_key_instances(const PianoModel& model, const PianoPose& pose, Scene& scene);
+
 /// Writes the posed positions and normals of every movable part into `scene`, which must be a
 /// copy of model.scene (same sizes; any earlier pose is overwritten). Touches only the movable
 /// parts' vertex ranges: keys and pedals turn about their pivots, both spools turn by

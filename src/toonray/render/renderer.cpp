@@ -169,7 +169,7 @@ void Renderer::render_buckets(const FrameContext& frame, const ShadingContext& s
     for (std::uint32_t m = 0; m < frame.scene.materials.size(); ++m)
         textured = textured || material_texture(shading, m) != nullptr;
     const LookFrame look{frame.scene, settings.shading, settings.background,
-                         textured || !frame.scene.colours.empty()};
+                         textured || frame.scene.has_colours()};
     SamplerFrame sampling{frame.accel,
                           shading,
                           look,

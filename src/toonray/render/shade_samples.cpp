@@ -16,6 +16,7 @@ constexpr float kInf = std::numeric_limits<float>::infinity();
 // operations, so they have the same bits.
 struct HitTriangle {
     std::uint32_t prim = kNoIndex;
+    std::uint32_t instance = kNoIndex;
     std::uint32_t material = 0, object = 0;
     bool plain = false;           ///< lit by plain_light_terms: plain light, untextured material
     bool vertex_normals = false;  ///< all three corners have one
@@ -26,9 +27,15 @@ struct HitTriangle {
     bool texcoords = false;  ///< all three corners have texture coordinates
     Vec2f t0, t1, t2;
 
-    void load(const ShadingContext& ctx, const Light* plain_light, std::uint32_t p) {
+    [[nodiscard]] bool is(const Hit& hit) const {
+        return hit.prim == prim && hit.instance == instance;
+    }
+    void load(const ShadingContext& ctx, const Light* plain_light, const Hit& hit) {
         const Scene& scene = ctx.scene;
+        const std::uint32_t p = hit.prim;
         prim = p;
+        instance = hit.instance;
+        if (instance != kNoIndex) return load_instanced(ctx, plain_light);
         material = scene.tri_material[p];
         object = scene.tri_object[p];
         plain = plain_light && !material_texture(ctx, material);
@@ -50,6 +57,35 @@ struct HitTriangle {
         const auto& tri = scene.tri_positions[p];
         const Vec3f& p0 = scene.positions[tri[0]];
         face = cross(scene.positions[tri[1]] - p0, scene.positions[tri[2]] - p0);
+        const float len = length(face);
+        face_ok = len > 0.0f;
+        if (face_ok) face = face / len;
+    }
+    // A triangle of an instance: its mesh's, in world space as flatten_instances would put it
+    // (world_corners, world_normal), with the instance's object.
+    [[gnu::noinline]] void load_instanced(const ShadingContext& ctx, const Light* plain_light) {
+        const Scene& scene = ctx.scene;
+        const TriangleMesh& mesh = scene.mesh_of(instance);
+        material = mesh.tri_material[prim];
+        object = scene.instances[instance].object;
+        plain = plain_light && !material_texture(ctx, material);
+        kd = scene.materials[material].kd;
+        const auto& tn = mesh.tri_normals[prim];
+        vertex_normals = tn[0] != kNoIndex && tn[1] != kNoIndex && tn[2] != kNoIndex;
+        if (vertex_normals) {
+            n0 = world_normal(scene, instance, prim, 0);
+            n1 = world_normal(scene, instance, prim, 1);
+            n2 = world_normal(scene, instance, prim, 2);
+        }
+        const auto& tt = mesh.tri_texcoords[prim];
+        texcoords = tt[0] != kNoIndex && tt[1] != kNoIndex && tt[2] != kNoIndex;
+        if (texcoords) {
+            t0 = mesh.texcoords[tt[0]];
+            t1 = mesh.texcoords[tt[1]];
+            t2 = mesh.texcoords[tt[2]];
+        }
+        const std::array<Vec3f, 3> p = world_corners(scene, instance, prim);
+        face = cross(p[1] - p[0], p[2] - p[0]);
         const float len = length(face);
         face_ok = len > 0.0f;
         if (face_ok) face = face / len;
@@ -175,7 +211,7 @@ void shade_run(const ShadingContext& ctx, const LookFrame& look, const ViewPlane
         }
         const Hit& hit = hits[i];
         const Vec3f& dir = dirs[i];
-        if (hit.prim != triangle.prim) triangle.load(ctx, plain, hit.prim);
+        if (!triangle.is(hit)) triangle.load(ctx, plain, hit);
         const Vec3f normal = triangle.shading_normal(hit, dir);
         float* n_dot_l = kAll ? out.n_dot_l + i * lights : nullptr;
         const LightTerms terms =

@@ -70,8 +70,9 @@ namespace {
                                                  const Vec3f& dir, const Vec3f& n, const Vec3f& p,
                                                  const ImageRgb8* texture, float* n_dot_l) {
     const Scene& scene = ctx.scene;
+    const TriangleMesh& mesh = scene.mesh_of(hit.instance);
     const ShadingSettings& s = ctx.settings;
-    const Material& material = scene.materials[scene.tri_material[hit.prim]];
+    const Material& material = scene.materials[mesh.tri_material[hit.prim]];
     LightTerms terms;
     float diffuse = 0.0f;
     bool highlight = false;
@@ -107,18 +108,23 @@ namespace {
         }
     }
     Vec3f kd = material.kd;
-    if (!scene.colours.empty()) {
-        const auto& tri = scene.tri_positions[hit.prim];
-        kd = kd * (scene.colours[tri[0]] * (1.0f - hit.u - hit.v) + scene.colours[tri[1]] * hit.u +
-                   scene.colours[tri[2]] * hit.v);
+    if (!mesh.colours.empty()) {
+        const auto& tri = mesh.tri_positions[hit.prim];
+        kd = kd * (mesh.colours[tri[0]] * (1.0f - hit.u - hit.v) + mesh.colours[tri[1]] * hit.u +
+                   mesh.colours[tri[2]] * hit.v);
+    } else if (!scene.meshes.empty() && scene.has_colours()) {
+        // Where other meshes have colours, one without has white ones (as flatten_instances
+        // gives it), interpolated like any others.
+        const Vec3f white(1.0f);
+        kd = kd * (white * (1.0f - hit.u - hit.v) + white * hit.u + white * hit.v);
     }
     if (texture) {
-        const auto& tt = scene.tri_texcoords[hit.prim];
+        const auto& tt = mesh.tri_texcoords[hit.prim];
         if (tt[0] != kNoIndex && tt[1] != kNoIndex && tt[2] != kNoIndex) {
             float w0 = 1.0f - hit.u - hit.v;
-            const Vec2f& a = scene.texcoords[tt[0]];
-            const Vec2f& b = scene.texcoords[tt[1]];
-            const Vec2f& c = scene.texcoords[tt[2]];
+            const Vec2f& a = mesh.texcoords[tt[0]];
+            const Vec2f& b = mesh.texcoords[tt[1]];
+            const Vec2f& c = mesh.texcoords[tt[2]];
             kd = kd * sample_texture(*texture, a.x * w0 + b.x * hit.u + c.x * hit.v,
                                      a.y * w0 + b.y * hit.u + c.y * hit.v);
         }
@@ -137,13 +143,13 @@ namespace {
 const Light* plain_point_light(const ShadingContext& ctx) {
     const ShadingSettings& s = ctx.settings;
     const bool plain = ctx.lights.size() == 1 && ctx.lights[0].kind == Light::Kind::Point &&
-                       !s.shadows && !s.specular && !(s.rim > 0.0f) && ctx.scene.colours.empty();
+                       !s.shadows && !s.specular && !(s.rim > 0.0f) && !ctx.scene.has_colours();
     return plain ? &ctx.lights[0] : nullptr;
 }
 
 LightTerms light_terms(const ShadingContext& ctx, const Hit& hit, const Vec3f& eye,
                        const Vec3f& dir, const Vec3f& n, float* n_dot_l) {
-    const std::uint32_t m = ctx.scene.tri_material[hit.prim];
+    const std::uint32_t m = ctx.scene.mesh_of(hit.instance).tri_material[hit.prim];
     const ImageRgb8* texture = material_texture(ctx, m);
     if (const Light* light = plain_point_light(ctx); light && !texture)
         return plain_light_terms(ctx, *light, ctx.scene.materials[m].kd, hit, eye, dir, n, n_dot_l);
@@ -153,7 +159,8 @@ LightTerms light_terms(const ShadingContext& ctx, const Hit& hit, const Vec3f& e
 Vec3f shade_hit(const ShadingContext& ctx, const Hit& hit, const Vec3f& eye, const Vec3f& dir,
                 const Vec3f& n) {
     const LightTerms t = light_terms(ctx, hit, eye, dir, n);
-    const Material& material = ctx.scene.materials[ctx.scene.tri_material[hit.prim]];
+    const Material& material =
+        ctx.scene.materials[ctx.scene.mesh_of(hit.instance).tri_material[hit.prim]];
     return cel_colour(ctx.settings, t.albedo, t.band, t.accents, material.ks);
 }
 

@@ -72,12 +72,31 @@ struct ShadingContext {
     const TextureSet* textures = nullptr;
 };
 
+/// The corners of triangle `prim` of instance `instance` (kNoIndex: the scene's own) in world
+/// space: an instance's transformed by Affine3::point, as flatten_instances places them.
+inline std::array<Vec3f, 3> world_corners(const Scene& scene, std::uint32_t instance,
+                                          std::uint32_t prim) {
+    const TriangleMesh& mesh = scene.mesh_of(instance);
+    const auto& tri = mesh.tri_positions[prim];
+    std::array<Vec3f, 3> p{mesh.positions[tri[0]], mesh.positions[tri[1]], mesh.positions[tri[2]]};
+    if (instance != kNoIndex)
+        for (Vec3f& q : p) q = scene.instances[instance].to_world.point(q);
+    return p;
+}
+
+/// Corner k's normal of triangle `prim` of instance `instance` in world space (an instance's by
+/// Affine3::unit_normal, as flatten_instances transforms them); the triangle must have one.
+inline Vec3f world_normal(const Scene& scene, std::uint32_t instance, std::uint32_t prim, int k) {
+    const TriangleMesh& mesh = scene.mesh_of(instance);
+    const Vec3f& n = mesh.normals[mesh.tri_normals[prim][static_cast<std::size_t>(k)]];
+    return instance == kNoIndex ? n : scene.instances[instance].to_world.unit_normal(n);
+}
+
 /// The hit triangle's geometric normal, unit, facing the viewer. Inline (as is shading_normal):
 /// both run once per sample, inside the renderer's per-tile loop.
 inline Vec3f geometric_normal(const Scene& scene, const Hit& hit, const Vec3f& dir) {
-    const auto& tri = scene.tri_positions[hit.prim];
-    const Vec3f& p0 = scene.positions[tri[0]];
-    Vec3f n = cross(scene.positions[tri[1]] - p0, scene.positions[tri[2]] - p0);
+    const std::array<Vec3f, 3> p = world_corners(scene, hit.instance, hit.prim);
+    Vec3f n = cross(p[1] - p[0], p[2] - p[0]);
     float len = length(n);
     n = len > 0.0f ? n / len : -dir;
     return dot(n, dir) > 0.0f ? -n : n;
@@ -86,13 +105,15 @@ inline Vec3f geometric_normal(const Scene& scene, const Hit& hit, const Vec3f& d
 /// The shading normal at a hit: vertex normals interpolated when all three corners have one,
 /// else the geometric normal; turned to face the viewer (against `dir`).
 inline Vec3f shading_normal(const Scene& scene, const Hit& hit, const Vec3f& dir) {
-    const auto& tri = scene.tri_positions[hit.prim];
-    const auto& tn = scene.tri_normals[hit.prim];
+    const TriangleMesh& mesh = scene.mesh_of(hit.instance);
+    const auto& tn = mesh.tri_normals[hit.prim];
     Vec3f n;
     bool interpolated = false;
     if (tn[0] != kNoIndex && tn[1] != kNoIndex && tn[2] != kNoIndex) {
         float w0 = 1.0f - hit.u - hit.v;
-        n = scene.normals[tn[0]] * w0 + scene.normals[tn[1]] * hit.u + scene.normals[tn[2]] * hit.v;
+        n = world_normal(scene, hit.instance, hit.prim, 0) * w0 +
+            world_normal(scene, hit.instance, hit.prim, 1) * hit.u +
+            world_normal(scene, hit.instance, hit.prim, 2) * hit.v;
         float len = length(n);
         if (len > 0.0f && std::isfinite(len)) {
             n = n / len;
@@ -100,8 +121,8 @@ inline Vec3f shading_normal(const Scene& scene, const Hit& hit, const Vec3f& dir
         }
     }
     if (!interpolated) {
-        const Vec3f& p0 = scene.positions[tri[0]];
-        n = cross(scene.positions[tri[1]] - p0, scene.positions[tri[2]] - p0);
+        const std::array<Vec3f, 3> p = world_corners(scene, hit.instance, hit.prim);
+        n = cross(p[1] - p[0], p[2] - p[0]);
         float len = length(n);
         n = len > 0.0f ? n / len : -normalize(dir);
     }

@@ -98,7 +98,7 @@ struct Edge {
 
 }  // namespace
 
-std::size_t auto_smooth(Scene& scene, float angle_degrees) {
+std::size_t auto_smooth(TriangleMesh& scene, float angle_degrees) {
     if (!(angle_degrees >= 0.0f && angle_degrees <= 180.0f))
         throw Error(
             fmt::format("auto-smooth angle {} is not between 0 and 180 degrees", angle_degrees));
@@ -229,6 +229,22 @@ std::size_t auto_smooth(Scene& scene, float angle_degrees) {
         ++smoothed;
     }
     return smoothed;
+}
+
+std::size_t auto_smooth_scene(Scene& scene, float angle_degrees) {
+    std::size_t count = auto_smooth(static_cast<TriangleMesh&>(scene), angle_degrees);
+    for (auto& mesh : scene.meshes) {
+        bool flat = false;
+        for (const auto& tn : mesh->tri_normals)
+            flat = flat || tn[0] == kNoIndex || tn[1] == kNoIndex || tn[2] == kNoIndex;
+        if (!flat) continue;
+        auto smoothed = std::make_shared<TriangleMesh>(*mesh);
+        // One object: the instance names the triangles, not the mesh.
+        std::fill(smoothed->tri_object.begin(), smoothed->tri_object.end(), 0u);
+        count += auto_smooth(*smoothed, angle_degrees);
+        mesh = std::move(smoothed);
+    }
+    return count;
 }
 
 }  // namespace toonray

@@ -25,7 +25,13 @@ namespace toonray {
 /// normals are appended to scene.normals. Deterministic: the same scene gives the same bits on
 /// every platform (IEEE operations only, no libm functions; see core/portable_math.h).
 /// Returns the number of triangles given normals. Throws Error when `angle_degrees` is not in
-/// [0, 180] or the normals would not fit 32-bit indices.
-std::size_t auto_smooth(Scene& scene, float angle_degrees);
+/// [0, 180] or the normals would not fit 32-bit indices. Works on a scene's own triangles or a
+/// mesh's (the triangles of an instanced mesh are all of one object here).
+std::size_t auto_smooth(TriangleMesh& scene, float angle_degrees);
+
+/// auto_smooth on the scene's own triangles and on each instanced mesh that has triangles
+/// without normals (replaced by a smoothed copy: meshes are shared and immutable). Returns the
+/// number of triangles given normals, each mesh's counted once.
+std::size_t auto_smooth_scene(Scene& scene, float angle_degrees);
 
 }  // namespace toonray

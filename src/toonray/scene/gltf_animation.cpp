@@ -174,6 +174,67 @@ std::vector<int> scene_order(const GltfDocument& doc) {
     return order;
 }
 
+// A primitive's positions and normals morphed by `weights` (one per target; fewer: the rest
+// are zero), into `positions` and `normals`.
+void morph(const GltfPrimitive& prim, const std::vector<float>& weights,
+           std::vector<Vec3f>& positions, std::vector<Vec3f>& normals) {
+    positions = prim.positions;
+    normals = prim.normals;
+    for (std::size_t t = 0; t < prim.targets.size() && t < weights.size(); ++t) {
+        if (weights[t] == 0.0f) continue;
+        const GltfMorphTarget& target = prim.targets[t];
+        for (std::size_t v = 0; v < target.positions.size(); ++v)
+            positions[v] += target.positions[v] * weights[t];
+        for (std::size_t v = 0; v < target.normals.size() && v < normals.size(); ++v)
+            normals[v] += target.normals[v] * weights[t];
+    }
+}
+
+// Appends a primitive's texture coordinates, its colours (white without; only when `colours`)
+// and its triangles to `mesh`, whose positions and normals from `base` and `normal_base` on are
+// the primitive's.
+void add_primitive(const GltfPrimitive& prim, std::uint32_t object, std::uint32_t base,
+                   std::uint32_t normal_base, bool colours, TriangleMesh& mesh) {
+    const auto texcoord_base = static_cast<std::uint32_t>(mesh.texcoords.size());
+    mesh.texcoords.insert(mesh.texcoords.end(), prim.texcoords.begin(), prim.texcoords.end());
+    if (colours) {
+        if (prim.colours.empty()) mesh.colours.resize(mesh.positions.size(), Vec3f(1.0f));
+        else mesh.colours.insert(mesh.colours.end(), prim.colours.begin(), prim.colours.end());
+    }
+    for (std::size_t k = 0; k + 2 < prim.indices.size(); k += 3) {
+        const std::array<std::uint32_t, 3> tri{base + prim.indices[k], base + prim.indices[k + 1],
+                                               base + prim.indices[k + 2]};
+        std::array<std::uint32_t, 3> nt{kNoIndex, kNoIndex, kNoIndex};
+        std::array<std::uint32_t, 3> tt{kNoIndex, kNoIndex, kNoIndex};
+        if (!prim.normals.empty())
+            for (int c = 0; c < 3; ++c) nt[c] = normal_base + prim.indices[k + c];
+        if (!prim.texcoords.empty())
+            for (int c = 0; c < 3; ++c) tt[c] = texcoord_base + prim.indices[k + c];
+        mesh.add_triangle(tri, prim.material, object, nt, tt);
+    }
+}
+
+// A glTF mesh's primitives as one mesh in object space, morphed by `weights`, with vertex
+// colours when a primitive has them (white for the others, as the flattened scene has them).
+std::shared_ptr<const TriangleMesh> object_mesh(const GltfMesh& mesh,
+                                                const std::vector<float>& weights) {
+    auto out = std::make_shared<TriangleMesh>();
+    bool colours = false;
+    for (const GltfPrimitive& prim : mesh.primitives) colours = colours || !prim.colours.empty();
+    std::vector<Vec3f> positions, normals;
+    for (const GltfPrimitive& prim : mesh.primitives) {
+        const auto base = static_cast<std::uint32_t>(out->positions.size());
+        const auto normal_base = static_cast<std::uint32_t>(out->normals.size());
+        morph(prim, weights, positions, normals);
+        out->positions.insert(out->positions.end(), positions.begin(), positions.end());
+        out->normals.insert(out->normals.end(), normals.begin(), normals.end());
+        add_primitive(prim, 0, base, normal_base, colours, *out);
+    }
+    return out;
+}
+
+Affine3 to_affine(const Mat4& m) { return Affine3::from_column_major(m.m); }
+
 }  // namespace
 
 double gltf_frame_time(int frame, double fps) { return static_cast<double>(frame) / fps; }
@@ -203,6 +264,10 @@ GltfAnimator::GltfAnimator(GltfDocument document, const GltfPoseOptions& options
         for (std::size_t i = 0; i < doc_.animations.size(); ++i)
             animations_.push_back(static_cast<int>(i));
     }
+    meshes_.resize(doc_.meshes.size());
+    for (std::size_t m = 0; m < doc_.meshes.size(); ++m)
+        if (m < doc_.instanced_meshes.size() && doc_.instanced_meshes[m])
+            meshes_[m] = object_mesh(doc_.meshes[m], doc_.meshes[m].weights);
     std::string cameras;
     for (int n : scene_order(doc_)) {
         const GltfNode& node = doc_.nodes[static_cast<std::size_t>(n)];
@@ -321,10 +386,49 @@ void GltfAnimator::pose(double seconds, int width, int height, Scene& scene,
     }
     std::vector<Vec3f> positions, normals;
     std::vector<Mat4> joint_matrices;
+    // Instanced meshes get their scene index when first placed.
+    std::vector<std::uint32_t> scene_mesh(doc_.meshes.size(), kNoIndex);
+    auto place = [&](std::uint32_t mesh_index, const Mat4& m, std::string name) {
+        const Affine3 to_world = to_affine(m);
+        // A node scaled to nothing (a common way to hide one) has no inverse and no area: it
+        // is left out, as its flattened triangles would be hit by no ray.
+        if (!to_world.invertible()) return;
+        scene.add_instance(mesh_index, to_world, std::move(name));
+    };
     for (int i : order) {
         const GltfNode& node = doc_.nodes[static_cast<std::size_t>(i)];
         if (node.mesh < 0) continue;
         const GltfMesh& mesh = doc_.meshes[static_cast<std::size_t>(node.mesh)];
+        const std::shared_ptr<const TriangleMesh>& shared =
+            meshes_[static_cast<std::size_t>(node.mesh)];
+        const std::size_t gpu = node.gpu_instances.count;
+        if (shared || gpu > 0) {
+            std::uint32_t index;
+            if (shared) {
+                std::uint32_t& known = scene_mesh[static_cast<std::size_t>(node.mesh)];
+                if (known == kNoIndex) known = scene.add_mesh(shared);
+                index = known;
+            } else {
+                // A morphed mesh placed by EXT_mesh_gpu_instancing: this node's pose of it.
+                const std::vector<float>& w = weights[static_cast<std::size_t>(i)].empty()
+                                                  ? mesh.weights
+                                                  : weights[static_cast<std::size_t>(i)];
+                index = scene.add_mesh(object_mesh(mesh, w));
+            }
+            const Mat4& node_world = world[static_cast<std::size_t>(i)];
+            if (gpu == 0) {
+                place(index, node_world, node_label(doc_, i));
+                continue;
+            }
+            const GltfGpuInstances& g = node.gpu_instances;
+            for (std::size_t k = 0; k < gpu; ++k) {
+                const Mat4 local = trs(g.translation.empty() ? Vec3f(0.0f) : g.translation[k],
+                                       g.rotation.empty() ? GltfQuat{} : g.rotation[k],
+                                       g.scale.empty() ? Vec3f(1.0f) : g.scale[k]);
+                place(index, node_world * local, fmt::format("{}.{}", node_label(doc_, i), k));
+            }
+            continue;
+        }
         const auto object = static_cast<std::uint32_t>(scene.objects.size());
         scene.objects.push_back(node_label(doc_, i));
         // The loader checked that a node's weights, given or animated, match its mesh's.
@@ -341,20 +445,9 @@ void GltfAnimator::pose(double seconds, int width, int height, Scene& scene,
         }
         const Mat4& node_world = world[static_cast<std::size_t>(i)];
         for (const GltfPrimitive& prim : mesh.primitives) {
-            // Morph targets.
-            positions = prim.positions;
-            normals = prim.normals;
-            for (std::size_t t = 0; t < prim.targets.size() && t < w.size(); ++t) {
-                if (w[t] == 0.0f) continue;
-                const GltfMorphTarget& target = prim.targets[t];
-                for (std::size_t v = 0; v < target.positions.size(); ++v)
-                    positions[v] += target.positions[v] * w[t];
-                for (std::size_t v = 0; v < target.normals.size() && v < normals.size(); ++v)
-                    normals[v] += target.normals[v] * w[t];
-            }
+            morph(prim, w, positions, normals);
             const auto base = static_cast<std::uint32_t>(scene.positions.size());
             const auto normal_base = static_cast<std::uint32_t>(scene.normals.size());
-            const auto texcoord_base = static_cast<std::uint32_t>(scene.texcoords.size());
             const bool skinned = skin && !prim.joints.empty();
             for (std::size_t v = 0; v < positions.size(); ++v) {
                 Mat4 blended;
@@ -380,25 +473,7 @@ void GltfAnimator::pose(double seconds, int width, int height, Scene& scene,
                     scene.normals.push_back(len > 0 && std::isfinite(len) ? nn / len : Vec3f(0.0f));
                 }
             }
-            scene.texcoords.insert(scene.texcoords.end(), prim.texcoords.begin(),
-                                   prim.texcoords.end());
-            if (any_colours) {
-                if (prim.colours.empty()) scene.colours.resize(scene.positions.size(), Vec3f(1.0f));
-                else
-                    scene.colours.insert(scene.colours.end(), prim.colours.begin(),
-                                         prim.colours.end());
-            }
-            for (std::size_t k = 0; k + 2 < prim.indices.size(); k += 3) {
-                const std::array<std::uint32_t, 3> tri{
-                    base + prim.indices[k], base + prim.indices[k + 1], base + prim.indices[k + 2]};
-                std::array<std::uint32_t, 3> nt{kNoIndex, kNoIndex, kNoIndex};
-                std::array<std::uint32_t, 3> tt{kNoIndex, kNoIndex, kNoIndex};
-                if (!prim.normals.empty())
-                    for (int c = 0; c < 3; ++c) nt[c] = normal_base + prim.indices[k + c];
-                if (!prim.texcoords.empty())
-                    for (int c = 0; c < 3; ++c) tt[c] = texcoord_base + prim.indices[k + c];
-                scene.add_triangle(tri, prim.material, object, nt, tt);
-            }
+            add_primitive(prim, object, base, normal_base, any_colours, scene);
         }
     }
 

@@ -4,6 +4,7 @@
 /// hierarchy, skins (linear blend skinning) and morph targets evaluated, and the result as a
 /// Scene, a camera and toon lights. docs/gltf.md has the rules.
 
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -53,6 +54,10 @@ private:
     GltfDocument doc_;
     std::vector<int> animations_;  ///< played
     int camera_node_ = -1;
+    /// Per glTF mesh, its triangles in object space when it is instanced
+    /// (GltfDocument::instanced_meshes), else null: every pose shares these objects, so a
+    /// renderer keeps its work on them from frame to frame.
+    std::vector<std::shared_ptr<const TriangleMesh>> meshes_;
 };
 
 /// The frames of a glTF animation: frame N is the document posed at gltf_frame_time(N, fps),

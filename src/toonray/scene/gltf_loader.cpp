@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 #include <map>
 #include <tiny_gltf.h>
+#include <tuple>
 
 #include "toonray/core/saturating.h"
 #include "toonray/io/file.h"
@@ -367,11 +368,79 @@ private:
             const std::string& name = m_.extensionsRequired[i];
             const bool known = name == "KHR_lights_punctual" || name == "KHR_mesh_quantization" ||
                                name == "KHR_texture_transform" ||
+                               name == "EXT_mesh_gpu_instancing" ||
                                name.rfind("KHR_materials_", 0) == 0;
             if (!known)
                 fail(fmt::format("extensionsRequired[{}]", i),
                      fmt::format("{} is not supported", name));
         }
+    }
+
+    // EXT_mesh_gpu_instancing's TRANSLATION, ROTATION and SCALE accessors, all of one count.
+    void read_gpu_instances(const tinygltf::Value& ext, const std::string& at,
+                            const tinygltf::Node& src, GltfNode& node) {
+        if (!ext.IsObject() || !ext.Has("attributes") || !ext.Get("attributes").IsObject())
+            fail(at, "no attributes object");
+        const tinygltf::Value& attributes = ext.Get("attributes");
+        GltfGpuInstances& out = node.gpu_instances;
+        std::size_t count = 0;
+        bool any = false;
+        auto read = [&](const char* name, int width, auto&& store) {
+            if (!attributes.Has(name)) return;
+            const tinygltf::Value& v = attributes.Get(name);
+            const std::string where = at + ".attributes." + name;
+            if (!v.IsNumber() && !v.IsInt()) fail(where, "not an accessor index");
+            const int index = v.GetNumberAsInt();
+            const auto& a = accessor_or_fail(index, where);
+            if (any && a.count != count)
+                fail(where,
+                     fmt::format("{} entries where the other attributes have {}", a.count, count));
+            count = a.count;
+            any = true;
+            store(a.count);
+            read_accessor(index, where, {width == 4 ? TINYGLTF_TYPE_VEC4 : TINYGLTF_TYPE_VEC3},
+                          false, [&](std::size_t i, int c, double value) {
+                              if (!std::isfinite(value) || std::abs(value) > 1e30)
+                                  fail(where,
+                                       fmt::format("value {} at entry {} is not usable", value, i));
+                              store(i, c, static_cast<float>(value));
+                          });
+        };
+        read("TRANSLATION", 3, [&](auto... args) {
+            if constexpr (sizeof...(args) == 1) out.translation.resize(args...);
+            else {
+                auto t = std::make_tuple(args...);
+                out.translation[std::get<0>(t)][std::get<1>(t)] = std::get<2>(t);
+            }
+        });
+        read("ROTATION", 4, [&](auto... args) {
+            if constexpr (sizeof...(args) == 1) out.rotation.resize(args...);
+            else {
+                auto t = std::make_tuple(args...);
+                GltfQuat& q = out.rotation[std::get<0>(t)];
+                const int c = std::get<1>(t);
+                (c == 0 ? q.x : c == 1 ? q.y : c == 2 ? q.z : q.w) = std::get<2>(t);
+            }
+        });
+        read("SCALE", 3, [&](auto... args) {
+            if constexpr (sizeof...(args) == 1) out.scale.resize(args...);
+            else {
+                auto t = std::make_tuple(args...);
+                out.scale[std::get<0>(t)][std::get<1>(t)] = std::get<2>(t);
+            }
+        });
+        if (!any) fail(at + ".attributes", "none of TRANSLATION, ROTATION and SCALE");
+        if (src.mesh == -1) {
+            warn(at, "the node has no mesh: ignored");
+            out = {};
+            return;
+        }
+        if (src.skin != -1) {
+            warn(at, "a skinned node is not instanced: drawn once");
+            out = {};
+            return;
+        }
+        out.count = count;
     }
 
     void read_nodes() {
@@ -426,6 +495,10 @@ private:
             }
             numbers(src.weights, src.weights.size(), "weights");
             for (double w : src.weights) node.weights.push_back(static_cast<float>(w));
+            if (auto it = src.extensions.find("EXT_mesh_gpu_instancing");
+                it != src.extensions.end())
+                read_gpu_instances(it->second, at + ".extensions.EXT_mesh_gpu_instancing", src,
+                                   node);
             for (std::size_t k = 0; k < src.children.size(); ++k) {
                 const int child = src.children[k];
                 check_index(child, n, fmt::format("{}.children[{}]", at, k), "nodes");
@@ -951,25 +1024,64 @@ private:
         }
     }
 
-    // Triangles and vertices of every mesh instance, against the limits.
+    // Which meshes are instanced, and the triangles and vertices stored (every flattened node's
+    // mesh, each instanced mesh once), against the limits.
     void count_instances() {
+        const std::size_t meshes = doc_.meshes.size();
+        std::vector<std::uint64_t> placements(meshes, 0);
+        std::vector<std::uint8_t> excluded(meshes, 0);
+        for (std::size_t m = 0; m < meshes; ++m)
+            for (const auto& prim : doc_.meshes[m].primitives)
+                if (!prim.targets.empty()) excluded[m] = 1;
         std::vector<int> stack(doc_.roots.rbegin(), doc_.roots.rend());
+        std::vector<int> order;
         while (!stack.empty()) {
-            const GltfNode& node = doc_.nodes[static_cast<std::size_t>(stack.back())];
+            const int n = stack.back();
             stack.pop_back();
-            if (node.mesh >= 0)
-                for (const auto& prim :
-                     doc_.meshes[static_cast<std::size_t>(node.mesh)].primitives) {
-                    doc_.triangles = add_saturated(doc_.triangles, prim.indices.size() / 3);
-                    doc_.vertices = add_saturated(doc_.vertices, prim.positions.size());
-                }
-            stack.insert(stack.end(), node.children.begin(), node.children.end());
+            order.push_back(n);
+            const GltfNode& node = doc_.nodes[static_cast<std::size_t>(n)];
+            stack.insert(stack.end(), node.children.rbegin(), node.children.rend());
+        }
+        for (int n : order) {
+            const GltfNode& node = doc_.nodes[static_cast<std::size_t>(n)];
+            if (node.mesh < 0) continue;
+            const auto m = static_cast<std::size_t>(node.mesh);
+            if (node.skin >= 0) excluded[m] = 1;
+            placements[m] =
+                add_saturated(placements[m], node.gpu_instances.count > 0 ? node.gpu_instances.count
+                                                                          : std::uint64_t{1});
+        }
+        doc_.instanced_meshes.assign(meshes, 0);
+        for (std::size_t m = 0; m < meshes; ++m)
+            doc_.instanced_meshes[m] = !excluded[m] && placements[m] >= 2;
+        auto add_mesh = [&](std::size_t m) {
+            for (const auto& prim : doc_.meshes[m].primitives) {
+                doc_.triangles = add_saturated(doc_.triangles, prim.indices.size() / 3);
+                doc_.vertices = add_saturated(doc_.vertices, prim.positions.size());
+            }
+        };
+        for (std::size_t m = 0; m < meshes; ++m)
+            if (doc_.instanced_meshes[m]) {
+                add_mesh(m);
+                doc_.instances = add_saturated(doc_.instances, placements[m]);
+            }
+        for (int n : order) {
+            const GltfNode& node = doc_.nodes[static_cast<std::size_t>(n)];
+            if (node.mesh < 0 || doc_.instanced_meshes[static_cast<std::size_t>(node.mesh)])
+                continue;
+            // A morphed mesh instanced by EXT_mesh_gpu_instancing is posed once per node.
+            add_mesh(static_cast<std::size_t>(node.mesh));
+            if (node.gpu_instances.count > 0)
+                doc_.instances = add_saturated(doc_.instances, node.gpu_instances.count);
         }
         const std::uint64_t max_triangles = std::min(options_.limits.max_triangles, kMaxIndexable);
         if (doc_.triangles > max_triangles)
             throw LimitError(Limit::Triangles,
                              fmt::format("{}: {} triangles, more than the limit of {}", file_,
                                          doc_.triangles, max_triangles));
+        if (doc_.instances >= kMaxIndexable)
+            throw LimitError(Limit::Memory,
+                             fmt::format("{}: {} instances are too many", file_, doc_.instances));
         const std::uint64_t max_vertices = std::min(options_.limits.max_vertices, kMaxIndexable);
         if (doc_.vertices > max_vertices)
             throw LimitError(Limit::Vertices,

@@ -33,6 +33,16 @@ struct GltfQuat {
 /// A column-major 4x4 matrix, as glTF stores them.
 using GltfMatrix = std::array<float, 16>;
 
+/// EXT_mesh_gpu_instancing: the node's mesh is drawn once per entry, placed by the node's world
+/// transform times the entry's translation, rotation and scale (an attribute the file leaves
+/// out is the identity).
+struct GltfGpuInstances {
+    std::size_t count = 0;           ///< 0: the node is not instanced this way
+    std::vector<Vec3f> translation;  ///< empty or `count` long
+    std::vector<GltfQuat> rotation;
+    std::vector<Vec3f> scale;
+};
+
 struct GltfNode {
     std::string name;
     int mesh = -1, camera = -1, skin = -1, light = -1;  ///< -1: none
@@ -43,6 +53,7 @@ struct GltfNode {
     Vec3f scale{1.0f};
     std::optional<GltfMatrix> matrix;  ///< replaces translation, rotation and scale when given
     std::vector<float> weights;        ///< one per morph target of the mesh; empty: the mesh's
+    GltfGpuInstances gpu_instances;
 };
 
 /// One morph target's displacements (an empty array: that attribute does not move).
@@ -124,8 +135,14 @@ struct GltfDocument {
     std::vector<GltfCamera> cameras;
     std::vector<GltfLight> lights;
     std::vector<GltfAnimation> animations;
-    std::uint64_t triangles = 0;  ///< of every mesh instance in the scene
+    /// Per mesh: posed as instances of one shared mesh (scene/scene.h) rather than flattened
+    /// into the scene's triangles: meshes that the scene places more than once (on several
+    /// nodes, or by EXT_mesh_gpu_instancing), with no morph targets and no skinned node.
+    std::vector<std::uint8_t> instanced_meshes;
+    /// Triangles stored: of every flattened node's mesh, and of each instanced mesh once.
+    std::uint64_t triangles = 0;
     std::uint64_t vertices = 0;   ///< likewise
+    std::uint64_t instances = 0;  ///< instances of instanced meshes (and of morphed GPU meshes)
 
     /// Whether posing at a time can move vertices relative to each other (skins, animated morph
     /// weights), rather than only move whole meshes.

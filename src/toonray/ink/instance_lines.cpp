@@ -1,0 +1,807 @@
+#include "toonray/ink/instance_lines.h"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <numbers>
+#include <tuple>
+
+#include "toonray/core/parallel.h"
+#include "toonray/core/portable_math.h"
+#include "toonray/ink/chunks.h"
+#include "toonray/ink/mesh_topology.h"
+
+namespace toonray::ink {
+
+namespace {
+
+// Bounds on the normals of a set of (point, normal) pairs: every unit normal lies within the
+// angle whose cosine is cos_a of `axis`. Not valid when they spread over a half-space or more
+// (or a normal is zero), where no bound on n . (eye - p) follows.
+struct Cone {
+    Vec3f axis{0.0f};
+    float cos_a = 1.0f, sin_a = 0.0f;
+    bool valid = false;
+};
+
+// A cone around unit normals (axis: their normalised sum; cosine: the least dot product with
+// it, lowered a little so that the bound holds despite rounding).
+Cone cone_of(std::span<const Vec3f> normals) {
+    Cone c;
+    Vec3f sum(0.0f);
+    for (const Vec3f& n : normals) sum += n;
+    const float len = length(sum);
+    if (!(len > 0.0f) || !std::isfinite(len)) return c;
+    c.axis = sum / len;
+    float least = 1.0f;
+    for (const Vec3f& n : normals) least = std::min(least, dot(c.axis, n));
+    least -= 1e-5f;
+    if (!(least > 0.02f)) return c;  // a half-space or more: no use
+    c.cos_a = least;
+    c.sin_a = std::sqrt(std::max(0.0f, 1.0f - least * least));
+    c.valid = true;
+    return c;
+}
+
+// The cone around two cones.
+Cone merge(const Cone& a, const Cone& b) {
+    if (!a.valid || !b.valid) return Cone{};
+    const Vec3f sum = a.axis + b.axis;
+    const float len = length(sum);
+    Cone c;
+    if (!(len > 0.0f) || !std::isfinite(len)) return c;
+    c.axis = sum / len;
+    // The angle from the new axis to each cone's farthest normal, as cos(alpha + beta).
+    auto reach = [&](const Cone& k) {
+        const float ca = std::clamp(dot(c.axis, k.axis), -1.0f, 1.0f);
+        const float sa = std::sqrt(std::max(0.0f, 1.0f - ca * ca));
+        return ca * k.cos_a - sa * k.sin_a;
+    };
+    const float least = std::min(reach(a), reach(b)) - 1e-5f;
+    if (!(least > 0.02f)) return c;
+    c.cos_a = least;
+    c.sin_a = std::sqrt(std::max(0.0f, 1.0f - least * least));
+    c.valid = true;
+    return c;
+}
+
+// The sign of n . (eye - p) for every normal n of the cone and point p of the box: +1 when
+// positive for all, -1 when negative for all, 0 when it may change (or the cone is not valid).
+// The bound is n . (eye - c) - n . (p - c) with c the box's centre: the second term is at most
+// the box's half diagonal r, the first within D cos(phi -+ alpha) of the eye's direction phi
+// from the axis; a margin of 1e-4 (D + r) covers the rounding of this bound and of the dot
+// products the lines are classified with (a few 2^-24 of D + r).
+int facing_bound(const Cone& cone, const BBox& box, const Vec3f& eye) {
+    if (!cone.valid || box.empty()) return 0;
+    const Vec3f c = box.center();
+    const float r = 0.5f * length(box.extent());
+    const Vec3f d = eye - c;
+    const float dist = length(d);
+    if (!std::isfinite(dist) || !std::isfinite(r) || dist <= r) return 0;
+    const float cos_phi = std::clamp(dot(cone.axis, d) / dist, -1.0f, 1.0f);
+    const float sin_phi = std::sqrt(std::max(0.0f, 1.0f - cos_phi * cos_phi));
+    const float margin = 1e-4f * (dist + r);
+    // phi + alpha < 180 degrees and cos(phi + alpha) D - r > 0: all positive.
+    const float cos_sum = cos_phi * cone.cos_a - sin_phi * cone.sin_a;
+    if (dist * cos_sum - r > margin) return 1;
+    // phi > alpha and cos(phi - alpha) D + r < 0: all negative.
+    const float cos_diff = cos_phi * cone.cos_a + sin_phi * cone.sin_a;
+    if (cos_phi < cone.cos_a && dist * cos_diff + r < -margin) return -1;
+    return 0;
+}
+
+std::uint32_t float_bits(float f) { return std::bit_cast<std::uint32_t>(f + 0.0f); }
+
+bool same_point(const Vec3f& a, const Vec3f& b) {
+    return float_bits(a.x) == float_bits(b.x) && float_bits(a.y) == float_bits(b.y) &&
+           float_bits(a.z) == float_bits(b.z);
+}
+
+bool overlap(const BBox& a, const BBox& b) {
+    return !(a.lo.x > b.hi.x || a.hi.x < b.lo.x || a.lo.y > b.hi.y || a.hi.y < b.lo.y ||
+             a.lo.z > b.hi.z || a.hi.z < b.lo.z);
+}
+
+BBox intersection(const BBox& a, const BBox& b) { return BBox{max(a.lo, b.lo), min(a.hi, b.hi)}; }
+
+// Grown by a relative margin: transformed boxes hold transformed points only up to rounding.
+BBox grown(const BBox& b) {
+    if (b.empty()) return b;
+    const float size = std::max({b.hi.x - b.lo.x, b.hi.y - b.lo.y, b.hi.z - b.lo.z,
+                                 std::abs(b.lo.x), std::abs(b.lo.y), std::abs(b.lo.z),
+                                 std::abs(b.hi.x), std::abs(b.hi.y), std::abs(b.hi.z)});
+    const Vec3f pad(size * 1e-5f);
+    return BBox{b.lo - pad, b.hi + pad};
+}
+
+// The view as five half-spaces through or in front of the eye: the near plane and the four
+// sides through the image's edges grown by `margin` pixels. A box whose eight corners are all
+// outside one of them holds nothing that visibility keeps.
+class ViewVolume {
+public:
+    ViewVolume(const ScreenProjection& view, const ViewPlane& plane, float margin) {
+        eye_ = view.eye();
+        const float w = static_cast<float>(view.width()), h = static_cast<float>(view.height());
+        auto at = [&](float x, float y) { return plane.pixel_point(x, y) - eye_; };
+        const Vec3f centre = at(0.5f * w, 0.5f * h);
+        // Sides: the plane through the eye and an image line.
+        const Vec3f corners[4] = {at(-margin, -margin), at(w + margin, -margin),
+                                  at(w + margin, h + margin), at(-margin, h + margin)};
+        for (int i = 0; i < 4; ++i) {
+            Vec3f n = cross(corners[i], corners[(i + 1) % 4]);
+            if (dot(n, centre) < 0.0f) n = -n;
+            normal_[i] = n / length(n);
+            offset_[i] = 0.0f;
+        }
+        // Near: behind the eye (visibility clips a little in front of it).
+        normal_[4] = normalize(centre);
+        offset_[4] = 0.0f;
+    }
+    // Whether the box may hold a point in the view.
+    [[nodiscard]] bool may_see(const BBox& box) const {
+        if (box.empty()) return false;
+        const float size = length(box.extent()) + length(box.center() - eye_);
+        for (int i = 0; i < 5; ++i) {
+            // The box's corner farthest along the normal.
+            const Vec3f& n = normal_[i];
+            const Vec3f p((n.x >= 0 ? box.hi.x : box.lo.x), (n.y >= 0 ? box.hi.y : box.lo.y),
+                          (n.z >= 0 ? box.hi.z : box.lo.z));
+            if (dot(n, p - eye_) < offset_[i] - 1e-4f * size) return false;
+        }
+        return true;
+    }
+    // Whether the whole box is inside (its nodes need no test).
+    [[nodiscard]] bool sees_all(const BBox& box) const {
+        const float size = length(box.extent()) + length(box.center() - eye_);
+        for (int i = 0; i < 5; ++i) {
+            const Vec3f& n = normal_[i];
+            const Vec3f p((n.x >= 0 ? box.lo.x : box.hi.x), (n.y >= 0 ? box.lo.y : box.hi.y),
+                          (n.z >= 0 ? box.lo.z : box.hi.z));
+            if (dot(n, p - eye_) < offset_[i] + 1e-4f * size) return false;
+        }
+        return true;
+    }
+
+private:
+    Vec3f eye_;
+    Vec3f normal_[5];
+    float offset_[5];
+};
+
+}  // namespace
+
+// The eye-independent ink work on one mesh, in object space.
+struct MeshLines {
+    std::shared_ptr<const TriangleMesh> mesh;  ///< held: its address is its identity
+    FeatureEdgeSettings settings;              ///< what the classes were made with
+    WeldedMesh welded;
+    std::vector<std::array<Vec3f, 3>> corners;
+    std::vector<Vec3f> normal;  ///< unit face normals; zero for a triangle that is not usable
+    std::vector<std::uint8_t> corner_normals;
+    std::vector<float> normal_length;  ///< per normal: its length, 1 for a zero one
+    int volume_sign = 0;               ///< closed with a non-zero volume: its sign; else 0
+    BBox box;
+
+    enum : std::uint8_t { kCandidate = 1, kCrease = 2, kMaterial = 4, kBorder = 8 };
+    // A mesh edge that can be a line: a silhouette from some eye, or a crease, material
+    // boundary or border from every eye.
+    struct Edge {
+        std::uint32_t lo, hi, t0, t1;
+        Vec3f n0, n1;  ///< the faces' normals, n1 turned for inconsistent winding
+        std::uint8_t flags;
+        std::uint32_t order;  ///< in the mesh's edge order (by welded ends)
+    };
+    std::vector<Edge> edges;
+    std::vector<std::uint32_t> owned_first;  ///< per triangle: its edges owned_first[t] ..
+    Bvh tree;                                ///< over the triangles
+    struct Node {
+        Cone poly, smooth;
+        bool candidates = false, fixed = false, smooth_triangles = false;
+    };
+    std::vector<Node> nodes;
+    std::vector<PairCrossing> crossings;  ///< within the mesh (usable triangles), by (t, u)
+
+    [[nodiscard]] bool usable(std::uint32_t t) const { return normal[t] != Vec3f(0.0f); }
+    [[nodiscard]] bool made_with(const FeatureEdgeSettings& s) const {
+        return s.crease_angle == settings.crease_angle && s.silhouettes == settings.silhouettes &&
+               s.borders == settings.borders && s.creases == settings.creases &&
+               s.materials == settings.materials && s.intersections == settings.intersections &&
+               s.smooth_contours == settings.smooth_contours;
+    }
+};
+
+namespace {
+
+Vec3f face_normal(const std::array<Vec3f, 3>& p) {
+    const Vec3f n = cross(p[1] - p[0], p[2] - p[0]);
+    const float len = length(n);
+    if (!(len > 0.0f) || !std::isfinite(len)) return Vec3f(0.0f);
+    return n / len;
+}
+
+std::shared_ptr<const MeshLines> make_mesh_lines(std::shared_ptr<const TriangleMesh> source,
+                                                 const FeatureEdgeSettings& settings, int threads) {
+    auto out = std::make_shared<MeshLines>();
+    MeshLines& ml = *out;
+    const TriangleMesh& mesh = *source;
+    ml.mesh = std::move(source);
+    ml.settings = settings;
+    const std::size_t n = mesh.triangle_count();
+    ml.welded = weld_vertices(mesh, true);
+    ml.corners.resize(n);
+    ml.normal.resize(n);
+    ml.corner_normals.resize(n);
+    std::vector<std::uint8_t> usable(n);
+    double volume = 0.0;
+    for (std::size_t t = 0; t < n; ++t) {
+        const auto& v = mesh.tri_positions[t];
+        auto& p = ml.corners[t];
+        p = {mesh.positions[v[0]], mesh.positions[v[1]], mesh.positions[v[2]]};
+        ml.normal[t] = face_normal(p);
+        usable[t] = ml.normal[t] != Vec3f(0.0f);
+        bool corner = true;
+        for (std::uint32_t k : mesh.tri_normals[t])
+            corner = corner && k != kNoIndex && k < mesh.normals.size();
+        ml.corner_normals[t] = corner;
+        for (const Vec3f& q : p) ml.box.extend(q);
+        volume += static_cast<double>(dot(p[0], cross(p[1], p[2])));
+    }
+    ml.normal_length.resize(mesh.normals.size());
+    for (std::size_t k = 0; k < mesh.normals.size(); ++k) {
+        const float len = length(mesh.normals[k]);
+        ml.normal_length[k] = len > 0.0f ? len : 1.0f;
+    }
+    const std::vector<std::uint32_t> one_object(n, 0u);
+    const MeshTopology topology(one_object, ml.welded, usable, 1);
+    if (!topology.open[0] && volume != 0.0) ml.volume_sign = volume > 0.0 ? 1 : -1;
+
+    // The edges that can be lines, in edge order, each owned by its first side's triangle.
+    const float cos_crease =
+        portable::cos(settings.crease_angle * std::numbers::pi_v<float> / 180.0f);
+    auto corner_normal = [&](std::uint32_t t, std::uint32_t welded) {
+        for (int k = 0; k < 3; ++k)
+            if (ml.welded.tri_vertices[t][k] == welded) return mesh.normals[mesh.tri_normals[t][k]];
+        return Vec3f(0.0f);
+    };
+    auto smooth_across = [&](const Side& s0, const Side& s1) {
+        if (!ml.corner_normals[s0.tri] || !ml.corner_normals[s1.tri]) return false;
+        return corner_normal(s0.tri, s0.lo) == corner_normal(s1.tri, s1.lo) &&
+               corner_normal(s0.tri, s0.hi) == corner_normal(s1.tri, s1.hi);
+    };
+    std::vector<std::uint32_t> owner;
+    const std::size_t edge_count = topology.edge_first.size() - 1;
+    for (std::size_t e = 0; e < edge_count; ++e) {
+        const std::uint32_t i = topology.edge_first[e], j = topology.edge_first[e + 1];
+        const Side& s0 = topology.sides[i];
+        MeshLines::Edge edge{
+            s0.lo,       s0.hi,       s0.tri, j - i > 1 ? topology.sides[i + 1].tri : kNoIndex,
+            Vec3f(0.0f), Vec3f(0.0f), 0,      static_cast<std::uint32_t>(ml.edges.size())};
+        if (j - i != 2) {
+            if (!settings.borders) continue;
+            edge.flags = MeshLines::kBorder;
+        } else {
+            const Side& s1 = topology.sides[i + 1];
+            edge.n0 = ml.normal[s0.tri];
+            edge.n1 = s0.forward != s1.forward ? ml.normal[s1.tri] : -ml.normal[s1.tri];
+            if (settings.silhouettes && !(settings.smooth_contours && smooth_across(s0, s1)))
+                edge.flags |= MeshLines::kCandidate;
+            if (settings.creases && dot(edge.n0, edge.n1) < cos_crease)
+                edge.flags |= MeshLines::kCrease;
+            else if (settings.materials && mesh.tri_material[s0.tri] != mesh.tri_material[s1.tri])
+                edge.flags |= MeshLines::kMaterial;
+            if (!edge.flags) continue;
+        }
+        ml.edges.push_back(edge);
+        owner.push_back(s0.tri);
+    }
+    // Edges by owning triangle (a stable counting sort keeps edge order within a triangle).
+    ml.owned_first.assign(n + 1, 0);
+    for (std::uint32_t t : owner) ++ml.owned_first[t + 1];
+    for (std::size_t t = 0; t < n; ++t) ml.owned_first[t + 1] += ml.owned_first[t];
+    {
+        std::vector<MeshLines::Edge> sorted(ml.edges.size());
+        std::vector<std::uint32_t> fill(ml.owned_first.begin(), ml.owned_first.end() - 1);
+        for (std::size_t e = 0; e < ml.edges.size(); ++e) sorted[fill[owner[e]]++] = ml.edges[e];
+        ml.edges.swap(sorted);
+    }
+
+    // The hierarchy: the triangles' BVH, each node with cones around the normals its lines are
+    // classified by.
+    ml.tree = Bvh::build(mesh.positions, mesh.tri_positions, Bvh::Config{}, nullptr);
+    ml.nodes.resize(ml.tree.nodes.size());
+    std::vector<Vec3f> poly, smooth;
+    for (std::size_t i = ml.tree.nodes.size(); i-- > 0;) {  // children after parents
+        const BvhNode& b = ml.tree.nodes[i];
+        MeshLines::Node& node = ml.nodes[i];
+        if (!b.is_leaf()) {
+            const MeshLines::Node& l = ml.nodes[b.first];
+            const MeshLines::Node& r = ml.nodes[b.first + 1];
+            node.candidates = l.candidates || r.candidates;
+            node.fixed = l.fixed || r.fixed;
+            node.smooth_triangles = l.smooth_triangles || r.smooth_triangles;
+            node.poly = !l.candidates ? r.poly : (!r.candidates ? l.poly : merge(l.poly, r.poly));
+            node.smooth = !l.smooth_triangles
+                              ? r.smooth
+                              : (!r.smooth_triangles ? l.smooth : merge(l.smooth, r.smooth));
+            continue;
+        }
+        poly.clear();
+        smooth.clear();
+        bool zero_normal = false;
+        for (std::uint32_t k = b.first; k < b.first + b.count; ++k) {
+            const std::uint32_t t = ml.tree.prim_indices[k];
+            for (std::uint32_t e = ml.owned_first[t]; e < ml.owned_first[t + 1]; ++e) {
+                const MeshLines::Edge& edge = ml.edges[e];
+                if (edge.flags & MeshLines::kCandidate) {
+                    node.candidates = true;
+                    poly.push_back(edge.n0);
+                    poly.push_back(edge.n1);
+                }
+                if (edge.flags & ~MeshLines::kCandidate) node.fixed = true;
+            }
+            if (settings.silhouettes && settings.smooth_contours && usable[t] &&
+                ml.corner_normals[t]) {
+                node.smooth_triangles = true;
+                for (std::uint32_t k2 : mesh.tri_normals[t]) {
+                    const Vec3f& nn = mesh.normals[k2];
+                    const float len = length(nn);
+                    if (!(len > 0.0f) || !std::isfinite(len)) zero_normal = true;
+                    else smooth.push_back(nn / len);
+                }
+            }
+        }
+        node.poly = cone_of(poly);
+        node.smooth = zero_normal ? Cone{} : cone_of(smooth);
+    }
+
+    // The crossings within the mesh, among its usable triangles.
+    if (settings.intersections && !ml.tree.nodes.empty()) {
+        ml.crossings = find_crossings(ml.tree, ml.corners, ml.welded, usable, nullptr, threads);
+        std::sort(ml.crossings.begin(), ml.crossings.end(),
+                  [](const PairCrossing& x, const PairCrossing& y) {
+                      return std::tie(x.t, x.u) < std::tie(y.t, y.u);
+                  });
+    }
+    return out;
+}
+
+// The segment of crossing `c` between triangle t of instance a and triangle u of instance b
+// (kNoIndex: the own triangles), whose welded meshes are wa and wb: each end keyed by the
+// welded edge that crosses and the triangle it crosses, with their instances.
+FeatureSegment crossing_segment(const TriangleCrossing& c, std::uint32_t t, std::uint32_t u,
+                                std::uint32_t a, std::uint32_t b, const WeldedMesh& wa,
+                                const WeldedMesh& wb, bool hidden) {
+    FeatureSegment seg;
+    seg.type = EdgeType::Intersection;
+    seg.p0 = c.p[0];
+    seg.p1 = c.p[1];
+    seg.faces = {t, u};
+    seg.face_instance = {a, b};
+    seg.certainly_hidden = hidden;
+    for (int e = 0; e < 2; ++e) {
+        const std::uint32_t on = c.on_b[e] ? u : t, other = c.on_b[e] ? t : u;
+        const std::uint32_t on_instance = c.on_b[e] ? b : a, other_instance = c.on_b[e] ? a : b;
+        const WeldedMesh& w = c.on_b[e] ? wb : wa;
+        std::uint32_t w0 = w.tri_vertices[on][c.edge[e][0]], w1 = w.tri_vertices[on][c.edge[e][1]];
+        if (w1 < w0) std::swap(w0, w1);
+        (e == 0 ? seg.key0 : seg.key1) = {w0, w1, other, on_instance, other_instance};
+    }
+    return seg;
+}
+
+// One instance seen from the eye: the eye in its object space and what follows from it.
+struct Placement {
+    std::uint32_t instance = kNoIndex;
+    const MeshLines* ml = nullptr;
+    const Affine3* to_world = nullptr;
+    Vec3f eye;        ///< in object space
+    int outward = 0;  ///< certainly-hidden rule: +1 / -1 outward normals, 0 none
+
+    [[nodiscard]] bool turned_away(std::uint32_t t) const {
+        if (outward == 0 || !ml->usable(t)) return false;
+        const float facing = dot(ml->normal[t], eye - ml->corners[t][0]);
+        return outward > 0 ? facing < 0 : facing > 0;
+    }
+};
+
+Placement place(const Scene& scene, std::uint32_t i, const MeshLines* ml, const Vec3f& eye) {
+    Placement p;
+    p.instance = i;
+    p.ml = ml;
+    p.to_world = &scene.instances[i].to_world;
+    p.eye = p.to_world->inverse().point(eye);
+    const BBox& b = ml->box;
+    const bool outside = p.eye.x < b.lo.x || p.eye.y < b.lo.y || p.eye.z < b.lo.z ||
+                         p.eye.x > b.hi.x || p.eye.y > b.hi.y || p.eye.z > b.hi.z;
+    p.outward = outside ? ml->volume_sign : 0;
+    return p;
+}
+
+// The mesh edges and smooth contours of one instance, then the crossings within its mesh.
+void instance_segments(const Placement& pl, const ViewVolume* volume,
+                       const FeatureEdgeSettings& settings, const InstanceLineOptions& options,
+                       std::vector<FeatureSegment>& out, std::vector<FeatureSegment>& smooth,
+                       std::vector<std::pair<std::uint32_t, FeatureSegment>>& edges_found) {
+    const MeshLines& ml = *pl.ml;
+    const TriangleMesh& mesh = *ml.mesh;
+    const Affine3& m = *pl.to_world;
+    const Vec3f& eye = pl.eye;
+    const std::uint32_t inst = pl.instance;
+    smooth.clear();
+    edges_found.clear();
+    auto edge_segment = [&](const MeshLines::Edge& e) {
+        const Vec3f p0 = mesh.positions[ml.welded.vertex_position[e.lo]];
+        EdgeType type = EdgeType::Border;
+        bool certainly_hidden = false;
+        if (!(e.flags & MeshLines::kBorder)) {
+            const float d0 = dot(e.n0, eye - p0), d1 = dot(e.n1, eye - p0);
+            const bool front0 = d0 > 0, front1 = d1 > 0;
+            if ((e.flags & MeshLines::kCandidate) && front0 != front1) type = EdgeType::Silhouette;
+            else if (e.flags & MeshLines::kCrease) type = EdgeType::Crease;
+            else if (e.flags & MeshLines::kMaterial) type = EdgeType::Material;
+            else return;
+            const int out_sign = pl.outward;
+            certainly_hidden = out_sign != 0 && front0 == (out_sign < 0) &&
+                               front1 == (out_sign < 0) && d0 != 0 && d1 != 0;
+            if (certainly_hidden && !settings.certainly_hidden) return;
+        }
+        FeatureSegment& seg = edges_found.emplace_back(e.order, FeatureSegment{}).second;
+        seg.p0 = m.point(p0);
+        seg.p1 = m.point(mesh.positions[ml.welded.vertex_position[e.hi]]);
+        seg.key0 = {e.lo, kNoIndex, kNoIndex, inst, kNoIndex};
+        seg.key1 = {e.hi, kNoIndex, kNoIndex, inst, kNoIndex};
+        seg.faces = {e.t0, e.t1};
+        seg.face_instance = {inst, e.t1 != kNoIndex ? inst : kNoIndex};
+        seg.type = type;
+        seg.certainly_hidden = certainly_hidden;
+    };
+    auto contour = [&](std::uint32_t t) {
+        const auto& p = ml.corners[t];
+        float g[3];
+        for (int k = 0; k < 3; ++k) {
+            const std::uint32_t ni = mesh.tri_normals[t][k];
+            g[k] = dot(mesh.normals[ni], p[k] - eye) / ml.normal_length[ni];
+        }
+        FeatureSegment seg;
+        seg.type = EdgeType::Silhouette;
+        seg.smooth = true;
+        seg.faces = {t, kNoIndex};
+        seg.face_instance = {inst, kNoIndex};
+        int found = 0;
+        Vec3f q[2];
+        for (int k = 0; k < 3; ++k) {
+            int u = k, v = (k + 1) % 3;
+            if ((g[u] >= 0) == (g[v] >= 0)) continue;
+            std::uint32_t wu = ml.welded.tri_vertices[t][u], wv = ml.welded.tri_vertices[t][v];
+            if (wv < wu) {
+                std::swap(u, v);
+                std::swap(wu, wv);
+            }
+            q[found == 0 ? 0 : 1] = p[u] + (p[v] - p[u]) * (g[u] / (g[u] - g[v]));
+            (found == 0 ? seg.key0 : seg.key1) = {wu, wv, kNoIndex, inst, kNoIndex};
+            ++found;
+        }
+        if (found != 2 || q[0] == q[1]) return;
+        seg.p0 = m.point(q[0]);
+        seg.p1 = m.point(q[1]);
+        if (seg.p0 != seg.p1) smooth.push_back(seg);
+    };
+    if (!ml.tree.nodes.empty()) {
+        // Depth first, left to right: the order of the leaves, whatever is skipped.
+        std::vector<std::pair<std::uint32_t, bool>> stack{{0u, volume == nullptr}};
+        while (!stack.empty()) {
+            const auto [i, inside] = stack.back();
+            stack.pop_back();
+            const BvhNode& b = ml.tree.nodes[i];
+            const MeshLines::Node& node = ml.nodes[i];
+            bool all_inside = inside;
+            if (!inside) {
+                const BBox world = grown(m.box(b.bounds));
+                if (!volume->may_see(world)) continue;
+                all_inside = volume->sees_all(world);
+            }
+            const bool cones = options.cone_culling;
+            const int poly = cones && node.candidates ? facing_bound(node.poly, b.bounds, eye) : 0;
+            const int around =
+                cones && node.smooth_triangles ? facing_bound(node.smooth, b.bounds, eye) : 0;
+            const bool edges = node.fixed || (node.candidates && poly == 0);
+            const bool contours = node.smooth_triangles && around == 0;
+            if (!edges && !contours) continue;
+            if (!b.is_leaf()) {
+                stack.push_back({b.first + 1, all_inside});
+                stack.push_back({b.first, all_inside});
+                continue;
+            }
+            for (std::uint32_t k = b.first; k < b.first + b.count; ++k) {
+                const std::uint32_t t = ml.tree.prim_indices[k];
+                if (edges)
+                    for (std::uint32_t e = ml.owned_first[t]; e < ml.owned_first[t + 1]; ++e) {
+                        const MeshLines::Edge& edge = ml.edges[e];
+                        // No silhouette in the node: an edge that is only a candidate is not
+                        // a line.
+                        if (poly != 0 && edge.flags == MeshLines::kCandidate) continue;
+                        edge_segment(edge);
+                    }
+                if (contours && ml.usable(t) && ml.corner_normals[t]) contour(t);
+            }
+        }
+    }
+    // Mesh edges in the mesh's edge order (as the flattened scene lists them: chaining starts
+    // strokes in segment order), whichever parts of the hierarchy were skipped; then the smooth
+    // contours by triangle.
+    std::sort(edges_found.begin(), edges_found.end(),
+              [](const auto& x, const auto& y) { return x.first < y.first; });
+    for (auto& [order, seg] : edges_found) out.push_back(seg);
+    std::sort(smooth.begin(), smooth.end(), [](const FeatureSegment& x, const FeatureSegment& y) {
+        return x.faces[0] < y.faces[0];
+    });
+    out.insert(out.end(), smooth.begin(), smooth.end());
+    // The crossings within the mesh: its pairs are found once, in object space; each is then
+    // crossed again with the instance's corners in the world, so that the segment is the one the
+    // flattened scene has, bit for bit.
+    for (const PairCrossing& pc : ml.crossings) {
+        const bool hidden = pl.turned_away(pc.t) || pl.turned_away(pc.u);
+        if (hidden && !settings.certainly_hidden) continue;
+        const auto world = [&](std::uint32_t t) {
+            const auto& p = ml.corners[t];
+            return std::array<Vec3f, 3>{m.point(p[0]), m.point(p[1]), m.point(p[2])};
+        };
+        TriangleCrossing c;
+        if (!intersect_triangles(world(pc.t), world(pc.u), c)) continue;
+        out.push_back(crossing_segment(c, pc.t, pc.u, inst, inst, ml.welded, ml.welded, hidden));
+    }
+}
+
+// A triangle of one side of a pair: its id, its corners in the world and their box.
+struct WorldTriangle {
+    std::uint32_t t;
+    std::array<Vec3f, 3> p;
+    BBox box;
+};
+
+// The triangles of an instance's mesh whose world boxes overlap `region`.
+void triangles_in(const MeshLines& ml, const Affine3& m, const BBox& region,
+                  std::vector<WorldTriangle>& out) {
+    out.clear();
+    if (ml.tree.nodes.empty()) return;
+    std::vector<std::uint32_t> stack{0u};
+    while (!stack.empty()) {
+        const std::uint32_t i = stack.back();
+        stack.pop_back();
+        const BvhNode& b = ml.tree.nodes[i];
+        if (!overlap(grown(m.box(b.bounds)), region)) continue;
+        if (!b.is_leaf()) {
+            stack.push_back(b.first + 1);
+            stack.push_back(b.first);
+            continue;
+        }
+        for (std::uint32_t k = b.first; k < b.first + b.count; ++k) {
+            const std::uint32_t t = ml.tree.prim_indices[k];
+            if (!ml.usable(t)) continue;
+            WorldTriangle w{
+                t,
+                {m.point(ml.corners[t][0]), m.point(ml.corners[t][1]), m.point(ml.corners[t][2])},
+                {}};
+            for (const Vec3f& q : w.p) w.box.extend(q);
+            if (overlap(w.box, region)) out.push_back(w);
+        }
+    }
+}
+
+// The scene's own triangles whose boxes overlap `region`, through the own binary tree.
+void own_triangles_in(const Scene& scene, const Bvh& bvh, const BBox& region,
+                      std::vector<WorldTriangle>& out) {
+    out.clear();
+    if (bvh.nodes.empty()) return;
+    std::vector<std::uint32_t> stack{0u};
+    while (!stack.empty()) {
+        const std::uint32_t i = stack.back();
+        stack.pop_back();
+        const BvhNode& b = bvh.nodes[i];
+        if (!overlap(b.bounds, region)) continue;
+        if (!b.is_leaf()) {
+            stack.push_back(b.first + 1);
+            stack.push_back(b.first);
+            continue;
+        }
+        for (std::uint32_t k = b.first; k < b.first + b.count; ++k) {
+            const std::uint32_t t = bvh.prim_indices[k];
+            const auto& v = scene.tri_positions[t];
+            WorldTriangle w{
+                t, {scene.positions[v[0]], scene.positions[v[1]], scene.positions[v[2]]}, {}};
+            if (face_normal(w.p) == Vec3f(0.0f)) continue;
+            for (const Vec3f& q : w.p) w.box.extend(q);
+            if (overlap(w.box, region)) out.push_back(w);
+        }
+    }
+}
+
+// Every crossing between a triangle of `a` and one of `b` (by their world corners; pairs that
+// share a corner position touch there and are not tested), t from a and u from b.
+std::vector<PairCrossing> cross(const std::vector<WorldTriangle>& a,
+                                const std::vector<WorldTriangle>& b) {
+    std::vector<PairCrossing> out;
+    for (const WorldTriangle& x : a)
+        for (const WorldTriangle& y : b) {
+            if (!overlap(x.box, y.box)) continue;
+            bool shared = false;
+            for (const Vec3f& p : x.p)
+                for (const Vec3f& q : y.p) shared = shared || same_point(p, q);
+            if (shared) continue;
+            PairCrossing pc{x.t, y.t, {}};
+            if (intersect_triangles(x.p, y.p, pc.crossing)) out.push_back(pc);
+        }
+    std::sort(out.begin(), out.end(), [](const PairCrossing& x, const PairCrossing& y) {
+        return std::tie(x.t, x.u) < std::tie(y.t, y.u);
+    });
+    return out;
+}
+
+}  // namespace
+
+const WeldedMesh& instance_welded_mesh(const InstanceLineCache& cache, std::uint32_t instance) {
+    return cache.of_instance[instance]->welded;
+}
+
+void add_instance_segments(const Scene& scene, const TriangleAccel& accel, const WeldedMesh& own,
+                           const ViewPlane& plane, const ScreenProjection& view, float margin,
+                           const FeatureEdgeSettings& settings, int threads,
+                           InstanceLineCache& cache, std::vector<FeatureSegment>& segments,
+                           const InstanceLineOptions& options) {
+    cache.of_instance.clear();
+    if (scene.instances.empty()) {
+        cache.meshes.clear();
+        cache.pairs.clear();
+        return;
+    }
+    // Each mesh's work, from the cache when the same mesh object was seen with these settings.
+    std::vector<std::shared_ptr<const MeshLines>> by_mesh(scene.meshes.size());
+    std::vector<std::shared_ptr<const MeshLines>> kept;
+    for (const Instance& instance : scene.instances) {
+        std::shared_ptr<const MeshLines>& ml = by_mesh[instance.mesh];
+        if (ml) continue;
+        const auto& mesh = scene.meshes[instance.mesh];
+        for (const auto& entry : cache.meshes)
+            if (entry->mesh == mesh && entry->made_with(settings)) {
+                kept.push_back(entry);
+                break;
+            }
+        if (kept.empty() || kept.back()->mesh != mesh) {
+            kept.push_back(make_mesh_lines(mesh, settings, threads));
+            ++cache.mesh_builds;
+        }
+        ml = kept.back();
+    }
+    cache.meshes = std::move(kept);
+    cache.of_instance.reserve(scene.instances.size());
+    for (const Instance& instance : scene.instances)
+        cache.of_instance.push_back(by_mesh[instance.mesh].get());
+
+    // Visibility keeps what lies within its margin of the image: the view volume is wider by
+    // some pixels more, so that rounding never culls what visibility would keep.
+    const ViewVolume volume_all(view, plane, margin + 8.0f);
+    const ViewVolume* view_volume = options.view_culling ? &volume_all : nullptr;
+    // The instances' world boxes.
+    const std::size_t count = scene.instances.size();
+    std::vector<BBox> world(count);
+    for (std::size_t i = 0; i < count; ++i)
+        world[i] = grown(scene.instances[i].to_world.box(cache.of_instance[i]->box));
+
+    // Per instance, in chunks of instances joined in order.
+    const Vec3f eye = view.eye();
+    std::vector<FeatureSegment> lines = gather_chunks<FeatureSegment>(
+        static_cast<int>(count), 16, threads,
+        [&](int i0, int i1, std::vector<FeatureSegment>& out) {
+            std::vector<FeatureSegment> smooth;
+            std::vector<std::pair<std::uint32_t, FeatureSegment>> edges_found;
+            for (int i = i0; i < i1; ++i) {
+                const auto u = static_cast<std::uint32_t>(i);
+                const ViewVolume* volume = nullptr;
+                if (view_volume) {
+                    if (!view_volume->may_see(world[u])) continue;
+                    if (!view_volume->sees_all(world[u])) volume = view_volume;
+                }
+                instance_segments(place(scene, u, cache.of_instance[u], eye), volume, settings,
+                                  options, out, smooth, edges_found);
+            }
+        });
+    segments.insert(segments.end(), lines.begin(), lines.end());
+    if (!settings.intersections) {
+        cache.pairs.clear();
+        return;
+    }
+
+    // Intersection lines between instances whose boxes overlap (found by a sweep along x),
+    // and between the own triangles and instances. A pair counts when the boxes' common part
+    // may be in view.
+    std::vector<std::uint32_t> order(count);
+    for (std::uint32_t i = 0; i < count; ++i) order[i] = i;
+    std::sort(order.begin(), order.end(), [&](std::uint32_t x, std::uint32_t y) {
+        return std::tie(world[x].lo.x, x) < std::tie(world[y].lo.x, y);
+    });
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;
+    for (std::size_t i = 0; i < count; ++i)
+        for (std::size_t j = i + 1; j < count && world[order[j]].lo.x <= world[order[i]].hi.x;
+             ++j) {
+            std::uint32_t a = order[i], b = order[j];
+            if (!overlap(world[a], world[b])) continue;
+            if (view_volume && !view_volume->may_see(intersection(world[a], world[b]))) continue;
+            if (b < a) std::swap(a, b);
+            pairs.push_back({a, b});
+        }
+    std::sort(pairs.begin(), pairs.end());
+    std::vector<InstanceLineCache::Pair> found(pairs.size());
+    parallel_for(static_cast<int>(pairs.size()), 1, threads, [&](int p0, int p1) {
+        std::vector<WorldTriangle> ta, tb;
+        for (int p = p0; p < p1; ++p) {
+            const auto [a, b] = pairs[static_cast<std::size_t>(p)];
+            InstanceLineCache::Pair& pair = found[static_cast<std::size_t>(p)];
+            pair.a = a;
+            pair.b = b;
+            pair.mesh_a = by_mesh[scene.instances[a].mesh];
+            pair.mesh_b = by_mesh[scene.instances[b].mesh];
+            pair.to_world_a = scene.instances[a].to_world;
+            pair.to_world_b = scene.instances[b].to_world;
+            // The last frame's crossings when neither moved (the cache's pairs are sorted).
+            const auto it = std::lower_bound(
+                cache.pairs.begin(), cache.pairs.end(), pair,
+                [](const InstanceLineCache::Pair& x, const InstanceLineCache::Pair& y) {
+                    return std::tie(x.a, x.b) < std::tie(y.a, y.b);
+                });
+            if (it != cache.pairs.end() && it->a == a && it->b == b && it->mesh_a == pair.mesh_a &&
+                it->mesh_b == pair.mesh_b && it->to_world_a == pair.to_world_a &&
+                it->to_world_b == pair.to_world_b) {
+                pair.crossings = it->crossings;
+                continue;
+            }
+            const BBox region = intersection(world[a], world[b]);
+            triangles_in(*pair.mesh_a, pair.to_world_a, region, ta);
+            triangles_in(*pair.mesh_b, pair.to_world_b, region, tb);
+            pair.crossings = cross(ta, tb);
+        }
+    });
+    cache.pairs = std::move(found);
+
+    for (const InstanceLineCache::Pair& pair : cache.pairs) {
+        if (pair.crossings.empty()) continue;
+        const Placement pa = place(scene, pair.a, pair.mesh_a.get(), eye);
+        const Placement pb = place(scene, pair.b, pair.mesh_b.get(), eye);
+        for (const PairCrossing& pc : pair.crossings) {
+            const bool hidden = pa.turned_away(pc.t) || pb.turned_away(pc.u);
+            if (hidden && !settings.certainly_hidden) continue;
+            segments.push_back(crossing_segment(pc.crossing, pc.t, pc.u, pair.a, pair.b,
+                                                pair.mesh_a->welded, pair.mesh_b->welded, hidden));
+        }
+    }
+    // The own triangles against each instance (in instance order). The own triangles' rule
+    // for faces turned away is not applied here: those crossings are traced and found hidden.
+    const Bvh& own_tree = accel.bvh();
+    if (own_tree.nodes.empty()) return;
+    const BBox own_box = grown(own_tree.nodes[0].bounds);
+    std::vector<std::vector<FeatureSegment>> own_pairs(count);
+    parallel_for(static_cast<int>(count), 16, threads, [&](int i0, int i1) {
+        std::vector<WorldTriangle> ta, tb;
+        for (int i = i0; i < i1; ++i) {
+            const auto b = static_cast<std::uint32_t>(i);
+            if (!overlap(own_box, world[b])) continue;
+            const BBox region = intersection(own_box, world[b]);
+            if (view_volume && !view_volume->may_see(region)) continue;
+            own_triangles_in(scene, own_tree, region, ta);
+            if (ta.empty()) continue;
+            triangles_in(*cache.of_instance[b], scene.instances[b].to_world, region, tb);
+            const std::vector<PairCrossing> crossings = cross(ta, tb);
+            if (crossings.empty()) continue;
+            const Placement pb = place(scene, b, cache.of_instance[b], eye);
+            for (const PairCrossing& pc : crossings) {
+                const bool hidden = pb.turned_away(pc.u);
+                if (hidden && !settings.certainly_hidden) continue;
+                own_pairs[static_cast<std::size_t>(i)].push_back(
+                    crossing_segment(pc.crossing, pc.t, pc.u, kNoIndex, b, own,
+                                     cache.of_instance[b]->welded, hidden));
+            }
+        }
+    });
+    for (const auto& part : own_pairs) segments.insert(segments.end(), part.begin(), part.end());
+}
+
+}  // namespace toonray::ink

@@ -1,0 +1,121 @@
+#pragma once
+/// Internal to the ink module (feature_edges.cpp, instance_lines.cpp): the mesh edges of a
+/// welded mesh and the intersection search, shared by the scene's own triangles and the meshes
+/// of its instances.
+
+#include <algorithm>
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "toonray/accel/bvh.h"
+#include "toonray/ink/feature_edges.h"
+#include "toonray/scene/scene.h"
+
+namespace toonray::ink {
+
+// A side of a usable triangle: from welded vertex lo to hi (lo < hi).
+struct Side {
+    std::uint32_t lo, hi, tri;
+    bool forward;  // lo -> hi in the triangle's winding
+};
+
+struct MeshTopology {
+    // What it was made from.
+    std::vector<std::array<std::uint32_t, 3>> tri_vertices;
+    std::vector<std::uint32_t> tri_object;
+    std::vector<std::uint8_t> usable;
+    std::size_t objects = 0;
+    /// Every side of a usable triangle, in order of (lo, hi, triangle, corner), so that the
+    /// sides of one edge are adjacent: edge e is sides [edge_first[e], edge_first[e + 1]).
+    std::unique_ptr<Side[]> sides;  // every one written: not cleared first
+    std::vector<std::uint32_t> edge_first;
+    /// Per object: not closed, for an edge without exactly two sides in opposite directions,
+    /// or a triangle that is not usable or has two corners welded together.
+    std::vector<std::uint8_t> open;
+
+    /// `object_of` has each triangle's object (< objects_).
+    MeshTopology(std::span<const std::uint32_t> object_of, const WeldedMesh& mesh,
+                 std::span<const std::uint8_t> usable_, std::size_t objects_)
+        : tri_vertices(mesh.tri_vertices),
+          tri_object(object_of.begin(), object_of.begin() + usable_.size()),
+          usable(usable_.begin(), usable_.end()),
+          objects(objects_),
+          open(objects_, 0) {
+        const std::size_t n = usable.size(), vertices = mesh.vertex_count();
+        // A counting sort by lo over the triangles in order puts each vertex's sides in
+        // (triangle, corner) order; a stable sort by hi within each vertex then gives the
+        // whole order.
+        std::vector<std::uint32_t> offsets(vertices + 1, 0);
+        for (std::size_t t = 0; t < n; ++t) {
+            const auto& w = tri_vertices[t];
+            if (!usable[t] || w[0] == w[1] || w[1] == w[2] || w[2] == w[0]) open[tri_object[t]] = 1;
+            if (!usable[t]) continue;
+            for (int k = 0; k < 3; ++k)
+                if (w[k] != w[(k + 1) % 3]) ++offsets[std::min(w[k], w[(k + 1) % 3]) + 1];
+        }
+        for (std::size_t v = 0; v < vertices; ++v) offsets[v + 1] += offsets[v];
+        const std::size_t side_count = offsets[vertices];
+        sides = std::make_unique_for_overwrite<Side[]>(side_count);
+        {
+            std::vector<std::uint32_t> fill(offsets.begin(), offsets.end() - 1);
+            for (std::size_t t = 0; t < n; ++t) {
+                if (!usable[t]) continue;
+                const auto& w = tri_vertices[t];
+                for (int k = 0; k < 3; ++k) {
+                    const std::uint32_t u = w[k], v = w[(k + 1) % 3];
+                    if (u == v) continue;
+                    const std::uint32_t lo = std::min(u, v);
+                    sides[fill[lo]++] = {lo, std::max(u, v), static_cast<std::uint32_t>(t), u < v};
+                }
+            }
+        }
+        edge_first.reserve(side_count / 2 + 1);
+        for (std::size_t v = 0; v < vertices; ++v) {
+            Side* const first = sides.get() + offsets[v];
+            Side* const last = sides.get() + offsets[v + 1];
+            // By insertion, as a vertex has few sides (but not at the centre of a large fan).
+            if (last - first > 32) {
+                std::stable_sort(first, last,
+                                 [](const Side& a, const Side& b) { return a.hi < b.hi; });
+            } else {
+                for (Side* i = first + 1; i < last; ++i) {
+                    const Side side = *i;
+                    Side* j = i;
+                    for (; j > first && (j - 1)->hi > side.hi; --j) *j = *(j - 1);
+                    *j = side;
+                }
+            }
+            for (const Side* i = first; i < last;) {
+                const Side* j = i + 1;
+                while (j < last && j->hi == i->hi) ++j;
+                edge_first.push_back(static_cast<std::uint32_t>(i - sides.get()));
+                if (j - i != 2 || i[0].forward == i[1].forward) open[tri_object[i->tri]] = 1;
+                i = j;
+            }
+        }
+        edge_first.push_back(static_cast<std::uint32_t>(side_count));
+    }
+
+    [[nodiscard]] bool same(const TriangleMesh& scene, const WeldedMesh& mesh,
+                            std::span<const std::uint8_t> usable_, std::size_t objects_) const {
+        return objects_ == objects && usable_.size() == usable.size() &&
+               std::equal(usable.begin(), usable.end(), usable_.begin()) &&
+               mesh.tri_vertices == tri_vertices &&
+               std::equal(tri_object.begin(), tri_object.end(), scene.tri_object.begin());
+    }
+};
+
+/// Every pair of triangles that take part (`live`) and cross, as intersect_triangles finds them,
+/// with (when `stale` is given) at least one stale triangle; in no particular order. `bvh` is
+/// built over the triangles whose corners are `tri_corners`; triangles sharing a corner
+/// position (mesh.vertex_position) are not tested.
+std::vector<PairCrossing> find_crossings(const Bvh& bvh,
+                                         const std::vector<std::array<Vec3f, 3>>& tri_corners,
+                                         const WeldedMesh& mesh,
+                                         const std::vector<std::uint8_t>& live,
+                                         const std::vector<std::uint8_t>* stale, int threads);
+
+}  // namespace toonray::ink

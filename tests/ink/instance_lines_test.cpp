@@ -1,0 +1,223 @@
+// Ink lines on instances: culling by normal cones and by the view changes no segment; the
+// mesh edges are those of the flattened scene; intersection lines between instances; strokes
+// styled by their instance's object; per-mesh work kept across frames.
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <bit>
+#include <cstring>
+#include <map>
+#include <set>
+#include <tuple>
+#include <vector>
+
+#include "toonray/accel/scene_accel.h"
+#include "toonray/ink/ink.h"
+#include "toonray/ink/instance_lines.h"
+#include "support/instance_scenes.h"
+#include "ink/ink_scenes.h"
+
+using namespace toonray;
+using namespace toonray::ink;
+
+namespace {
+
+std::array<std::uint32_t, 3> bits(const Vec3f& v) {
+    return std::bit_cast<std::array<std::uint32_t, 3>>(v);
+}
+
+bool same_segment(const FeatureSegment& a, const FeatureSegment& b) {
+    return bits(a.p0) == bits(b.p0) && bits(a.p1) == bits(b.p1) && a.key0 == b.key0 &&
+           a.key1 == b.key1 && a.type == b.type && a.faces == b.faces &&
+           a.face_instance == b.face_instance && a.smooth == b.smooth &&
+           a.certainly_hidden == b.certainly_hidden;
+}
+
+std::vector<FeatureSegment> instance_lines(const Scene& scene, const TriangleAccel& accel,
+                                           const CameraSpec& camera, InstanceLineCache& cache,
+                                           const InstanceLineOptions& options = {},
+                                           FeatureEdgeSettings settings = {}, int w = 320,
+                                           int h = 200) {
+    const ViewPlane plane = make_view_plane(camera, w, h);
+    const ScreenProjection view(plane, w, h);
+    const WeldedMesh own = weld_vertices(scene);
+    std::vector<FeatureSegment> out;
+    add_instance_segments(scene, accel, own, plane, view, 4.0f, settings, 2, cache, out, options);
+    return out;
+}
+
+TEST(InstanceLines, CullingChangesNoSegment) {
+    const Scene scene = test_support::instanced_test_scene();
+    const TriangleAccel accel = build_scene_accel(scene);
+    const WeldedMesh own = weld_vertices(scene);
+    InstanceLineCache a, b, c;  // the meshes' work is kept across views
+    int culled_views = 0;
+    for (int turn = 0; turn < 360; turn += 90) {
+        for (const Vec3f& target : {Vec3f(0, 1, 0), Vec3f(-6, 0.5f, -3), Vec3f(6, 0, -8)}) {
+            const CameraSpec around = test_support::orbit_camera(
+                test_support::instanced_test_camera(), static_cast<float>(turn));
+            const CameraSpec camera = test_support::looking_at(around.eye, target);
+            for (const bool hidden : {false, true}) {
+                FeatureEdgeSettings settings;
+                settings.certainly_hidden = hidden;
+                const auto culled = instance_lines(scene, accel, camera, a, {}, settings);
+                const auto all = instance_lines(scene, accel, camera, b, {false, false}, settings);
+                // Culling may drop only segments that visibility would clip away.
+                std::vector<FeatureSegment> kept;
+                const ScreenProjection view(make_view_plane(camera, 320, 200), 320, 200);
+                VisibilitySettings visibility;
+                visibility.max_invisibility = 1;
+                std::vector<std::uint8_t> shows(all.size(), 0);
+                for (const EdgePiece& piece : split_by_visibility(
+                         all, VisibilityContext{scene, own, accel, view, &b}, visibility, 2))
+                    shows[piece.segment] = 1;
+                for (std::size_t i = 0; i < all.size(); ++i)
+                    if (shows[i]) kept.push_back(all[i]);
+                culled_views += culled.size() < all.size();
+                // Every segment that shows is among the culled ones, in the same order.
+                std::size_t j = 0;
+                for (const FeatureSegment& s : kept) {
+                    while (j < culled.size() && !same_segment(culled[j], s)) ++j;
+                    ASSERT_LT(j, culled.size())
+                        << "a segment in view was culled (turn " << turn << ")";
+                }
+                // And the cones never drop a segment of an instance in full view.
+                const auto no_cones =
+                    instance_lines(scene, accel, camera, c, {false, true}, settings);
+                ASSERT_EQ(no_cones.size(), culled.size());
+                for (std::size_t i = 0; i < culled.size(); ++i)
+                    ASSERT_TRUE(same_segment(no_cones[i], culled[i])) << i;
+            }
+        }
+    }
+    EXPECT_GT(culled_views, 5);  // the test saw culling at work
+}
+
+// The flattened scene's segments of the instances' mesh edges (its own triangles are the
+// ground; everything else came from instances) against the instanced ones, by their ends.
+TEST(InstanceLines, MeshEdgesAreTheFlattenedScenes) {
+    const Scene scene = test_support::instanced_test_scene();
+    const Scene flat = flatten_instances(scene);
+    const TriangleAccel accel = build_scene_accel(scene), flat_accel = build_scene_accel(flat);
+    const CameraSpec camera = test_support::instanced_test_camera();
+    FeatureEdgeSettings settings;
+    settings.intersections = false;
+    InstanceLineCache cache;
+    const auto inst = instance_lines(scene, accel, camera, cache, {false, false}, settings);
+    const WeldedMesh welded = weld_vertices(flat);
+    const auto flat_segments =
+        find_feature_edges(flat, welded, flat_accel.bvh(), camera.eye, settings, 2);
+    using Key = std::tuple<std::array<std::uint32_t, 3>, std::array<std::uint32_t, 3>, int>;
+    std::set<Key> a, b;
+    for (const FeatureSegment& s : inst)
+        if (!s.smooth) a.insert({bits(s.p0), bits(s.p1), static_cast<int>(s.type)});
+    for (const FeatureSegment& s : flat_segments)
+        if (!s.smooth && flat.tri_object[s.faces[0]] != 1)  // not the ground
+            b.insert({bits(s.p0), bits(s.p1), static_cast<int>(s.type)});
+    std::vector<Key> common;
+    std::set_intersection(a.begin(), a.end(), b.begin(), b.end(), std::back_inserter(common));
+    // Silhouettes are classified from object-space normals, creases judged in object space:
+    // a few grazing or borderline edges may go the other way.
+    EXPECT_GE(common.size() * 100, a.size() * 99) << common.size() << " of " << a.size();
+    EXPECT_GE(common.size() * 100, b.size() * 99) << common.size() << " of " << b.size();
+    // Smooth contours: as many on each side, within a few.
+    const auto smooth = [](const auto& v) {
+        return std::count_if(v.begin(), v.end(), [](const FeatureSegment& s) { return s.smooth; });
+    };
+    EXPECT_NEAR(double(smooth(inst)), double(smooth(flat_segments)), 0.02 * double(smooth(inst)));
+    EXPECT_GT(smooth(inst), 50);
+}
+
+TEST(InstanceLines, IntersectionsAreTheFlattenedScenes) {
+    const Scene scene = test_support::instanced_test_scene();
+    const Scene flat = flatten_instances(scene);
+    const TriangleAccel accel = build_scene_accel(scene), flat_accel = build_scene_accel(flat);
+    const CameraSpec camera = test_support::instanced_test_camera();
+    InstanceLineCache cache;
+    const auto inst = instance_lines(scene, accel, camera, cache, {false, false});
+    const auto flat_segments =
+        find_feature_edges(flat, weld_vertices(flat), flat_accel.bvh(), camera.eye, {}, 2);
+    // By their ends, and whether they join two instances (two objects, flattened).
+    using Ends = std::tuple<std::array<std::uint32_t, 3>, std::array<std::uint32_t, 3>, bool>;
+    std::set<Ends> a, b;
+    int between = 0;
+    for (const FeatureSegment& s : inst) {
+        if (s.type != EdgeType::Intersection) continue;
+        const bool two = s.face_instance[0] != s.face_instance[1];
+        a.insert({bits(s.p0), bits(s.p1), two});
+        between += two;
+    }
+    for (const FeatureSegment& s : flat_segments)
+        if (s.type == EdgeType::Intersection)
+            b.insert({bits(s.p0), bits(s.p1),
+                      flat.tri_object[s.faces[0]] != flat.tri_object[s.faces[1]]});
+    EXPECT_GT(between, 20);      // pot.1 and pot.2 cross
+    EXPECT_GT(a.size(), 1000u);  // and the teapot's spout and handle cross its body
+    std::vector<Ends> only_a, only_b;
+    std::set_difference(a.begin(), a.end(), b.begin(), b.end(), std::back_inserter(only_a));
+    std::set_difference(b.begin(), b.end(), a.begin(), a.end(), std::back_inserter(only_b));
+    // Between instances the crossings are found from the same world corners: the same
+    // segments. Within a mesh the pairs are found in object space and crossed again in the
+    // world: a pair that only touches may be found on one side and not the other.
+    EXPECT_LE(200 * (only_a.size() + only_b.size()), a.size())
+        << only_a.size() << " only instanced, " << only_b.size() << " only flattened";
+    for (const Ends& e : only_a) EXPECT_FALSE(std::get<2>(e));
+    for (const Ends& e : only_b) EXPECT_FALSE(std::get<2>(e));
+}
+
+TEST(InstanceLines, StrokesTakeTheirInstancesObject) {
+    const Scene scene = test_support::instanced_test_scene();
+    const TriangleAccel accel = build_scene_accel(scene);
+    InkSettings settings;
+    settings.styles = parse_line_styles("match object=pot.3 color=#ff0000\n", "test.style");
+    InkLines lines;
+    draw_ink_lines(scene, accel, test_support::instanced_test_camera(), 320, 200, settings, 2,
+                   lines);
+    int red = 0;
+    for (const Stroke& s : lines.strokes) red += lines.styles[s.style].colour == Vec3f(1, 0, 0);
+
+    EXPECT_GT(red, 0);
+    for (const FeatureSegment& s : lines.segments) {
+        const auto [object, material] = style_source(scene, s);
+        if (s.face_instance[0] == 3 && s.face_instance[1] == 3) {
+            EXPECT_EQ(scene.objects[object], "pot.3");
+        }
+        (void)material;
+    }
+    // Keys of different instances never meet: a stroke's pieces are of one instance.
+    std::map<EndpointKey, std::set<std::uint32_t>> owners;
+    for (const FeatureSegment& s : lines.segments)
+        for (const EndpointKey& k : {s.key0, s.key1})
+            if (k.a != kNoIndex) owners[k].insert(s.face_instance[0]);
+    for (const auto& [key, instances] : owners)
+        if (key.c == kNoIndex) {
+            EXPECT_EQ(instances.size(), 1u);
+        }
+}
+
+TEST(InstanceLines, MeshWorkIsKeptAcrossFrames) {
+    Scene scene = test_support::instanced_test_scene();
+    const CameraSpec camera = test_support::instanced_test_camera();
+    InkLines lines;
+    for (int frame = 0; frame < 4; ++frame) {
+        // The pots move, the balls stay; the eye moves.
+        for (std::size_t i = 0; i < 6; ++i)
+            scene.instances[i].to_world.m[0][3] += 0.01 * static_cast<double>(frame);
+        const TriangleAccel accel = build_scene_accel(scene);
+        draw_ink_lines(scene, accel, test_support::orbit_camera(camera, 5.0f * frame), 320, 200, {},
+                       2, lines);
+        EXPECT_EQ(lines.instances.mesh_builds, 2u);  // the teapot's and the sphere's, once
+    }
+    // A fresh cache finds the same segments as the one carried over the frames.
+    InkLines fresh;
+    const TriangleAccel accel = build_scene_accel(scene);
+    draw_ink_lines(scene, accel, test_support::orbit_camera(camera, 15.0f), 320, 200, {}, 2, fresh);
+    ASSERT_EQ(fresh.segments.size(), lines.segments.size());
+    for (std::size_t i = 0; i < fresh.segments.size(); ++i)
+        ASSERT_TRUE(same_segment(fresh.segments[i], lines.segments[i])) << i;
+    EXPECT_TRUE(std::equal(fresh.coverage.data(), fresh.coverage.data() + fresh.coverage.size(),
+                           lines.coverage.data()));
+}
+
+}  // namespace
