@@ -58,9 +58,10 @@ void write_svg(const FrameLayers& layers, const RenderSettings& settings,
     svg.colour = settings.lines.colour;
     svg.hidden = options.svg_hidden;
     svg.pens = lines.pens;
+    svg.plotter = options.svg_plotter;
     svg.software = options.record.software;
     svg.metadata = options.record.settings;
-    if (options.svg_fill) {
+    if (options.svg_fill && !options.svg_plotter) {
         const ImageRgb8& cel = layers.cel;
         svg.fill_href = ink::png_data_uri(
             encode_png(cel.width(), cel.height(), 3,
@@ -69,6 +70,25 @@ void write_svg(const FrameLayers& layers, const RenderSettings& settings,
     const std::string text = ink::svg_text(lines.strokes, svg);
     write_file_atomic(path,
                       std::span(reinterpret_cast<const std::uint8_t*>(text.data()), text.size()));
+}
+
+// Reads the brushes the rules name that are not read yet into `brushes`; whether any rule
+// names one.
+bool read_brushes(const ink::LineStyleSet& styles, ink::BrushSet& brushes) {
+    bool any = false;
+    for (const ink::LineStyleRule& rule : styles.rules) {
+        if (!rule.sets_field(&ink::LineStyle::brush) || rule.values.brush.empty()) continue;
+        any = true;
+        if (brushes.contains(rule.values.brush)) continue;
+        try {
+            const DecodedPng png = read_png(rule.values.brush);
+            brushes.emplace(rule.values.brush,
+                            std::make_shared<const ink::Brush>(ink::make_brush(png.rgb)));
+        } catch (const Error& e) {
+            throw Error(fmt::format("line style brush '{}': {}", rule.values.brush, e.what()));
+        }
+    }
+    return any;
 }
 
 }  // namespace
@@ -128,7 +148,9 @@ void FrameRenderer::render(const SceneFrame& frame, const std::filesystem::path&
     const TriangleAccel& accel = accel_.update(scene, options.bvh);
     const TextureSet* textures =
         settings.shading.textures ? &textures_.load(scene, warnings) : nullptr;
-    renderer_.render(scene, accel, frame.camera, frame.lights, settings, textures);
+    RenderSettings with_brushes = settings;
+    if (read_brushes(settings.lines.ink.styles, brushes_)) with_brushes.brushes = &brushes_;
+    renderer_.render(scene, accel, frame.camera, frame.lights, with_brushes, textures);
     const FrameLayers& layers = renderer_.layers();
     PngOptions png = options.png;
     if (!options.record.software.empty())

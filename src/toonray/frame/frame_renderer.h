@@ -40,6 +40,8 @@ struct FrameOptions {
     std::optional<std::filesystem::path> svg_dir;
     /// The SVG also holds the cel-shaded picture (without lines) as an embedded PNG under them.
     bool svg_fill = false;
+    /// The SVG is for a pen plotter (ink/plotter.h): layers per pen, merged and ordered paths.
+    bool svg_plotter = false;
     Bvh::Config bvh;
     PngOptions png;
     /// Recorded in every PNG (tEXt chunks "Software" and "toonray settings"), in the EXR's
@@ -92,6 +94,7 @@ public:
 private:
     AnimationAccel accel_;
     TextureCache textures_;
+    ink::BrushSet brushes_;  ///< the line styles' brushes, read once
     Renderer renderer_;
     FeatureLayers exr_layers_;
 };
