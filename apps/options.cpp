@@ -130,7 +130,15 @@ Settings SettingsArgs::settings() const {
     if (!line_style_.empty())
         settings.render.lines.ink.styles =
             ink::parse_line_styles(read_file(line_style_), line_style_);
-    with_flag("--lines", [&] { check_settings(settings); });
+    // check_settings names the key at fault ("lines.types: ..."): its flag goes in front.
+    try {
+        check_settings(settings);
+    } catch (const Error& e) {
+        const std::string_view what = e.what();
+        const Setting* setting = find_setting(what.substr(0, what.find(':')));
+        if (!setting || setting->flag.empty()) throw;
+        throw Error(fmt::format("{}: {}", setting->flag.substr(0, setting->flag.find(',')), what));
+    }
     return settings;
 }
 

@@ -39,6 +39,14 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
             }
             FUZZ_CHECK(s.dash.empty() || total > 0.0f);
             for (int c = 0; c < 3; ++c) FUZZ_CHECK(s.colour[c] >= 0.0f && s.colour[c] <= 1.0f);
+            FUZZ_CHECK(s.pressure.empty() || (s.pressure.size() >= 2 && s.pressure.size() <= 16));
+            for (float f : s.pressure) FUZZ_CHECK(f >= 0.0f && f <= 10.0f);
+            FUZZ_CHECK(s.calligraphy >= 0.0f && s.calligraphy <= 1.0f);
+            FUZZ_CHECK(s.nib_angle >= -360.0f && s.nib_angle <= 360.0f);
+            FUZZ_CHECK(s.brush.find_first_of(" \t\r\n") == std::string::npos);
+            for (float count : {s.sketch, s.sketch_seed, s.boil})
+                FUZZ_CHECK(count >= 0.0f && count == std::floor(count));
+            FUZZ_CHECK(s.sketch <= 16.0f);
         }
     return 0;
 }

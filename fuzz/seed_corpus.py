@@ -133,6 +133,10 @@ put("line_style", "all_keys.style",
     "match type=crease,silhouette,border,material,intersection lines=visible draw=yes colour=0.5,0.25,1 "
     "width=0 opacity=1 dash=none taper=0\nmatch object=a?c*,d lines=hidden dash=1,2,3 color=#ff00ff\n")
 put("line_style", "bad.style", "match width=-1\n")
+put("line_style", "brush_keys.style",
+    "match type=band,shadow,tone pressure=0.2,1,0.4 calligraphy=0.3 nib_angle=30 brush=b.png "
+    "brush_stretch=yes sketch=3 sketch_offset=2 sketch_period=40 sketch_seed=5 boil=2\n"
+    "match pressure=none brush=none sketch=0\n")
 
 # --- settings documents ---
 put("settings", "every_key.toml",
@@ -150,6 +154,17 @@ put("settings", "rules.toml",
     "[[lines.rule]]\ntype = \"crease\"\ncolor = \"#3050a0\"\nwidth = 1.0\n"
     "[[lines.rule]]\nobject = \"box*\"\nlines = \"hidden\"\ndraw = true\ndash = [4, 3]\n")
 put("settings", "bad_key.toml", "[lines]\nwidht = 2\n")
+put("settings", "tone.toml",
+    "[tone]\nmode = \"hatch\"\nanchor = \"screen\"\nhatch_direction = \"1,0,0\"\nspacing = 5.0\n"
+    "angle = 30.0\n[lines]\ntypes = \"all,band\"\n[output]\nsvg_plotter = true\n")
+
+# --- tone looks and line types (fuzz_tone) ---
+for name, text in [("mode_hatch", "hatch"), ("mode_screentone", "screentone"),
+                   ("anchor_screen", "screen"), ("direction_curvature", "curvature"),
+                   ("direction_light", "light"), ("direction_vector", "0.5,1,-2"),
+                   ("direction_y", "y"), ("direction_tiny", "1e-30,0,0"),
+                   ("lines_all_band", "all,band,shadow"), ("lines_shadow", "silhouette,shadow")]:
+    put("tone", name, text)
 
 
 # --- PNG ---

@@ -63,9 +63,10 @@ void keep_frame(const FrameLayers& layers, const Scene& scene, const FrameOption
             d.visible = s.visible;
             d.closed = s.closed;
             if (s.segment < lines.segments.size()) {
-                const std::uint32_t tri =
-                    ink::style_source_triangle(scene, lines.segments[s.segment]);
-                if (tri != kNoIndex) d.object = scene.tri_object[tri];
+                // An instance's strokes carry the instance's object (style_source).
+                const ink::FeatureSegment& segment = lines.segments[s.segment];
+                if (segment.faces[0] != kNoIndex || segment.faces[1] != kNoIndex)
+                    d.object = ink::style_source(scene, segment).first;
             }
             d.points = s.points;
         }

@@ -24,7 +24,7 @@ cd "$(dirname "$0")/.."
 
 seconds=${1:-60}
 shift || true
-all_targets=(obj mtl camera note_script midi camera_path options png render shading gltf glb line_style settings)
+all_targets=(obj mtl camera note_script midi camera_path options png render shading gltf glb line_style settings tone)
 targets=("$@")
 [ ${#targets[@]} -gt 0 ] || targets=("${all_targets[@]}")
 build=${TOONRAY_FUZZ_BUILD_DIR:-build-fuzz}

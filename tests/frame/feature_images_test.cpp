@@ -16,10 +16,11 @@ TEST(FeatureImages, TheTableListsEachModesImages) {
         if (f.in(LineMode::Robust)) robust.push_back(f.name);
         if (f.in(LineMode::Ink)) ink.push_back(f.name);
     }
-    EXPECT_EQ(ink, (std::vector<std::string_view>{
-                       "depth", "normal", "edges", "cel", "lines_silhouette", "lines_crease",
-                       "lines_material", "lines_border", "lines_intersection", "lines_polyline",
-                       "object_id", "material_id", "samples"}));
+    EXPECT_EQ(ink,
+              (std::vector<std::string_view>{
+                  "depth", "normal", "edges", "tone", "cel", "lines_silhouette", "lines_crease",
+                  "lines_material", "lines_border", "lines_intersection", "lines_polyline",
+                  "lines_band", "lines_shadow", "object_id", "material_id", "samples"}));
     EXPECT_EQ(classic, (std::vector<std::string_view>{"depth", "normal", "edges_depth",
                                                       "edges_normal", "edges", "cel"}));
     EXPECT_EQ(robust, (std::vector<std::string_view>{

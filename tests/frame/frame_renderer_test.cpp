@@ -72,7 +72,7 @@ TEST(FrameRenderer, WritesTheImageAndAllFeatureImagesNamedAfterTheOutput) {
             EXPECT_EQ(read_png(p).width, 64);
             EXPECT_EQ(p, aov_path(dir.path / "aov", dir.path / "frame.png", f.name));
         }
-        EXPECT_EQ(written, mode == LineMode::Robust ? 12u : (mode == LineMode::Ink ? 13u : 6u));
+        EXPECT_EQ(written, mode == LineMode::Robust ? 12u : (mode == LineMode::Ink ? 16u : 6u));
         fs::remove_all(dir.path / "aov");
     }
 }

@@ -38,6 +38,11 @@ Settings changed() {
     set_setting(s, "lines.robust.silhouette_ratio", 0.2);
     set_setting(s, "lines.ink.taper", 4.0);
     set_setting(s, "lines.ink.width_by_depth", true);
+    set_setting(s, "tone.mode", std::string("hatch"));
+    set_setting(s, "tone.anchor", std::string("screen"));
+    set_setting(s, "tone.hatch_direction", std::string("light"));
+    set_setting(s, "tone.spacing", 5.5);
+    set_setting(s, "tone.angle", std::int64_t{30});
     set_setting(s, "sampling.samples", std::int64_t{9});
     set_setting(s, "sampling.adaptive", false);
     set_setting(s, "sampling.tile_size", std::int64_t{64});
@@ -46,6 +51,7 @@ Settings changed() {
     set_setting(s, "output.png_level", std::int64_t{6});
     set_setting(s, "output.svg_hidden", true);
     set_setting(s, "output.svg_fill", true);
+    set_setting(s, "output.svg_plotter", true);
     set_setting(s, "limits.triangles", std::string("5M"));
     set_setting(s, "limits.vertices", std::string("6M"));
     set_setting(s, "limits.image_pixels", std::string("10M"));
@@ -131,6 +137,15 @@ TEST(Settings, OutputsRecordOnlyWhatCanChangeThePicture) {
     other.render.threads = 7;
     other.render.sampling.tile_size = 5;
     EXPECT_EQ(output_record(other).settings, recorded);
+    // Keys that came later are recorded when set, and left out at their defaults, so that the
+    // frames made without them record what they did before.
+    for (const char* kept : {"[tone]", "mode = \"hatch\"", "spacing = 5.5", "svg_plotter = true"})
+        EXPECT_NE(recorded.find(kept), std::string::npos) << kept;
+    const std::string plain = settings_toml(Settings{}, true);
+    for (const char* left_out : {"[tone]", "svg_plotter", "anchor"})
+        EXPECT_EQ(plain.find(left_out), std::string::npos) << left_out;
+    EXPECT_NE(settings_toml(Settings{}).find("[tone]"), std::string::npos)
+        << "the whole document has every key";
 }
 
 TEST(Settings, TheTableHasOneKeyAndFlagEach) {

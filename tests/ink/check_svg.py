@@ -13,7 +13,7 @@ import sys
 import xml.etree.ElementTree as ET
 
 SVG = "{http://www.w3.org/2000/svg}"
-TYPES = ["silhouette", "border", "crease", "material", "intersection", "polyline"]
+TYPES = ["silhouette", "border", "crease", "material", "intersection", "polyline", "band", "shadow"]
 
 
 def fail(message):
@@ -30,6 +30,9 @@ def main():
         fail(f"viewBox {root.get('viewBox')}")
     layers = [g.get("id") for g in root.findall(SVG + "g")]
     expected = ["visible", "hidden"] if hidden else ["visible"]
+    # A tone look's strokes and dots come first, under the lines.
+    if layers and layers[0] == "tone":
+        expected = ["tone"] + expected
     if layers != expected:
         fail(f"layers {layers}")
     min_dashed_hidden = int(sys.argv[6]) if len(sys.argv) > 6 else 0
@@ -47,7 +50,13 @@ def main():
         if layer.get("stroke-linecap") != "round" or float(layer.get("stroke-width")) <= 0:
             fail(f"layer {layer.get('id')} lacks round caps or a width")
         ids = [g.get("id") for g in layer.findall(SVG + "g")]
-        if ids != [f"{layer.get('id')}-{t}" for t in TYPES]:
+        if layer.get("id") == "tone":
+            if ids:
+                fail(f"the tone has subgroups {ids}")
+            for circle in layer.iter(SVG + "circle"):
+                if not re.fullmatch(r"#[0-9a-f]{6}", circle.get("fill") or "") or float(circle.get("r")) <= 0:
+                    fail(f"dot {circle.attrib}")
+        elif ids != [f"{layer.get('id')}-{t}" for t in TYPES]:
             fail(f"subgroups {ids}")
         for path_element in layer.iter(SVG + "path"):
             d = path_element.get("d")

@@ -128,14 +128,20 @@ TEST(LineStyle, LaterRulesOverrideTheAttributesTheySet) {
 
 TEST(LineStyle, TheKeysAreTheMatchersThenTheTablesAttributes) {
     const std::vector<std::string_view> keys = ink::line_rule_keys();
-    EXPECT_EQ(keys, (std::vector<std::string_view>{"object", "material", "type", "lines", "draw",
-                                                   "color", "colour", "width", "opacity", "dash",
-                                                   "taper", "width_by_depth"}));
+    EXPECT_EQ(keys, (std::vector<std::string_view>{
+                        "object",        "material",    "type",          "lines",
+                        "draw",          "color",       "colour",        "width",
+                        "opacity",       "dash",        "taper",         "width_by_depth",
+                        "pressure",      "calligraphy", "nib_angle",     "brush",
+                        "brush_stretch", "sketch",      "sketch_offset", "sketch_period",
+                        "sketch_seed",   "boil"}));
     for (const ink::StyleAttribute& a : ink::style_attributes()) {
         EXPECT_FALSE(a.help.empty()) << a.name;
         EXPECT_TRUE(a.named(a.name));
         // Lengths in pixels at 720 lines scale with the image; nothing else does.
-        EXPECT_EQ(a.scales(), a.name == "width" || a.name == "taper" || a.name == "dash") << a.name;
+        EXPECT_EQ(a.scales(), a.name == "width" || a.name == "taper" || a.name == "dash" ||
+                                  a.name == "sketch_offset" || a.name == "sketch_period")
+            << a.name;
     }
     for (const ink::RuleMatcher& m : ink::rule_matchers()) EXPECT_FALSE(m.help.empty()) << m.name;
 }
@@ -166,7 +172,9 @@ TEST(LineStyle, RulesFromEntriesNameTheirPlaceInErrors) {
               "settings.toml: lines.rule[2].dash: the lengths must not all be 0");
     EXPECT_EQ(rule_error({{"draw", "yes"}, {"colr", "#000000"}}),
               "settings.toml: lines.rule[2]: unknown key 'colr' (object, material, type, lines, "
-              "draw, color, width, opacity, dash, taper, width_by_depth)");
+              "draw, color, width, opacity, dash, taper, width_by_depth, pressure, calligraphy, "
+              "nib_angle, brush, brush_stretch, sketch, sketch_offset, sketch_period, sketch_seed, "
+              "boil)");
     EXPECT_EQ(rule_error({{"width", "1"}, {"width", "2"}}),
               "settings.toml: lines.rule[2]: 'width' given twice");
     // Entries and a .style line are read by the same code.
@@ -217,9 +225,13 @@ TEST(LineStyle, RulesRoundTripThroughEntries) {
         "match type=border,material,intersection,polyline colour=1,0,0 width=1000 opacity=1 "
         "taper=10000 dash=1,2,3,4,5,6,7,8,9,10,11,12,13,14,15\n"
         "match object=*,* material=a,b,c dash=0,1e-3 width=3.14159274 color=0.0039215689,1,0\n"
-        "match lines=visible width=-0 dash=0.5,0,0.25 opacity=1e-7\n",
+        "match lines=visible width=-0 dash=0.5,0,0.25 opacity=1e-7\n"
+        "match type=band,shadow,tone pressure=0.2,1,0.30000001 calligraphy=0.25 nib_angle=-45.5 "
+        "brush=ink/dry.png brush_stretch=yes sketch=3 sketch_offset=1.5 sketch_period=25 "
+        "sketch_seed=16777216 boil=12\n"
+        "match pressure=none brush=none sketch=0 calligraphy=1 nib_angle=360\n",
         "round.style");
-    ASSERT_EQ(set.rules.size(), 6u);
+    ASSERT_EQ(set.rules.size(), 8u);
     for (const ink::LineStyleRule& rule : set.rules) expect_round_trip(rule);
     // Every matcher and every attribute was written back by some rule above.
     std::vector<std::string> written;
@@ -248,8 +260,18 @@ TEST(LineStyle, RulesRoundTripThroughEntries) {
                     } else if constexpr (std::is_same_v<Value, Vec3f>) {
                         rule.values.*field = {unit(rng), unit(rng), unit(rng)};
                     } else if constexpr (std::is_same_v<Value, float>) {
-                        rule.values.*field =
-                            unit(rng) * (a.kind == ink::StyleValueKind::Length ? a.max : 1.0f);
+                        float v = unit(rng);
+                        if (a.kind == ink::StyleValueKind::Length) v *= a.max;
+                        if (a.kind == ink::StyleValueKind::Degrees) v = (2.0f * v - 1.0f) * a.max;
+                        if (a.kind == ink::StyleValueKind::Count)
+                            v = std::floor(v * std::min(a.max, 1000.0f));
+                        rule.values.*field = v;
+                    } else if constexpr (std::is_same_v<Value, std::string>) {
+                        rule.values.*field = "brushes/b" + std::to_string(rng() % 100) + ".png";
+                    } else if (a.kind == ink::StyleValueKind::Profile) {
+                        std::vector<float> profile(2 + rng() % 15);
+                        for (float& f : profile) f = unit(rng) * a.max;
+                        rule.values.*field = profile;
                     } else {
                         std::vector<float> dash(2 * (1 + rng() % 8));
                         for (float& d : dash) d = unit(rng) * 50.0f;
@@ -304,7 +326,7 @@ TEST(StyledStrokes, OneSolidPenDrawsExactlyLikeDrawStrokes) {
     const std::vector<ink::Stroke> strokes{
         line(10.3f, 0),
         line(12.0f, 0),
-        {ink::EdgeType::Crease, true, {{5, 5}, {30, 40}}, false, 0, {}}};
+        {ink::EdgeType::Crease, true, {{5, 5}, {30, 40}}, false, 0, {}, {}, 1.0f}};
     ImageF plain(64, 48, 0.0f);
     ink::draw_strokes(strokes, 2.5f, plain, 1);
     const std::vector<ink::StrokePen> pens{pen(2.5f)};
@@ -348,7 +370,7 @@ TEST(StyledStrokes, DashesOpacityAndTheStrongestStrokeWins) {
     std::vector<ink::Stroke> crossing{
         line(20.0f, 1),
         line(20.4f, 0),
-        {ink::EdgeType::Crease, true, {{30, 2}, {30, 46}}, false, 1, {}}};
+        {ink::EdgeType::Crease, true, {{30, 2}, {30, 46}}, false, 1, {}, {}, 1.0f}};
     ImageF c1, c2;
     Image<std::uint16_t> s1, s2;
     ink::draw_styled_strokes(crossing, pens, 64, 48, c1, s1, 1);

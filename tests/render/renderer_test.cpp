@@ -286,8 +286,10 @@ TEST(Renderer, LayersAreFilledOnlyWhenAskedAndChangeNothingElse) {
                                  l.normal.size(), l.object.size(), l.band.size(), l.light.size(),
                                  l.position.size(), l.uv.size(), l.refined.size(), l.lines.size()})
             EXPECT_EQ(size, a.size());
+        // The ink mode's tone layer (empty under the cel look, there all the same).
+        EXPECT_EQ(l.tone.size(), mode == LineMode::Ink ? a.size() : 0u);
         const std::size_t types =
-            mode == LineMode::Classic ? 2 : (mode == LineMode::Robust ? 5 : 6);
+            mode == LineMode::Classic ? 2 : (mode == LineMode::Robust ? 5 : 8);
         ASSERT_EQ(l.line_types.size(), types);
         for (const LineLayer& type : l.line_types) EXPECT_EQ(type.coverage.size(), a.size());
         const FrameLayers& none = without.layers();
@@ -298,6 +300,7 @@ TEST(Renderer, LayersAreFilledOnlyWhenAskedAndChangeNothingElse) {
         EXPECT_EQ(with.layers().distance.size(), 0u);
         EXPECT_EQ(with.layers().cel.size(), 0u);
         EXPECT_EQ(with.layers().lines.size(), 0u);
+        EXPECT_EQ(with.layers().tone.size(), 0u);
         EXPECT_TRUE(with.layers().line_types.empty());
     }
 }
@@ -389,9 +392,9 @@ TEST(Renderer, InkLinesAreTheCoverageOverTheCelColours) {
     // the teapot (a mesh without normals, open at the spout's and lid's rims) has silhouettes,
     // creases and borders.
     const std::vector<LineLayer>& types = r.layers().line_types;
-    ASSERT_EQ(types.size(), 6u);
-    const char* names[] = {"silhouette", "border",       "crease",
-                           "material",   "intersection", "polyline"};
+    ASSERT_EQ(types.size(), 8u);
+    const char* names[] = {"silhouette",   "border",   "crease", "material",
+                           "intersection", "polyline", "band",   "shadow"};
     for (std::size_t t = 0; t < types.size(); ++t) EXPECT_EQ(types[t].name, names[t]);
     std::vector<long> type_pixels(types.size(), 0);
     for (std::size_t i = 0; i < gray.size(); ++i) {

@@ -502,14 +502,19 @@ TEST(RobustLines, ParsesLineTypes) {
     EXPECT_EQ(parse_line_types("silhouette,crease"),
               static_cast<unsigned>(kLineSilhouette | kLineCrease));
     EXPECT_THROW((void)parse_line_types("silhouette,outline"), Error);
-    for (unsigned types : {0u, 1u, 5u, 30u, unsigned(kLineAll)})
+    for (unsigned types : {0u, 1u, 5u, 30u, unsigned(kLineAll), unsigned(kLineAll | kLineBand),
+                           unsigned(kLineSilhouette | kLineShadow), unsigned(kLineBand)})
         EXPECT_EQ(parse_line_types(format_line_types(types)), types) << format_line_types(types);
+    // Band and shadow lines are not among "all" (the default): they are added by name.
+    EXPECT_EQ(parse_line_types("all,band,shadow"),
+              static_cast<unsigned>(kLineAll | kLineBand | kLineShadow));
+    EXPECT_EQ(format_line_types(kLineAll | kLineShadow), "all,shadow");
     try {
         (void)parse_line_types("silhouette,outline");
     } catch (const Error& e) {
         EXPECT_EQ(std::string(e.what()),
                   "unknown line type 'outline' (choose from silhouette, crease, depth, "
-                  "object, material, all, none)");
+                  "object, material, band, shadow, all, none)");
     }
 }
 

@@ -28,6 +28,7 @@ int toonray_fuzz_gltf(const std::uint8_t*, std::size_t);
 int toonray_fuzz_glb(const std::uint8_t*, std::size_t);
 int toonray_fuzz_line_style(const std::uint8_t*, std::size_t);
 int toonray_fuzz_settings(const std::uint8_t*, std::size_t);
+int toonray_fuzz_tone(const std::uint8_t*, std::size_t);
 int toonray_fuzz_init_png(int*, char***);
 }
 
@@ -84,5 +85,6 @@ INSTANTIATE_TEST_SUITE_P(
         Target{"png", toonray_fuzz_png, toonray_fuzz_init_png},
         Target{"render", toonray_fuzz_render}, Target{"shading", toonray_fuzz_shading},
         Target{"gltf", toonray_fuzz_gltf}, Target{"glb", toonray_fuzz_glb},
-        Target{"line_style", toonray_fuzz_line_style}, Target{"settings", toonray_fuzz_settings}),
+        Target{"line_style", toonray_fuzz_line_style}, Target{"settings", toonray_fuzz_settings},
+        Target{"tone", toonray_fuzz_tone}),
     [](const auto& info) { return std::string(info.param.name); });

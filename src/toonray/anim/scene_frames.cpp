@@ -32,6 +32,7 @@ public:
         if (scenes.reads_files()) slot_ = 1 - slot_;
         warnings.insert(warnings.end(), current.warnings.begin(), current.warnings.end());
         if (current.error) std::rethrow_exception(current.error);
+        render_.settings.frame = frame;  // sketchy strokes boil with it
         renderer_.render(scene, frames_.output(frame), render_, warnings);
     }
 

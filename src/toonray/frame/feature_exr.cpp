@@ -97,6 +97,11 @@ void gather_feature_layers(const FrameLayers& layers, FeatureLayers& out) {
         channel("lines." + std::string(type.name), true,
                 [&](std::size_t i) { return coverage[i]; });
     }
+    // The tone look's coverage, where the mode draws one (ink).
+    if (layers.mode == LineMode::Ink) {
+        const float* tone = check(layers.tone, "tone");
+        channel("tone.coverage", true, [&](std::size_t i) { return tone[i]; });
+    }
 }
 
 void write_feature_exr(const std::filesystem::path& path, const FeatureLayers& layers,

@@ -86,6 +86,8 @@ constexpr FeatureImage kImages[] = {
      [](const FrameLayers& l, int, FeatureBytes& out) { line_type(l, "normal", out); }},
     {"edges", true, true, true,
      [](const FrameLayers& l, int, FeatureBytes& out) { gray(sized(l.lines, l, "lines"), out); }},
+    {"tone", false, false, true,
+     [](const FrameLayers& l, int, FeatureBytes& out) { gray(sized(l.tone, l, "tone"), out); }},
     {"cel", true, true, true,
      [](const FrameLayers& l, int, FeatureBytes& out) {
          out.channels = 3;
@@ -107,6 +109,10 @@ constexpr FeatureImage kImages[] = {
      [](const FrameLayers& l, int, FeatureBytes& out) { line_type(l, "intersection", out); }},
     {"lines_polyline", false, false, true,
      [](const FrameLayers& l, int, FeatureBytes& out) { line_type(l, "polyline", out); }},
+    {"lines_band", false, false, true,
+     [](const FrameLayers& l, int, FeatureBytes& out) { line_type(l, "band", out); }},
+    {"lines_shadow", false, false, true,
+     [](const FrameLayers& l, int, FeatureBytes& out) { line_type(l, "shadow", out); }},
     {"object_id", false, true, true,
      [](const FrameLayers& l, int, FeatureBytes& out) { ids(l.object, l, "object", out); }},
     {"material_id", false, true, true,

@@ -65,9 +65,10 @@ std::string frame_svg(const FrameLayers& layers, const FrameOptions& options) {
     svg.colour = settings.lines.colour;
     svg.hidden = options.svg_hidden;
     svg.pens = lines.pens;
+    svg.plotter = options.svg_plotter;
     svg.software = options.record.software;
     svg.metadata = options.record.settings;
-    if (options.svg_fill) {
+    if (options.svg_fill && !options.svg_plotter) {
         const ImageRgb8& cel = layers.cel;
         svg.fill_href = ink::png_data_uri(
             encode_png(cel.width(), cel.height(), 3,
@@ -75,6 +76,29 @@ std::string frame_svg(const FrameLayers& layers, const FrameOptions& options) {
     }
     return ink::svg_text(lines.strokes, svg);
 }
+
+namespace {
+
+// Reads the brushes the rules name that are not read yet into `brushes`; whether any rule
+// names one.
+bool read_brushes(const ink::LineStyleSet& styles, ink::BrushSet& brushes) {
+    bool any = false;
+    for (const ink::LineStyleRule& rule : styles.rules) {
+        if (!rule.sets_field(&ink::LineStyle::brush) || rule.values.brush.empty()) continue;
+        any = true;
+        if (brushes.contains(rule.values.brush)) continue;
+        try {
+            const DecodedPng png = read_png(rule.values.brush);
+            brushes.emplace(rule.values.brush,
+                            std::make_shared<const ink::Brush>(ink::make_brush(png.rgb)));
+        } catch (const Error& e) {
+            throw Error(fmt::format("line style brush '{}': {}", rule.values.brush, e.what()));
+        }
+    }
+    return any;
+}
+
+}  // namespace
 
 std::filesystem::path aov_path(const std::filesystem::path& dir,
                                const std::filesystem::path& output, std::string_view name) {
@@ -130,7 +154,9 @@ const FrameLayers& FrameRenderer::render_layers(const Scene& scene, const Camera
     const TriangleAccel& accel = accel_.update(scene, options.bvh);
     const TextureSet* textures =
         settings.shading.textures ? &textures_.load(scene, warnings) : nullptr;
-    renderer_.render(scene, accel, camera, lights, settings, textures, progress);
+    RenderSettings with_brushes = settings;
+    if (read_brushes(settings.lines.ink.styles, brushes_)) with_brushes.brushes = &brushes_;
+    renderer_.render(scene, accel, camera, lights, with_brushes, textures, progress);
     return renderer_.layers();
 }
 

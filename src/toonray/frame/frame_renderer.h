@@ -46,6 +46,8 @@ struct FrameOptions {
     /// (frame_svg), with hidden lines when svg_hidden.
     bool keep_layers = false;
     bool keep_strokes = false;
+    /// The SVG is for a pen plotter (ink/plotter.h): layers per pen, merged and ordered paths.
+    bool svg_plotter = false;
     Bvh::Config bvh;
     PngOptions png;
     /// Recorded in every PNG (tEXt chunks "Software" and "toonray settings"), in the EXR's
@@ -115,6 +117,7 @@ public:
 private:
     AnimationAccel accel_;
     TextureCache textures_;
+    ink::BrushSet brushes_;  ///< the line styles' brushes, read once
     Renderer renderer_;
     FeatureLayers exr_layers_;
 };

@@ -212,8 +212,10 @@ constexpr Setting kSettings[] = {
          s.render.lines.mode = parse_line_mode(as_text(v), "mode");
      }},
     {"lines.types", "--lines", SettingForm::Option,
-     "Line types to draw, from silhouette,crease,depth,object,material (or all, none); the ink "
-     "mode has no depth lines",
+     "Line types to draw, from silhouette,crease,depth,object,material (all: those five, the "
+     "default), band (boundaries between cel bands, the terminator included) and shadow "
+     "(boundaries of toon shadows, with --shadows), or none; the ink mode has no depth lines, "
+     "only the ink mode has band and shadow lines",
      true,
      [](const Settings& s) -> std::optional<SettingValue> {
          return format_line_types(s.render.lines.types);
@@ -290,6 +292,58 @@ constexpr Setting kSettings[] = {
          return s.render.lines.ink.width_by_depth;
      },
      [](Settings& s, const SettingValue& v) { s.render.lines.ink.width_by_depth = as_bool(v); }},
+    // [tone]
+    {"tone.mode", "--tone", SettingForm::Option,
+     "Tone look: cel (the ramp's levels scale the colour; the default), hatch (hatch strokes "
+     "over every band's full colour, as dark as the band) or screentone (dots likewise); hatch "
+     "and screentone are drawn as ink (the ink line mode)",
+     true,
+     [](const Settings& s) -> std::optional<SettingValue> {
+         return std::string(ink::tone_mode_name(s.render.tone.mode));
+     },
+     [](Settings& s, const SettingValue& v) {
+         s.render.tone.mode = ink::parse_tone_mode(as_text(v));
+     },
+     false},
+    {"tone.anchor", "--tone-anchor", SettingForm::Option,
+     "What tone strokes and dots are fixed to: object (they move with the surfaces; hatching's "
+     "default) or screen (locked to the image; screentone's default)",
+     true,
+     [](const Settings& s) -> std::optional<SettingValue> {
+         if (!s.render.tone.anchor) return std::nullopt;
+         return std::string(ink::tone_anchor_name(*s.render.tone.anchor));
+     },
+     [](Settings& s, const SettingValue& v) {
+         s.render.tone.anchor = ink::parse_tone_anchor(as_text(v));
+     },
+     false},
+    {"tone.hatch_direction", "--hatch-direction", SettingForm::Option,
+     "Object-anchored hatch strokes cross: curvature (per object, the direction its normals vary "
+     "least along, so strokes run around the form; the default), light (the light's direction: "
+     "strokes follow the band boundaries), an axis x, y, z or X,Y,Z, or screen (strokes at "
+     "--tone-angle on the image)",
+     true,
+     [](const Settings& s) -> std::optional<SettingValue> {
+         return ink::format_hatch_direction(s.render.tone.direction);
+     },
+     [](Settings& s, const SettingValue& v) {
+         s.render.tone.direction = ink::parse_hatch_direction(as_text(v));
+     },
+     false},
+    {"tone.spacing", "--tone-spacing", SettingForm::Option,
+     "Tone spacing in pixels at 720 lines (scales with the image height): hatch strokes of one "
+     "direction at their closest, the side of a screentone cell",
+     true,
+     [](const Settings& s) -> std::optional<SettingValue> { return number(s.render.tone.spacing); },
+     [](Settings& s, const SettingValue& v) { s.render.tone.spacing = as_float(v, 0.5, 1000); },
+     false},
+    {"tone.angle", "--tone-angle", SettingForm::Option,
+     "Degrees counter-clockwise on the image of screen-locked hatch strokes and of screentone "
+     "rows",
+     true,
+     [](const Settings& s) -> std::optional<SettingValue> { return number(s.render.tone.angle); },
+     [](Settings& s, const SettingValue& v) { s.render.tone.angle = as_float(v, -360, 360); },
+     false},
     // [sampling]
     {"sampling.samples", "--samples", SettingForm::Option,
      "Robust and ink: samples per pixel on a regular grid (1, 4, 9 or 16); lines and colours are "
@@ -347,6 +401,12 @@ constexpr Setting kSettings[] = {
      "With --svg: the cel-shaded colours as an embedded PNG under the lines", true,
      [](const Settings& s) -> std::optional<SettingValue> { return s.svg_fill; },
      [](Settings& s, const SettingValue& v) { s.svg_fill = as_bool(v); }},
+    {"output.svg_plotter", "--svg-plotter", SettingForm::Flag,
+     "With --svg: for a pen plotter: one Inkscape layer per pen (colour and width), touching "
+     "paths merged, paths ordered to cut pen-up travel, centrelines only; hidden lines only with "
+     "--hidden-lines; no fill",
+     true, [](const Settings& s) -> std::optional<SettingValue> { return s.svg_plotter; },
+     [](Settings& s, const SettingValue& v) { s.svg_plotter = as_bool(v); }, false},
     // [limits]: the help given on the command line is limit_help's, with the defaults.
     {"limits.triangles", "--max-triangles", SettingForm::Option, "Largest scene, in triangles",
      false, get_limit<&LimitSettings::triangles>,
@@ -403,6 +463,7 @@ FrameOptions Settings::frame_options() const {
     o.png = png;
     o.svg_hidden = svg_hidden;
     o.svg_fill = svg_fill;
+    o.svg_plotter = svg_plotter;
     o.record = output_record(*this);
     return o;
 }
@@ -432,6 +493,17 @@ void check_settings(const Settings& settings) {
     } catch (const Error& e) {
         throw Error(fmt::format("lines.types: {}", e.what()));
     }
+    if ((settings.render.lines.types & kLineShadow) && !settings.render.shading.shadows)
+        throw Error(
+            "lines.types: shadow lines are the boundaries of toon shadows, which are off: add "
+            "--shadows (shading.shadows = true)");
+    if (settings.render.tone.mode != ink::ToneMode::Cel &&
+        settings.render.lines.mode != LineMode::Ink)
+        throw Error(fmt::format(
+            "tone.mode: {} is drawn as ink, under the ink lines; the {} lines are drawn into "
+            "pixels with the colours: use --edges ink (the default)",
+            ink::tone_mode_name(settings.render.tone.mode),
+            line_mode_name(settings.render.lines.mode)));
 }
 
 OutputRecord output_record(const Settings& settings) {

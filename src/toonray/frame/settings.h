@@ -38,8 +38,9 @@ struct Settings {
     SceneSetup scene;       ///< its width and height follow render's (scene_setup())
     Bvh::Config bvh;
     PngOptions png;
-    bool svg_hidden = false;  ///< an SVG also holds the hidden lines
-    bool svg_fill = false;    ///< an SVG also holds the cel picture under its lines
+    bool svg_hidden = false;   ///< an SVG also holds the hidden lines
+    bool svg_fill = false;     ///< an SVG also holds the cel picture under its lines
+    bool svg_plotter = false;  ///< an SVG is for a pen plotter (ink/plotter.h)
     LimitSettings limits;
 
     /// The scene setup for frames of render's size.
@@ -77,6 +78,10 @@ struct Setting {
     std::optional<SettingValue> (*get)(const Settings&);
     /// Sets it; throws Error("what was wrong") without naming the key or flag.
     void (*set)(Settings&, const SettingValue&);
+    /// Whether an output records it at its default value. Keys that came after outputs first
+    /// recorded their settings are recorded only when set otherwise, so that a frame made
+    /// without them records, and is, the same bytes as before.
+    bool recorded_at_default = true;
 };
 
 /// Every key of the document, in the order they are written.

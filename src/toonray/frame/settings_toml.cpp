@@ -174,8 +174,10 @@ void load_settings(const std::filesystem::path& path, Settings& settings) {
 std::string settings_toml(const Settings& settings, bool picture_only) {
     std::string out = fmt::format("# toonray {} settings (docs/settings.md)\n", toonray_version());
     std::string section;
+    static const Settings defaults;
     for (const Setting& s : settings_table()) {
         if (picture_only && !s.picture) continue;
+        if (picture_only && !s.recorded_at_default && s.get(settings) == s.get(defaults)) continue;
         const std::size_t dot = s.key.rfind('.');
         const std::string_view table = s.key.substr(0, dot), key = s.key.substr(dot + 1);
         if (table != section) {

@@ -5,10 +5,13 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <utility>
 
 #include "toonray/core/error.h"
 #include "toonray/core/parallel.h"
+#include "toonray/core/portable_math.h"
+#include "toonray/ink/tone.h"
 
 namespace toonray::ink {
 
@@ -23,9 +26,11 @@ struct Segment2 {
     float max_reach;     // the largest reach anywhere on the segment (width by depth)
     std::uint16_t style;
     float arc0 = 0;                  // arc length of the stroke at a (dashes, taper)
-    const StrokePen* pen = nullptr;  // set for dashed, tapered or depth-scaled strokes only
-    float stroke_length = 0;
-    float d0 = 0, d1 = 0;  // depths at a and b (width by depth)
+    const StrokePen* pen = nullptr;  // set for strokes whose coverage is shaped only
+    float stroke_length = 0;         // -1 for a closed stroke: no ends to taper
+    float total = 0;                 // the stroke's length (pressure, brushes)
+    float nib = 1;                   // the broad nib's factor on this segment
+    float d0 = 0, d1 = 0;            // depths at a and b (width by depth)
 };
 
 constexpr float kMinDepthScale = 0.25f, kMaxDepthScale = 2.0f;
@@ -36,6 +41,10 @@ void add_stroke_segments(const Stroke& s, float thickness, std::uint16_t style,
     const float reach = thickness * 0.5f + 0.5f;
     const float total = pen ? polyline_length(s.points) : 0.0f;
     const bool by_depth = pen && scales_by_depth(*pen, s);
+    // The largest pressure reaches farthest.
+    float most = 1.0f;
+    if (pen)
+        for (float f : pen->pressure) most = std::max(most, f);
     float arc = 0.0f;
     for (std::size_t i = 0; i + 1 < s.points.size(); ++i) {
         const Point2 a = s.points[i], b = s.points[i + 1];
@@ -43,28 +52,32 @@ void add_stroke_segments(const Stroke& s, float thickness, std::uint16_t style,
         const float d0 = by_depth ? s.depth[i] : 0.0f, d1 = by_depth ? s.depth[i + 1] : 0.0f;
         // The widest the segment gets (the scale is monotonic in depth, so at an end).
         const float box_reach =
-            by_depth
-                ? thickness * 0.5f * std::max(depth_scale(*pen, d0), depth_scale(*pen, d1)) + 0.5f
-                : reach;
+            (by_depth ? thickness * 0.5f * std::max(depth_scale(*pen, d0), depth_scale(*pen, d1))
+                      : thickness * 0.5f) *
+                most +
+            0.5f;
         if (pen) arc += polyline_length(std::span<const Point2>(&s.points[i], 2));
         // Pixel x has its centre at x + 0.5; it can be covered if within reach of the box.
         const float lx = std::min(a.x, b.x) - box_reach, hx = std::max(a.x, b.x) + box_reach;
         const float ly = std::min(a.y, b.y) - box_reach, hy = std::max(a.y, b.y) + box_reach;
         if (!(hx >= 0.5f && lx <= w - 0.5f && hy >= 0.5f && ly <= h - 0.5f)) continue;  // also NaN
-        Segment2 seg{a,
-                     b,
-                     std::max(0, static_cast<int>(std::ceil(lx - 0.5f))),
-                     std::min(w - 1, static_cast<int>(std::floor(hx - 0.5f))),
-                     std::max(0, static_cast<int>(std::ceil(ly - 0.5f))),
-                     std::min(h - 1, static_cast<int>(std::floor(hy - 0.5f))),
-                     reach,
-                     box_reach,
-                     style,
-                     arc0,
-                     by_depth || (pen && (!pen->dash.empty() || pen->taper > 0.0f)) ? pen : nullptr,
-                     s.closed ? -1.0f : total,  // closed strokes have no ends to taper
-                     d0,
-                     d1};
+        Segment2 seg{
+            a,
+            b,
+            std::max(0, static_cast<int>(std::ceil(lx - 0.5f))),
+            std::min(w - 1, static_cast<int>(std::floor(hx - 0.5f))),
+            std::max(0, static_cast<int>(std::ceil(ly - 0.5f))),
+            std::min(h - 1, static_cast<int>(std::floor(hy - 0.5f))),
+            reach,
+            box_reach,
+            style,
+            arc0,
+            pen && (by_depth || !pen->dash.empty() || varies_width(*pen, s)) ? pen : nullptr,
+            s.closed ? -1.0f : total,  // closed strokes have no ends to taper
+            total,
+            pen ? nib_scale(*pen, b.x - a.x, b.y - a.y) : 1.0f,
+            d0,
+            d1};
         if (seg.x0 <= seg.x1 && seg.y0 <= seg.y1) out.push_back(seg);
     }
 }
@@ -148,7 +161,7 @@ void rasterise(const std::vector<Segment2>& segments, ImageF& coverage, Image<st
                 const float dx = s.b.x - s.a.x, dy = s.b.y - s.a.y;
                 const float len2 = dx * dx + dy * dy;
                 const float inv_len2 = len2 > 0.0f ? 1.0f / len2 : 0.0f;
-                const float len = s.pen ? std::sqrt(len2) : 0.0f;
+                const float len = s.pen ? std::sqrt(len2) : 0.0f;  // arc length along it
                 for (int y = std::max(s.y0, row0); y <= std::min(s.y1, row1); ++y) {
                     float* row = coverage.row(y);
                     std::uint16_t* style_row = style ? style->row(y) : nullptr;
@@ -159,16 +172,30 @@ void rasterise(const std::vector<Segment2>& segments, ImageF& coverage, Image<st
                         // Distance to the segment: to its nearest point, ends included (round caps).
                         const float t = std::clamp((px * dx + py * dy) * inv_len2, 0.0f, 1.0f);
                         const float ex = px - dx * t, ey = py - dy * t;
-                        float reach = s.reach;
+                        float c;
                         if (s.pen) {
                             const float arc = s.arc0 + t * len;
                             if (!s.pen->dash.empty() && !in_dash(s.pen->dash, arc)) continue;
-                            float f = taper_scale(*s.pen, arc, s.stroke_length);
+                            float f = taper_scale(*s.pen, arc, s.stroke_length) *
+                                      pressure_scale(*s.pen, arc, s.total) * s.nib;
                             // d0 is set (positive) only where the pen scales by depth.
                             if (s.d0 > 0.0f) f *= depth_scale(*s.pen, s.d0 + (s.d1 - s.d0) * t);
-                            reach = (s.reach - 0.5f) * f + 0.5f;
+                            const float reach = (s.reach - 0.5f) * f + 0.5f;
+                            c = std::min(1.0f, reach - std::sqrt(ex * ex + ey * ey));
+                            if (const Brush* brush = s.pen->brush_image) {
+                                // Across: the signed distance to the left of the segment (as
+                                // seen walking along it on the image, y down) over the width
+                                // there: the brush's first row on the left edge.
+                                const float half = reach - 0.5f;
+                                const float left = len > 0.0f ? (px * dy - py * dx) / len : 0.0f;
+                                const float across =
+                                    half > 0.0f ? std::clamp(0.5f - 0.5f * left / half, 0.0f, 1.0f)
+                                                : 0.5f;
+                                c *= brush_ink(*brush, brush_along(*s.pen, arc, s.total), across);
+                            }
+                        } else {
+                            c = std::min(1.0f, s.reach - std::sqrt(ex * ex + ey * ey));
                         }
-                        const float c = std::min(1.0f, reach - std::sqrt(ex * ex + ey * ey));
                         if (c > row[x]) {
                             row[x] = c;
                             if (style_row) style_row[x] = s.style;
@@ -201,10 +228,92 @@ float stroke_thickness(float width, int height) {
     return width * static_cast<float>(height) / 720.0f;
 }
 
-StrokePen stroke_pen(const LineStyle& style, int height, float depth_reference) {
+StrokePen stroke_pen(const LineStyle& style, int height, float depth_reference,
+                     const BrushSet* brushes) {
     StrokePen pen{scale_line_style(style, height)};
     pen.depth_reference = style.by_depth ? depth_reference : 0.0f;
+    const float a = style.nib_angle * std::numbers::pi_v<float> / 180.0f;
+    pen.nib = {portable::cos(a), -portable::sin(a)};
+    if (!style.brush.empty()) {
+        const auto it = brushes ? brushes->find(style.brush) : BrushSet::const_iterator{};
+        if (!brushes || it == brushes->end())
+            throw Error(
+                fmt::format("ink: the brush '{}' of a line style was not read", style.brush));
+        pen.brush_image = it->second.get();
+    }
     return pen;
+}
+
+Brush make_brush(const ImageRgb8& image) {
+    Brush brush;
+    brush.ink.reshape(image.width(), image.height());
+    brush.profile.assign(static_cast<std::size_t>(image.width()), 0.0f);
+    for (int y = 0; y < image.height(); ++y)
+        for (int x = 0; x < image.width(); ++x) {
+            const Rgb8& p = image(x, y);
+            // Rec. 709 luma of the bytes as they are.
+            const float luma = (0.2126f * p[0] + 0.7152f * p[1] + 0.0722f * p[2]) / 255.0f;
+            brush.ink(x, y) = std::clamp(1.0f - luma, 0.0f, 1.0f);
+            brush.profile[static_cast<std::size_t>(x)] += brush.ink(x, y);
+        }
+    for (float& f : brush.profile) f /= static_cast<float>(std::max(image.height(), 1));
+    return brush;
+}
+
+float pressure_scale(const StrokePen& pen, float arc, float length) {
+    const std::vector<float>& p = pen.pressure;
+    if (p.empty()) return 1.0f;
+    if (p.size() == 1 || !(length > 0.0f)) return p.front();
+    const float at = std::clamp(arc / length, 0.0f, 1.0f) * static_cast<float>(p.size() - 1);
+    const auto i = std::min(static_cast<std::size_t>(at), p.size() - 2);
+    const float f = at - static_cast<float>(i);
+    return p[i] + (p[i + 1] - p[i]) * f;
+}
+
+float nib_scale(const StrokePen& pen, float dx, float dy) {
+    if (!(pen.calligraphy < 1.0f)) return 1.0f;
+    const float len = std::sqrt(dx * dx + dy * dy);
+    if (!(len > 0.0f)) return 1.0f;
+    const float sine = std::abs(dx * pen.nib.y - dy * pen.nib.x) / len;
+    return pen.calligraphy + (1.0f - pen.calligraphy) * sine;
+}
+
+float brush_along(const StrokePen& pen, float arc, float length) {
+    const Brush* brush = pen.brush_image;
+    if (!brush || brush->ink.width() == 0) return 0.0f;
+    if (pen.brush_stretch) return length > 0.0f ? std::clamp(arc / length, 0.0f, 1.0f) : 0.5f;
+    const float stamp = pen.width * static_cast<float>(brush->ink.width()) /
+                        static_cast<float>(std::max(brush->ink.height(), 1));
+    if (!(stamp > 0.0f)) return 0.0f;
+    const float u = arc / stamp;
+    return u - std::floor(u);
+}
+
+float brush_ink(const Brush& brush, float along, float across) {
+    const int w = brush.ink.width(), h = brush.ink.height();
+    if (w == 0 || h == 0) return 1.0f;
+    const float x = along * static_cast<float>(w) - 0.5f, y = across * static_cast<float>(h) - 0.5f;
+    const float fx = std::floor(x), fy = std::floor(y);
+    const int x0 = static_cast<int>(fx), y0 = static_cast<int>(fy);
+    const float tx = x - fx, ty = y - fy;
+    auto at = [&](int xi, int yi) {
+        xi = ((xi % w) + w) % w;  // repeats along
+        yi = std::clamp(yi, 0, h - 1);
+        return brush.ink(xi, yi);
+    };
+    return (at(x0, y0) * (1.0f - tx) + at(x0 + 1, y0) * tx) * (1.0f - ty) +
+           (at(x0, y0 + 1) * (1.0f - tx) + at(x0 + 1, y0 + 1) * tx) * ty;
+}
+
+float brush_width(const Brush& brush, float along) {
+    const auto n = static_cast<int>(brush.profile.size());
+    if (n == 0) return 1.0f;
+    const float x = along * static_cast<float>(n) - 0.5f;
+    const float fx = std::floor(x);
+    const int x0 = static_cast<int>(fx);
+    const float t = x - fx;
+    auto at = [&](int i) { return brush.profile[static_cast<std::size_t>(((i % n) + n) % n)]; };
+    return at(x0) * (1.0f - t) + at(x0 + 1) * t;
 }
 
 const StrokePen& pen_of_stroke(std::span<const StrokePen> pens, const Stroke& stroke,
@@ -221,7 +330,8 @@ bool scales_by_depth(const StrokePen& pen, const Stroke& stroke) {
 }
 
 bool varies_width(const StrokePen& pen, const Stroke& stroke) {
-    return (pen.taper > 0.0f && !stroke.closed) || scales_by_depth(pen, stroke);
+    return (pen.taper > 0.0f && !stroke.closed) || scales_by_depth(pen, stroke) ||
+           !pen.pressure.empty() || pen.calligraphy < 1.0f || pen.brush_image != nullptr;
 }
 
 float taper_scale(const StrokePen& pen, float arc, float length) {
@@ -255,7 +365,14 @@ void draw_styled_strokes(std::span<const Stroke> strokes, std::span<const Stroke
         const StrokePen& pen = pen_of_stroke(pens, s, i);
         if (!pen.draw || !(pen.width > 0.0f) || !(pen.opacity > 0.0f)) continue;
         const bool shaped = !pen.dash.empty() || varies_width(pen, s);
-        add_stroke_segments(s, pen.width, s.style, shaped ? &pen : nullptr, width, height,
+        float thickness = pen.width * s.scale;
+        // A screentone dot covers its area exactly: a disc's coverage sums to a little more
+        // than its area (tone.h, drawn_disc_radius).
+        if (s.type == EdgeType::Tone && s.points.size() == 2 && s.points[0] == s.points[1]) {
+            const float r = thickness * 0.5f;
+            thickness = 2.0f * drawn_disc_radius(std::numbers::pi_v<float> * r * r);
+        }
+        add_stroke_segments(s, thickness, s.style, shaped ? &pen : nullptr, width, height,
                             segments);
     }
     rasterise(segments, coverage, &style, threads);

@@ -2,7 +2,11 @@
 /// Drawing strokes with exact anti-aliased coverage, and compositing them over a picture.
 
 #include <cstdint>
+#include <functional>
+#include <map>
+#include <memory>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "toonray/core/image.h"
@@ -24,6 +28,20 @@ namespace toonray::ink {
 /// Each segment is rasterised within its own bounding box.
 void draw_strokes(std::span<const Stroke> strokes, float thickness, ImageF& coverage, int threads);
 
+/// A decoded brush (LineStyle::brush): its ink per pixel in [0, 1] (1 - luma), rows across the
+/// stroke (the first row on the stroke's left, looking along it on the image) and columns along
+/// it; and per column the mean ink across, the width of the same ink that the SVG gets.
+struct Brush {
+    ImageF ink;
+    std::vector<float> profile;
+};
+
+/// A brush from an image: black ink, white paper.
+[[nodiscard]] Brush make_brush(const ImageRgb8& image);
+
+/// Brushes by the file names styles give (LineStyle::brush), as the frame layer reads them.
+using BrushSet = std::map<std::string, std::shared_ptr<const Brush>, std::less<>>;
+
 /// How the strokes of one resolved style are drawn: the style in pixels of this image (every
 /// attribute that scales, StyleAttribute::scales, times height / 720: `width` is the
 /// thickness, `dash` and `taper` are pixels along the stroke), plus what the drawing derives
@@ -33,12 +51,17 @@ struct StrokePen : LineStyle {
     /// at a point at distance d from the eye is scaled by clamp(depth_reference / d, 0.25, 2),
     /// d interpolated linearly along each segment on the image.
     float depth_reference = 0.0f;
+    /// The nib's direction on the image (calligraphy), a unit vector.
+    Point2 nib{1.0f, 0.0f};
+    /// The brush `brush` names, decoded; null without one.
+    const Brush* brush_image = nullptr;
 };
 
 /// The pen of `style` in an image `height` pixels tall (scale_line_style); `depth_reference`
-/// is kept when the style has width by depth, else 0.
-[[nodiscard]] StrokePen stroke_pen(const LineStyle& style, int height,
-                                   float depth_reference = 0.0f);
+/// is kept when the style has width by depth, else 0. A style's brush is looked up in
+/// `brushes`; throws Error naming it when it is not there.
+[[nodiscard]] StrokePen stroke_pen(const LineStyle& style, int height, float depth_reference = 0.0f,
+                                   const BrushSet* brushes = nullptr);
 
 /// pens[stroke.style]. The pens are made with the strokes' styles (ink.h, InkLines), so a style
 /// without a pen is a mistake upstream: throws Error naming the stroke (`index`), its style and
@@ -50,8 +73,27 @@ struct StrokePen : LineStyle {
 /// the stroke has a depth per point).
 [[nodiscard]] bool scales_by_depth(const StrokePen& pen, const Stroke& stroke);
 
-/// Whether the stroke's width varies along it: tapered (and open) or scaled by depth.
+/// Whether the stroke's width varies along it: tapered (and open), scaled by depth, with a
+/// pressure profile, a broad nib or a brush.
 [[nodiscard]] bool varies_width(const StrokePen& pen, const Stroke& stroke);
+
+/// The pressure profile's factor at arc length `arc` of a stroke `length` pixels long.
+[[nodiscard]] float pressure_scale(const StrokePen& pen, float arc, float length);
+
+/// The broad nib's factor on a segment along (dx, dy) on the image: calligraphy + (1 -
+/// calligraphy) |sin| of its angle to the nib; 1 for a round pen or a segment of no length.
+[[nodiscard]] float nib_scale(const StrokePen& pen, float dx, float dy);
+
+/// Where a brush is read along a stroke `length` pixels long at arc length `arc`, as a
+/// fraction of the image's width: the whole stroke once (stretched), or stamps of the pen's
+/// width times the image's aspect.
+[[nodiscard]] float brush_along(const StrokePen& pen, float arc, float length);
+
+/// The brush's ink at (along, across) in [0, 1]^2, bilinear, repeating along.
+[[nodiscard]] float brush_ink(const Brush& brush, float along, float across);
+
+/// The brush's width profile (Brush::profile) at `along`, linear between columns, repeating.
+[[nodiscard]] float brush_width(const Brush& brush, float along);
 
 /// The taper's factor on the thickness at arc length `arc` of a stroke `length` pixels long:
 /// min(1, distance to the nearer end / taper), at least 0; 1 without taper or for a closed

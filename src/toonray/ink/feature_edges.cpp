@@ -14,6 +14,7 @@
 #include "toonray/ink/chunks.h"
 #include "toonray/ink/hash.h"
 #include "toonray/ink/mesh_topology.h"
+#include "toonray/ink/light_lines.h"
 
 namespace toonray::ink {
 
@@ -25,6 +26,9 @@ const char* edge_type_name(EdgeType type) {
         case EdgeType::Material: return "material";
         case EdgeType::Intersection: return "intersection";
         case EdgeType::Polyline: return "polyline";
+        case EdgeType::Band: return "band";
+        case EdgeType::Shadow: return "shadow";
+        case EdgeType::Tone: return "tone";
     }
     return "?";
 }
@@ -413,6 +417,81 @@ std::vector<PairCrossing> find_crossings(const Bvh& bvh,
     return found;
 }
 
+namespace {
+
+// What band changes across mesh edges are found with.
+struct EdgeBands {
+    const Scene& scene;
+    const WeldedMesh& mesh;
+    const FeatureEdgeSettings& settings;
+    const Vec3f& eye;
+    const std::vector<std::uint8_t>& corner_normals;
+};
+
+// Whether the faces t0 and t1 of a welded edge (lo, hi) fall in different bands at its middle,
+// each with its normal there (its corner normals' mean, else its face normal n0 or n1, wound
+// alike), turned to face the eye. Out of line: the edge loop that calls it stays as small as it
+// was.
+[[gnu::noinline]] bool bands_differ(const EdgeBands& b, std::uint32_t lo, std::uint32_t hi,
+                                    std::uint32_t t0, std::uint32_t t1, const Vec3f& n0,
+                                    const Vec3f& n1) {
+    const Scene& scene = b.scene;
+    const WeldedMesh& mesh = b.mesh;
+    const FeatureEdgeSettings& settings = b.settings;
+    const Vec3f& eye = b.eye;
+    const std::array<std::uint32_t, 2> faces{t0, t1};
+    const std::array<Vec3f, 2> face{n0, n1};
+    const Vec3f mid =
+        (scene.positions[mesh.vertex_position[lo]] + scene.positions[mesh.vertex_position[hi]]) *
+        0.5f;
+    std::uint8_t band[2];
+    for (int f = 0; f < 2; ++f) {
+        const std::uint32_t t = faces[static_cast<std::size_t>(f)];
+        Vec3f n = face[static_cast<std::size_t>(f)];
+        if (b.corner_normals[t]) {
+            Vec3f sum(0.0f);
+            for (int k = 0; k < 3; ++k) {
+                const std::uint32_t w = mesh.tri_vertices[t][k];
+                if (w == lo || w == hi) sum += normalize(scene.normals[scene.tri_normals[t][k]]);
+            }
+            n = normalize(sum);
+        }
+        if (dot(face[static_cast<std::size_t>(f)], eye - mid) < 0.0f) n = -n;
+        band[f] = band_of(settings.band_thresholds, diffuse_light(settings.lights, mid, n));
+    }
+    return band[0] != band[1];
+}
+
+}  // namespace
+
+std::vector<std::uint8_t> closed_objects(const IntersectionCache& cache) {
+    std::vector<std::uint8_t> closed;
+    if (!cache.topology) return closed;
+    for (std::uint8_t open : cache.topology->open) closed.push_back(open ? 0 : 1);
+    return closed;
+}
+
+std::vector<std::int8_t> outward_objects(const Scene& scene, std::span<const std::uint8_t> closed,
+                                         const Vec3f& eye) {
+    std::vector<double> volume(closed.size(), 0.0);
+    std::vector<BBox> box(closed.size());
+    for (std::size_t t = 0; t < scene.triangle_count(); ++t) {
+        const std::uint32_t o = scene.tri_object[t];
+        if (o >= closed.size() || !closed[o]) continue;
+        const auto p = corners(scene, t);
+        volume[o] += static_cast<double>(dot(p[0], cross(p[1], p[2])));
+        for (const Vec3f& q : p) box[o].extend(q);
+    }
+    std::vector<std::int8_t> outward(closed.size(), 0);
+    for (std::size_t o = 0; o < outward.size(); ++o) {
+        const BBox& b = box[o];
+        const bool around_eye = eye.x >= b.lo.x && eye.y >= b.lo.y && eye.z >= b.lo.z &&
+                                eye.x <= b.hi.x && eye.y <= b.hi.y && eye.z <= b.hi.z;
+        if (closed[o] && volume[o] != 0.0 && !around_eye) outward[o] = volume[o] > 0.0 ? 1 : -1;
+    }
+    return outward;
+}
+
 std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedMesh& mesh,
                                                const Bvh& bvh, const Vec3f& eye,
                                                const FeatureEdgeSettings& settings, int threads,
@@ -495,6 +574,7 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
         return corner_normal(s0.tri, s0.lo) == corner_normal(s1.tri, s1.lo) &&
                corner_normal(s0.tri, s0.hi) == corner_normal(s1.tri, s1.hi);
     };
+    const EdgeBands edge_bands{scene, mesh, settings, eye, corner_normals};
     // One segment per edge that is a line: each is classified first, and made only if drawn.
     for (std::size_t e = 0; e < edge_count; ++e) {
         const std::uint32_t i = edge_first[e], j = edge_first[e + 1];
@@ -517,6 +597,9 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
             else if (settings.creases && dot(n0, n1) < cos_crease) type = EdgeType::Crease;
             else if (settings.materials && scene.tri_material[s0.tri] != scene.tri_material[s1.tri])
                 type = EdgeType::Material;
+            else if (settings.bands && !smooth_across(s0, s1) &&
+                     bands_differ(edge_bands, s0.lo, s0.hi, s0.tri, s1.tri, n0, n1))
+                type = EdgeType::Band;
             else continue;
             const int out = outward[scene.tri_object[s0.tri]];
             certainly_hidden =

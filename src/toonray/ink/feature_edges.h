@@ -5,10 +5,12 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <vector>
 
 #include "toonray/accel/bvh.h"
 #include "toonray/core/math.h"
+#include "toonray/scene/light.h"
 #include "toonray/scene/scene.h"
 
 namespace toonray::ink {
@@ -22,9 +24,13 @@ enum class EdgeType : std::uint8_t {
     Material,      ///< the two faces have different materials
     Intersection,  ///< where two triangles cross
     Polyline,      ///< a polyline of the scene (OBJ `l`), drawn as it is (ink/polylines.h)
+    Band,          ///< a boundary between cel bands on a surface, the terminator included
+    Shadow,        ///< the boundary of a cast shadow on the surface receiving it
+    Tone,          ///< a hatch stroke or screentone dot of a tone look (ink/tone.h)
 };
-inline constexpr int kEdgeTypeCount = 6;
-/// "silhouette", "border", "crease", "material", "intersection", "polyline".
+inline constexpr int kEdgeTypeCount = 9;
+/// "silhouette", "border", "crease", "material", "intersection", "polyline", "band", "shadow",
+/// "tone".
 const char* edge_type_name(EdgeType type);
 
 /// Identifies a segment's endpoint so that segments meeting there can be chained without
@@ -72,6 +78,12 @@ struct FeatureEdgeSettings {
     /// (FeatureSegment::certainly_hidden). Without them the visible lines are the same, and
     /// finding the intersection lines skips those triangles.
     bool certainly_hidden = true;
+    /// Band lines along mesh edges whose faces do not shade smoothly into each other and fall
+    /// in different bands at the edge's middle (each face's normal there, turned to the eye),
+    /// under these lights and thresholds (light_lines.h has those inside triangles).
+    bool bands = false;
+    std::span<const Light> lights;
+    std::span<const float> band_thresholds;
 };
 
 /// Vertices welded by exact position within each object: two triangle corners share a welded
@@ -130,6 +142,19 @@ struct IntersectionCache {
     /// which of them are usable (not degenerate) stay the same.
     std::shared_ptr<const MeshTopology> topology;
 };
+
+/// Per object, whether the mesh edges of the cache's last frame make it closed (every edge has
+/// two faces wound in opposite directions along it): a triangle of a closed object turned away
+/// from the eye is behind its front. Empty before find_feature_edges has filled the cache.
+[[nodiscard]] std::vector<std::uint8_t> closed_objects(const IntersectionCache& cache);
+
+/// Per object, which way its outward normals point against its triangles' winding when it is a
+/// closed solid (`closed`, as closed_objects gives it) with a volume that does not hold the eye:
+/// 1 with it, -1 inside out (by the sign of its volume); else 0. A triangle of such an object
+/// turned away from the eye is hidden behind its front.
+[[nodiscard]] std::vector<std::int8_t> outward_objects(const Scene& scene,
+                                                       std::span<const std::uint8_t> closed,
+                                                       const Vec3f& eye);
 
 /// All feature segments of the scene seen from `eye`, in a fixed order (mesh edges by welded
 /// vertex pair, then smooth contours by triangle, then intersection lines by triangle pair),

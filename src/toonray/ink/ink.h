@@ -12,6 +12,7 @@
 #include "toonray/ink/instance_lines.h"
 #include "toonray/ink/line_style.h"
 #include "toonray/ink/strokes.h"
+#include "toonray/ink/tone.h"
 #include "toonray/ink/visibility.h"
 #include "toonray/scene/camera.h"
 #include "toonray/scene/scene.h"
@@ -32,13 +33,31 @@ struct InkSettings {
     /// are drawn with width and colour, hidden ones are not drawn.
     LineStyleSet styles;
     /// The line types drawn into the line layer (InkLines::coverage), as bits 1 << EdgeType;
-    /// the strokes of the others are kept (for SVG) but not drawn.
+    /// the strokes of the others are kept (for SVG) but not drawn. Tone strokes have a layer
+    /// of their own (InkLines::tone_coverage).
     unsigned drawn_types = (1u << kEdgeTypeCount) - 1;
+    /// The tone look (tone.h): with hatch or screentone, and `tone_shading` set, its strokes or
+    /// dots are made, styled as type `tone` (their base pen is `width` and `colour`, nothing
+    /// else), and drawn into the tone layer.
+    ToneSettings tone;
+    const ToneShading* tone_shading = nullptr;
+    /// The darkness each band of the ramp asks of the tone (1 - its level, within [0, 1]).
+    std::vector<float> band_darkness;
+    /// The frame's lights (the tone's light direction, band and shadow lines).
+    std::span<const Light> lights;
+    /// Band lines (light_lines.h, and along mesh edges: FeatureEdgeSettings::bands) at these
+    /// thresholds of the ramp; shadow lines, the boundaries of toon shadows.
+    bool bands = false, shadows = false;
+    std::vector<float> band_thresholds;
+    /// The brushes styles name (LineStyle::brush), read by the frame layer.
+    const BrushSet* brushes = nullptr;
+    /// The frame's number in its sequence: sketchy strokes' boil (sketch.h).
+    int frame = 0;
 };
 
 /// Seconds spent in each stage of the last draw_ink_lines.
 struct InkTimings {
-    double edges = 0, visibility = 0, chaining = 0, drawing = 0;
+    double edges = 0, tone = 0, visibility = 0, chaining = 0, drawing = 0;
 };
 
 /// Everything one frame's ink lines produce; kept between frames so buffers are reused.
@@ -53,7 +72,11 @@ struct InkLines {
     std::vector<LineStyle> styles;
     std::vector<StrokePen> pens;
     ImageF coverage;  ///< drawn strokes, 0 = no line, 1 = covered (the largest per pixel)
-    Image<std::uint16_t> style;       ///< per pixel, the style of the stroke that gave the coverage
+    Image<std::uint16_t> style;  ///< per pixel, the style of the stroke that gave the coverage
+    /// The tone strokes and dots drawn alike, to go under the lines; empty (0 x 0) without a
+    /// tone look.
+    ImageF tone_coverage;
+    Image<std::uint16_t> tone_style;
     IntersectionCache intersections;  ///< for the next frame's unmoved triangles
     InstanceLineCache instances;      ///< for the next frame's meshes and unmoved instances
     InkTimings timings;

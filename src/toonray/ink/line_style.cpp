@@ -79,16 +79,116 @@ constexpr std::array kAttributes{
                    SvgMapping::Outline,
                    "",
                    ""},
+    StyleAttribute{"pressure",
+                   {},
+                   StyleValueKind::Profile,
+                   &LineStyle::pressure,
+                   10.0f,
+                   "thickness along the stroke: factors on the width at evenly spaced points "
+                   "from its first point to its last (e.g. 0.2,1,0.4), or none",
+                   SvgMapping::Outline,
+                   "",
+                   "",
+                   2.0f},
+    StyleAttribute{"calligraphy",
+                   {},
+                   StyleValueKind::Fraction,
+                   &LineStyle::calligraphy,
+                   0.0f,
+                   "a broad nib: the width of strokes drawn along it, as a fraction of the width "
+                   "(across it the whole width); 1 = a round pen",
+                   SvgMapping::Outline,
+                   "",
+                   ""},
+    StyleAttribute{"nib_angle",
+                   {},
+                   StyleValueKind::Degrees,
+                   &LineStyle::nib_angle,
+                   360.0f,
+                   "the nib's angle, degrees counter-clockwise on the image",
+                   SvgMapping::Outline,
+                   "",
+                   ""},
+    StyleAttribute{"brush",
+                   {},
+                   StyleValueKind::Path,
+                   &LineStyle::brush,
+                   0.0f,
+                   "a PNG brush: its darkness is the ink across (rows) and along (columns) the "
+                   "stroke; the SVG gets the width profile of the same ink; or none",
+                   SvgMapping::Outline,
+                   "",
+                   ""},
+    StyleAttribute{"brush_stretch",
+                   {},
+                   StyleValueKind::YesNo,
+                   &LineStyle::brush_stretch,
+                   0.0f,
+                   "the brush stretched once along the whole stroke (no: stamped, repeating "
+                   "every width times the image's aspect)",
+                   SvgMapping::Outline,
+                   "",
+                   ""},
+    StyleAttribute{"sketch",
+                   {},
+                   StyleValueKind::Count,
+                   &LineStyle::sketch,
+                   16.0f,
+                   "sketchy strokes: this many overdrawn copies moved across the stroke by a "
+                   "noise anchored on the surface (0 or 1: the stroke itself)",
+                   SvgMapping::LeaveOut,
+                   "",
+                   ""},
+    StyleAttribute{"sketch_offset",
+                   {},
+                   StyleValueKind::Length,
+                   &LineStyle::sketch_offset,
+                   100.0f,
+                   "the largest offset of a sketchy copy",
+                   SvgMapping::LeaveOut,
+                   "",
+                   ""},
+    StyleAttribute{"sketch_period",
+                   {},
+                   StyleValueKind::Length,
+                   &LineStyle::sketch_period,
+                   1e4f,
+                   "the sketch noise's wavelength on the surface, as seen at the distance of the "
+                   "scene's centre",
+                   SvgMapping::LeaveOut,
+                   "",
+                   ""},
+    StyleAttribute{"sketch_seed",
+                   {},
+                   StyleValueKind::Count,
+                   &LineStyle::sketch_seed,
+                   16777216.0f,
+                   "the sketch noise's seed: other seeds, other copies",
+                   SvgMapping::LeaveOut,
+                   "",
+                   ""},
+    StyleAttribute{"boil",
+                   {},
+                   StyleValueKind::Count,
+                   &LineStyle::boil,
+                   1e6f,
+                   "the sketch noise changes every this many frames (0: never; a still camera "
+                   "and scene then give the same frames)",
+                   SvgMapping::LeaveOut,
+                   "",
+                   ""},
 };
 
 // Each row's field holds the type its kind reads (parse_style_value relies on it), and a rule's
 // mask has a bit for each.
 constexpr bool fields_match_kinds() {
     for (const StyleAttribute& a : kAttributes) {
-        const std::size_t want = a.kind == StyleValueKind::YesNo    ? 0
-                                 : a.kind == StyleValueKind::Colour ? 1
-                                 : a.kind == StyleValueKind::Dash   ? 3
-                                                                    : 2;
+        const std::size_t want =
+            a.kind == StyleValueKind::YesNo                                       ? 0
+            : a.kind == StyleValueKind::Colour                                    ? 1
+            : a.kind == StyleValueKind::Dash || a.kind == StyleValueKind::Profile ? 3
+            : a.kind == StyleValueKind::Path                                      ? 4
+                                                                                  : 2;
         if (a.field.index() != want) return false;
     }
     return true;
@@ -138,6 +238,21 @@ std::vector<float> parse_dash(std::string_view text, float max) {
     if (dash.size() % 2 != 0) dash.insert(dash.end(), dash.begin(), dash.end());  // as SVG does
     if (!(total > 0.0f)) throw Error("the lengths must not all be 0");
     return dash;
+}
+
+std::vector<float> parse_profile(std::string_view text, float max, std::size_t min_values) {
+    if (text == "none") return {};
+    std::vector<float> values;
+    for (std::string_view part : split(text, ',')) {
+        const float v = parse_number(part);
+        if (v < 0.0f || v > max)
+            throw Error(fmt::format("factors must be in [0, {}], got '{}'", max, part));
+        values.push_back(v);
+    }
+    if (values.size() < min_values || values.size() > kMaxDashes)
+        throw Error(fmt::format("{} to {} factors, or none; got {}", min_values, kMaxDashes,
+                                values.size()));
+    return values;
 }
 
 std::string format_dash(const std::vector<float>& dash) {
@@ -224,7 +339,8 @@ constexpr std::array<MatcherRow, 4> kMatchers{{
      [](std::string_view text, LineStyleRule& r) { r.materials = parse_globs(text); },
      [](const LineStyleRule& r) { return format_globs(r.materials); }},
     {{"type",
-      "silhouette, border, crease, material, intersection, polyline, comma-separated, or all"},
+      "silhouette, border, crease, material, intersection, polyline, band, shadow, tone, "
+      "comma-separated, or all"},
      [](std::string_view text, LineStyleRule& r) { r.types = parse_types(text); },
      [](const LineStyleRule& r) { return format_types(r.types); }},
     {{"lines", "visible, hidden or all (visible when not given)"},
@@ -365,6 +481,32 @@ void parse_style_value(const StyleAttribute& a, std::string_view text, LineStyle
         case StyleValueKind::Dash:
             style.*std::get<std::vector<float> LineStyle::*>(a.field) = parse_dash(text, a.max);
             return;
+        case StyleValueKind::Profile:
+            style.*std::get<std::vector<float> LineStyle::*>(a.field) =
+                parse_profile(text, a.max, static_cast<std::size_t>(a.min));
+            return;
+        case StyleValueKind::Degrees: {
+            const float v = parse_number(text);
+            if (v < -a.max || v > a.max)
+                throw Error(fmt::format("expected degrees in [-{0}, {0}], got '{1}'", a.max, text));
+            style.*std::get<float LineStyle::*>(a.field) = v;
+            return;
+        }
+        case StyleValueKind::Count: {
+            const float v = parse_number(text);
+            if (v < 0.0f || v > a.max || v != std::floor(v))
+                throw Error(
+                    fmt::format("expected a whole number in [0, {}], got '{}'", a.max, text));
+            style.*std::get<float LineStyle::*>(a.field) = v;
+            return;
+        }
+        case StyleValueKind::Path:
+            if (text.empty() || text.find_first_of(" \t\r\n") != std::string_view::npos ||
+                text.find('\0') != std::string_view::npos)
+                throw Error(
+                    fmt::format("expected a file name without blanks, or none; got '{}'", text));
+            style.*std::get<std::string LineStyle::*>(a.field) = text == "none" ? "" : text;
+            return;
     }
 }
 
@@ -376,10 +518,20 @@ std::string format_style_value(const StyleAttribute& a, const LineStyle& style) 
             return format_colour(style.*std::get<Vec3f LineStyle::*>(a.field));
         case StyleValueKind::Length:
         case StyleValueKind::Fraction:
+        case StyleValueKind::Degrees:
+        case StyleValueKind::Count:
             // The shortest text that reads back to the same float.
             return fmt::format("{}", style.*std::get<float LineStyle::*>(a.field));
         case StyleValueKind::Dash:
             return format_dash(style.*std::get<std::vector<float> LineStyle::*>(a.field));
+        case StyleValueKind::Profile: {
+            const auto& values = style.*std::get<std::vector<float> LineStyle::*>(a.field);
+            return values.empty() ? "none" : fmt::format("{}", fmt::join(values, ","));
+        }
+        case StyleValueKind::Path: {
+            const std::string& path = style.*std::get<std::string LineStyle::*>(a.field);
+            return path.empty() ? "none" : path;
+        }
     }
     return {};
 }

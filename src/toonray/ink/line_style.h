@@ -43,6 +43,26 @@ struct LineStyle {
     std::vector<float> dash;
     float taper = 0.0f;     ///< pixels at 720 lines over which open strokes thin to 0 at their ends
     bool by_depth = false;  ///< width scaled by depth (draw.h, StrokePen::depth_reference)
+    /// A pressure profile: factors on the width at evenly spaced points from the stroke's first
+    /// point to its last, linear between them; empty = 1 throughout.
+    std::vector<float> pressure;
+    /// A broad nib held at `nib_angle`: a stroke drawn along the nib is this fraction of the
+    /// width, across it the whole width, sin-weighted between; 1 = a round pen.
+    float calligraphy = 1.0f;
+    float nib_angle = 45.0f;  ///< degrees, counter-clockwise on the image
+    /// A brush: a PNG image whose darkness (1 - luma) is the ink across (its rows) and along
+    /// (its columns) the stroke; empty = none. Read by the frame layer (InkSettings::brushes).
+    std::string brush;
+    /// The brush stretched once along the whole stroke; else stamped, repeating every width
+    /// times the image's aspect.
+    bool brush_stretch = false;
+    /// Sketchy strokes: this many overdrawn copies, each moved across the stroke by up to
+    /// `sketch_offset` by a noise anchored on the surface (0 or 1: the stroke itself).
+    float sketch = 0.0f;
+    float sketch_offset = 2.0f;   ///< pixels at 720 lines
+    float sketch_period = 40.0f;  ///< pixels at 720 lines: the noise's wavelength
+    float sketch_seed = 0.0f;     ///< a whole number: another seed, other copies
+    float boil = 0.0f;  ///< a whole number: the noise changes every this many frames; 0 = never
     bool operator==(const LineStyle&) const = default;
 };
 
@@ -54,6 +74,10 @@ enum class StyleValueKind {
     Length,    ///< pixels at 720 lines in [0, max]; scales with the image height
     Fraction,  ///< a number in [0, 1]
     Dash,      ///< lengths in pixels at 720 lines in [0, max], on,off,...; `none`; scales
+    Profile,   ///< 2 to 16 factors in [0, max], comma-separated; `none`
+    Degrees,   ///< an angle in [-max, max]
+    Count,     ///< a whole number in [0, max]
+    Path,      ///< a file name (no blanks); `none`
 };
 
 /// How an attribute reaches the SVG (svg.h).
@@ -69,7 +93,7 @@ enum class SvgMapping {
 
 /// The LineStyle field of an attribute.
 using StyleField = std::variant<bool LineStyle::*, Vec3f LineStyle::*, float LineStyle::*,
-                                std::vector<float> LineStyle::*>;
+                                std::vector<float> LineStyle::*, std::string LineStyle::*>;
 
 /// One row of the table of style attributes: everything the parser, the resolver, the pen in
 /// pixels and the SVG need to know of it. Adding an attribute is adding a field to LineStyle,
@@ -84,6 +108,7 @@ struct StyleAttribute {
     SvgMapping svg = SvgMapping::PathAttribute;
     std::string_view svg_stroke;  ///< the attribute on a stroked path (PathAttribute)
     std::string_view svg_fill;    ///< the attribute on a filled outline, if any
+    float min = 0.0f;             ///< Profile: at least this many values
     /// Whether the value is in pixels at 720 lines and so scales with the image height.
     [[nodiscard]] bool scales() const {
         return kind == StyleValueKind::Length || kind == StyleValueKind::Dash;

@@ -44,6 +44,14 @@ public:
         return {dot(r, dual_x_), dot(r, dual_y_)};
     }
     [[nodiscard]] const Vec3f& eye() const { return eye_; }
+    /// The image plane's unit normal (away from the eye), the eye's distance to it, its upper
+    /// left corner and the dual basis of its steps: image x = dot(r, dual_x()) and y =
+    /// dot(r, dual_y()) for r = (point on the plane) - upper_left().
+    [[nodiscard]] const Vec3f& normal() const { return normal_; }
+    [[nodiscard]] float plane_distance() const { return plane_distance_; }
+    [[nodiscard]] const Vec3f& upper_left() const { return upper_left_; }
+    [[nodiscard]] const Vec3f& dual_x() const { return dual_x_; }
+    [[nodiscard]] const Vec3f& dual_y() const { return dual_y_; }
     [[nodiscard]] int width() const { return width_; }
     [[nodiscard]] int height() const { return height_; }
     /// Smallest depth a projected point may have: points closer to the eye than this are

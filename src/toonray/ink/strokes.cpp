@@ -270,10 +270,12 @@ std::vector<Stroke> chain_pieces(std::span<const EdgePiece> pieces, const ChainS
         const auto kept = static_cast<std::size_t>(std::count(keep.begin(), keep.end(), true));
         stroke.points.reserve(kept);
         if (settings.eye) stroke.depth.reserve(kept);
+        if (settings.world) stroke.world.reserve(kept);
         for (std::size_t i = 0; i < spaced.size(); ++i) {
             if (!keep[i]) continue;
             stroke.points.push_back(spaced[i]);
             if (settings.eye) stroke.depth.push_back(length(world[spaced_at[i]] - *settings.eye));
+            if (settings.world) stroke.world.push_back(world[spaced_at[i]]);
         }
         if (stroke.visible && settings.min_length > 0.0f &&
             polyline_length(stroke.points) < settings.min_length)

@@ -21,8 +21,14 @@ struct Stroke {
     /// Per point, its distance from the eye (world units) when ChainSettings::eye is set,
     /// else empty: for widths by depth.
     std::vector<float> depth;
+    /// Per point, where it lies in the world when ChainSettings::world is set, else empty:
+    /// for noise anchored on the surfaces (sketchy strokes).
+    std::vector<Vec3f> world;
+    /// The pen's width times this: a screentone dot (a tone stroke of one point) is as wide as
+    /// its darkness asks (ink/tone.h).
+    float scale = 1.0f;
     /// The segment of the piece the stroke was started from: its object and material
-    /// (style_source_triangle, ink.h), which the Python module reports per stroke.
+    /// (style_source, ink.h), which the Python module reports per stroke.
     std::uint32_t segment = 0;
 };
 
@@ -46,6 +52,8 @@ struct ChainSettings {
     bool hidden = false;  ///< also chain the hidden pieces (into strokes with visible = false)
     /// When set, strokes keep each point's distance from this eye (Stroke::depth).
     std::optional<Vec3f> eye;
+    /// Strokes keep each point's place in the world (Stroke::world).
+    bool world = false;
 };
 
 /// Chains pieces into strokes. The rule: pieces chain when they have the same type and the

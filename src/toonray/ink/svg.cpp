@@ -1,5 +1,7 @@
 #include "toonray/ink/svg.h"
 
+#include "toonray/ink/plotter.h"
+
 #include <fmt/format.h>
 
 #include <algorithm>
@@ -12,9 +14,7 @@
 
 namespace toonray::ink {
 
-namespace {
-
-std::string hex_colour(const Vec3f& c) {
+std::string svg_colour(const Vec3f& c) {
     auto byte = [](float v) {
         return static_cast<int>(std::min(std::max(v, 0.0f), 1.0f) * 255.0f + 0.5f);
     };
@@ -22,11 +22,13 @@ std::string hex_colour(const Vec3f& c) {
 }
 
 // "-0.000" and "0.000" are the same coordinate; print one.
-std::string coordinate(float v) {
+std::string svg_coordinate(float v) {
     std::string s = fmt::format("{:.3f}", v);
     if (s == "-0.000") s = "0.000";
     return s;
 }
+
+namespace {
 
 // An attribute's value as SVG writes it: colours #rrggbb, lengths and fractions with three
 // decimals, dash lists comma-separated or `none` (SVG's initial value).
@@ -36,15 +38,18 @@ std::string svg_value(const StyleAttribute& a, const LineStyle& style) {
             using Value = std::remove_cvref_t<decltype(style.*field)>;
             const Value& v = style.*field;
             if constexpr (std::is_same_v<Value, Vec3f>) {
-                return hex_colour(v);
+                return svg_colour(v);
             } else if constexpr (std::is_same_v<Value, float>) {
-                return coordinate(v);
+                return svg_coordinate(v);
             } else if constexpr (std::is_same_v<Value, bool>) {
                 return v ? "yes" : "no";
+            } else if constexpr (std::is_same_v<Value, std::string>) {
+                return v;
             } else {
                 if (v.empty()) return "none";
                 std::string out;
-                for (std::size_t i = 0; i < v.size(); ++i) out += (i ? "," : "") + coordinate(v[i]);
+                for (std::size_t i = 0; i < v.size(); ++i)
+                    out += (i ? "," : "") + svg_coordinate(v[i]);
                 return out;
             }
         },
@@ -119,12 +124,12 @@ public:
 private:
     void point(char command, Point2 p) {
         fmt::format_to(std::back_inserter(d_), "{}{} {} {}", d_.empty() ? "" : " ", command,
-                       coordinate(p.x), coordinate(p.y));
+                       svg_coordinate(p.x), svg_coordinate(p.y));
     }
     // A quarter circle, counter-clockwise on the image (sweep flag 0, y down).
     void arc(float r, Point2 to) {
-        fmt::format_to(std::back_inserter(d_), " A {} {} 0 0 0 {} {}", coordinate(r), coordinate(r),
-                       coordinate(to.x), coordinate(to.y));
+        fmt::format_to(std::back_inserter(d_), " A {} {} 0 0 0 {} {}", svg_coordinate(r),
+                       svg_coordinate(r), svg_coordinate(to.x), svg_coordinate(to.y));
     }
     std::string& d_;
 };
@@ -154,6 +159,10 @@ std::string outline_data(const Stroke& s, const StrokePen& pen) {
     float period = 0.0f;
     for (float v : pen.dash) period += v;
     const bool dashed = !pen.dash.empty() && period >= kMinOutlineDashPeriod;
+    // Where the radius is not linear between cuts: by depth, a brush, a pressure profile with a
+    // taper (a product of linear functions).
+    const bool curved =
+        by_depth || pen.brush_image != nullptr || (!pen.pressure.empty() && pen.taper > 0.0f);
     float arc = 0.0f;
     std::vector<float> cuts, ts, radii;
     for (std::size_t i = 0; i + 1 < s.points.size(); ++i) {
@@ -162,9 +171,13 @@ std::string outline_data(const Stroke& s, const StrokePen& pen) {
         const float arc0 = arc;
         arc += length;
         const float d0 = by_depth ? s.depth[i] : 0.0f, d1 = by_depth ? s.depth[i + 1] : 0.0f;
+        const float nib = nib_scale(pen, b.x - a.x, b.y - a.y);
         auto radius = [&](float t) {
-            float f = taper_scale(pen, arc0 + t * length, stroke_length);
+            const float at = arc0 + t * length;
+            float f = taper_scale(pen, at, stroke_length) * pressure_scale(pen, at, total) * nib;
             if (d0 > 0.0f) f *= depth_scale(pen, d0 + (d1 - d0) * t);
+            // A brush: the width of the same ink.
+            if (pen.brush_image) f *= brush_width(*pen.brush_image, brush_along(pen, at, total));
             return half * f;
         };
         auto on = [&](float t) { return !dashed || in_dash(pen.dash, arc0 + t * length); };
@@ -181,6 +194,9 @@ std::string outline_data(const Stroke& s, const StrokePen& pen) {
         if (pen.taper > 0.0f && stroke_length >= 0.0f)
             for (float at : {pen.taper, stroke_length - pen.taper, stroke_length * 0.5f})
                 cut_at(at);
+        // The pressure profile's points.
+        for (std::size_t k = 1; k + 1 < pen.pressure.size(); ++k)
+            cut_at(total * static_cast<float>(k) / static_cast<float>(pen.pressure.size() - 1));
         if (dashed)  // each period's start and the ends of its dashes (counted, not summed)
             for (double k = std::floor(arc0 / period); k * period <= arc; ++k) {
                 double at = k * period;
@@ -208,7 +224,7 @@ std::string outline_data(const Stroke& s, const StrokePen& pen) {
             radii = {radius(cuts[k])};
             for (; k + 1 < cuts.size() && on(0.5f * (cuts[k] + cuts[k + 1])); ++k) {
                 const float r1 = radius(cuts[k + 1]);
-                refine(cuts[k], radii.back(), cuts[k + 1], r1, by_depth ? 8 : 0);
+                refine(cuts[k], radii.back(), cuts[k + 1], r1, curved ? 8 : 0);
                 ts.push_back(cuts[k + 1]);
                 radii.push_back(r1);
             }
@@ -230,8 +246,8 @@ void polyline_data(const Stroke& s, std::string& out) {
             out += " Z";
             break;
         }
-        fmt::format_to(it, "{}{} {}", i == 1 ? " L " : " ", coordinate(s.points[i].x),
-                       coordinate(s.points[i].y));
+        fmt::format_to(it, "{}{} {}", i == 1 ? " L " : " ", svg_coordinate(s.points[i].x),
+                       svg_coordinate(s.points[i].y));
     }
 }
 
@@ -268,6 +284,7 @@ std::string xml_escaped(std::string_view text) {
 }
 
 std::string svg_text(std::span<const Stroke> strokes, const SvgSettings& settings) {
+    if (settings.plotter) return plotter_svg_text(strokes, settings);
     // Every stroke's style must have a pen, also of strokes not written (hidden ones without
     // the hidden layer, dots): the same check as the drawing's, whatever the settings.
     if (!settings.pens.empty())
@@ -290,6 +307,64 @@ std::string svg_text(std::span<const Stroke> strokes, const SvgSettings& setting
                        "<image id=\"fill\" x=\"0\" y=\"0\" width=\"{}\" height=\"{}\" "
                        "xlink:href=\"{}\"/>\n",
                        settings.width, settings.height, settings.fill_href);
+    // One stroke as a path (or a filled outline), with what its pen sets beyond the group's.
+    auto write_path = [&](const Stroke& s, const StrokePen* pen, const LineStyle& group) {
+        if (pen && pen->draw && varies_width(*pen, s)) {
+            // A stroke with nothing covered by more than half (a tapered dot) has no outline
+            // to write.
+            const std::string data = outline_data(s, *pen);
+            if (!data.empty())
+                out += "<path" + outline_attributes(*pen, group) + " d=\"" + data + "\"/>\n";
+            return;
+        }
+        out += "<path";
+        if (pen && pen->draw) {
+            out += stroke_attributes(*pen, group);
+            // The drawing ends dashes square (a pixel is covered from "on" centreline points
+            // only); the group's round caps would lengthen each dash by the line's width.
+            if (!pen->dash.empty()) out += " stroke-linecap=\"butt\"";
+        }
+        out += " d=\"";
+        polyline_data(s, out);
+        out += "\"/>\n";
+    };
+    auto group_start = [&](const char* name, const LineStyle& group) {
+        fmt::format_to(
+            it,
+            "<g id=\"{}\" fill=\"none\" stroke=\"{}\" stroke-width=\"{}\" stroke-linecap=\"round\" "
+            "stroke-linejoin=\"round\">\n",
+            name, svg_colour(group.colour), svg_coordinate(group.width));
+    };
+    // The tone first, under the lines: hatch strokes as paths, screentone dots as circles.
+    const bool any_tone = std::any_of(strokes.begin(), strokes.end(),
+                                      [](const Stroke& s) { return s.type == EdgeType::Tone; });
+    if (any_tone) {
+        LineStyle group;
+        group.colour = settings.colour;
+        group.width = settings.thickness;
+        group_start("tone", group);
+        for (std::size_t index = 0; index < strokes.size(); ++index) {
+            const Stroke& s = strokes[index];
+            if (s.type != EdgeType::Tone || !s.visible || s.points.size() < 2) continue;
+            const StrokePen* pen =
+                settings.pens.empty() ? nullptr : &pen_of_stroke(settings.pens, s, index);
+            if (pen && !pen->draw) continue;
+            if (s.points.size() == 2 && s.points[0] == s.points[1]) {
+                const float width = pen ? pen->width : settings.thickness;
+                const Vec3f colour = pen ? pen->colour : settings.colour;
+                fmt::format_to(it,
+                               "<circle cx=\"{}\" cy=\"{}\" r=\"{}\" fill=\"{}\" stroke=\"none\"",
+                               svg_coordinate(s.points[0].x), svg_coordinate(s.points[0].y),
+                               svg_coordinate(0.5f * width * s.scale), svg_colour(colour));
+                if (pen && pen->opacity != 1.0f)
+                    fmt::format_to(it, " fill-opacity=\"{}\"", svg_coordinate(pen->opacity));
+                out += "/>\n";
+                continue;
+            }
+            write_path(s, pen, group);
+        }
+        out += "</g>\n";
+    }
     for (int layer = 0; layer < (settings.hidden ? 2 : 1); ++layer) {
         const bool visible = layer == 0;
         const char* name = visible ? "visible" : "hidden";
@@ -299,13 +374,10 @@ std::string svg_text(std::span<const Stroke> strokes, const SvgSettings& setting
         LineStyle group;  // what the group's attributes say, the rest SVG's initial values
         group.colour = colour;
         group.width = width;
-        fmt::format_to(
-            it,
-            "<g id=\"{}\" fill=\"none\" stroke=\"{}\" stroke-width=\"{}\" stroke-linecap=\"round\" "
-            "stroke-linejoin=\"round\">\n",
-            name, hex_colour(colour), coordinate(width));
+        group_start(name, group);
         for (int t = 0; t < kEdgeTypeCount; ++t) {
             const auto type = static_cast<EdgeType>(t);
+            if (type == EdgeType::Tone) continue;  // in its own group above
             fmt::format_to(it, "<g id=\"{}-{}\">\n", name, edge_type_name(type));
             for (std::size_t index = 0; index < strokes.size(); ++index) {
                 const Stroke& s = strokes[index];
@@ -313,26 +385,7 @@ std::string svg_text(std::span<const Stroke> strokes, const SvgSettings& setting
                 const StrokePen* pen =
                     settings.pens.empty() ? nullptr : &pen_of_stroke(settings.pens, s, index);
                 if (pen && !pen->draw && visible) continue;  // this line set is off
-                if (pen && pen->draw && varies_width(*pen, s)) {
-                    // A stroke with nothing covered by more than half (a tapered dot) has no
-                    // outline to write.
-                    const std::string data = outline_data(s, *pen);
-                    if (!data.empty())
-                        out +=
-                            "<path" + outline_attributes(*pen, group) + " d=\"" + data + "\"/>\n";
-                    continue;
-                }
-                out += "<path";
-                if (pen && pen->draw) {
-                    out += stroke_attributes(*pen, group);
-                    // The drawing ends dashes square (a pixel is covered from "on" centreline
-                    // points only); the group's round caps would lengthen each dash by the
-                    // line's width.
-                    if (!pen->dash.empty()) out += " stroke-linecap=\"butt\"";
-                }
-                out += " d=\"";
-                polyline_data(s, out);
-                out += "\"/>\n";
+                write_path(s, pen, group);
             }
             out += "</g>\n";
         }

@@ -36,7 +36,16 @@ struct SvgSettings {
     /// wrote it (its `data-software` attribute) and this text (the settings that made it),
     /// escaped as XML character data.
     std::string software, metadata;
+    /// For a pen plotter instead (ink/plotter.h): one Inkscape layer per pen, paths merged and
+    /// ordered to cut pen-up travel, centrelines only; no fill image.
+    bool plotter = false;
 };
+
+/// `#rrggbb` of a colour (each channel clamped to [0, 1]).
+[[nodiscard]] std::string svg_colour(const Vec3f& colour);
+
+/// A coordinate or length with three decimals, "-0.000" written as "0.000".
+[[nodiscard]] std::string svg_coordinate(float v);
 
 /// `text` with &, <, > and " escaped, for XML character data and attribute values.
 [[nodiscard]] std::string xml_escaped(std::string_view text);
@@ -44,11 +53,13 @@ struct SvgSettings {
 /// `data:image/png;base64,...` for PNG bytes.
 [[nodiscard]] std::string png_data_uri(std::span<const std::uint8_t> png);
 
-/// The SVG text: a `<g id="visible">` with one subgroup per line type (`visible-silhouette`,
-/// `visible-border`, `visible-crease`, `visible-material`, `visible-intersection`), each
-/// stroke a `<path>` in pixel units with round caps and joins (or a filled outline, above); with
-/// hidden lines, a `<g id="hidden">` with `hidden-...` subgroups after it. Coordinates have three
-/// decimals.
+/// The SVG text: with a tone look first a `<g id="tone">` of its strokes (paths) and dots
+/// (filled circles), under the lines; then a `<g id="visible">` with one subgroup per line type
+/// (`visible-silhouette`, `visible-border`, `visible-crease`, `visible-material`,
+/// `visible-intersection`, `visible-polyline`, `visible-band`, `visible-shadow`), each stroke a
+/// `<path>` in pixel units with round caps and joins (or a filled outline, above); with hidden
+/// lines, a `<g id="hidden">` with `hidden-...` subgroups after it. Coordinates have three
+/// decimals. With `plotter`, plotter_svg_text's drawing instead (ink/plotter.h).
 [[nodiscard]] std::string svg_text(std::span<const Stroke> strokes, const SvgSettings& settings);
 
 }  // namespace toonray::ink

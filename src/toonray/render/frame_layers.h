@@ -26,18 +26,20 @@ struct FrameLayers {
     ImageRgb8 image;  ///< the final picture
     ImageRgb8 cel;    ///< the colours without lines
 
-    ImageF distance;                    ///< along the ray; +inf where nothing is seen
-    ImageF view_depth;                  ///< along the view direction; +inf likewise
-    Image<Vec3f> normal;                ///< shading normal facing the eye; 0 likewise
-    Image<Vec3f> geometric_normal;      ///< facing the eye; 0 likewise
-    Image<std::uint32_t> object;        ///< kNoIndex where nothing is seen
-    Image<std::uint32_t> material;      ///< kNoIndex likewise
-    Image<std::uint8_t> band;           ///< the ramp band; kNoBand likewise
-    ImageF light;                       ///< the summed light term the band comes from
-    Image<Vec3f> position;              ///< world space; 0 where nothing is seen
-    Image<Vec2f> uv;                    ///< texture coordinates; 0 likewise or without them
-    Image<std::uint8_t> refined;        ///< 1 where the pixel took all its samples
-    ImageF lines;                       ///< every line drawn over the picture
+    ImageF distance;                ///< along the ray; +inf where nothing is seen
+    ImageF view_depth;              ///< along the view direction; +inf likewise
+    Image<Vec3f> normal;            ///< shading normal facing the eye; 0 likewise
+    Image<Vec3f> geometric_normal;  ///< facing the eye; 0 likewise
+    Image<std::uint32_t> object;    ///< kNoIndex where nothing is seen
+    Image<std::uint32_t> material;  ///< kNoIndex likewise
+    Image<std::uint8_t> band;       ///< the ramp band; kNoBand likewise
+    ImageF light;                   ///< the summed light term the band comes from
+    Image<Vec3f> position;          ///< world space; 0 where nothing is seen
+    Image<Vec2f> uv;                ///< texture coordinates; 0 likewise or without them
+    Image<std::uint8_t> refined;    ///< 1 where the pixel took all its samples
+    ImageF lines;                   ///< every line drawn over the picture
+    /// The tone look's strokes or dots, drawn under the lines (ink mode; 0 for the cel look).
+    ImageF tone;
     std::vector<LineLayer> line_types;  ///< each line type's own, in the mode's order
 
     /// The strokes (ink lines, and polylines in every mode): in the ink mode, when the scene

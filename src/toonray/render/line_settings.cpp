@@ -9,7 +9,8 @@ namespace {
 
 constexpr std::pair<LineType, std::string_view> kTypeNames[] = {
     {kLineSilhouette, "silhouette"}, {kLineCrease, "crease"},     {kLineDepth, "depth"},
-    {kLineObject, "object"},         {kLineMaterial, "material"},
+    {kLineObject, "object"},         {kLineMaterial, "material"}, {kLineBand, "band"},
+    {kLineShadow, "shadow"},
 };
 
 }  // namespace
@@ -37,7 +38,8 @@ unsigned parse_line_types(const std::string& text) {
     for (;;) {
         const std::size_t comma = rest.find(',');
         const std::string_view item = rest.substr(0, comma);
-        bool known = false;
+        bool known = item == "all";
+        if (known) types |= kLineAll;
         for (const auto& [type, name] : kTypeNames)
             if (item == name) {
                 types |= type;
@@ -46,7 +48,7 @@ unsigned parse_line_types(const std::string& text) {
         if (!known)
             throw Error(
                 fmt::format("unknown line type '{}' (choose from silhouette, crease, depth, "
-                            "object, material, all, none)",
+                            "object, material, band, shadow, all, none)",
                             item));
         if (comma == std::string_view::npos) return types;
         rest.remove_prefix(comma + 1);
@@ -54,14 +56,21 @@ unsigned parse_line_types(const std::string& text) {
 }
 
 std::string format_line_types(unsigned types) {
-    if ((types & kLineAll) == kLineAll) return "all";
-    std::string out;
-    for (const auto& [type, name] : kTypeNames)
-        if (types & type) out += (out.empty() ? "" : ",") + std::string(name);
+    const bool all = (types & kLineAll) == kLineAll;
+    std::string out = all ? "all" : "";
+    for (const auto& [type, name] : kTypeNames) {
+        if (!(types & type) || (all && (type & kLineAll))) continue;
+        out += (out.empty() ? "" : ",") + std::string(name);
+    }
     return out.empty() ? "none" : out;
 }
 
 void check_line_settings(const LineSettings& lines) {
+    if (lines.mode != LineMode::Ink && (lines.types & (kLineBand | kLineShadow)))
+        throw Error(fmt::format(
+            "band and shadow lines are found on the geometry by the ink mode; the {} mode finds "
+            "lines between pixels: use --edges ink (the default)",
+            line_mode_name(lines.mode)));
     if (lines.mode == LineMode::Ink && (lines.types & kLineDepth) &&
         (lines.types & kLineAll) != kLineAll)
         throw Error(

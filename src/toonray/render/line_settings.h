@@ -41,13 +41,22 @@ enum LineType : unsigned {
     kLineDepth = 1u << 2,  ///< a step in depth where the surface is not a continuous plane or slope
     kLineObject = 1u << 3,    ///< neighbours belong to different objects
     kLineMaterial = 1u << 4,  ///< neighbours have different materials
+    /// The types of the geometry, every one the default draws: "all".
     kLineAll = 31u,
+    /// Boundaries between cel bands on the surfaces, the terminator included (the ink lines
+    /// only; not in "all": the bands show them, and the default look stays as it was).
+    kLineBand = 1u << 5,
+    /// Boundaries of toon shadows on the surfaces receiving them (the ink lines, with
+    /// shadows on).
+    kLineShadow = 1u << 6,
 };
 
-/// Parses "silhouette,crease,depth,object,material" (any subset, or "all" / "none"). Throws
-/// Error ("unknown line type '...' ...").
+/// Parses "silhouette,crease,depth,object,material,band,shadow" (any subset; "all" for the
+/// first five, also in a list: "all,band"; or "none"). Throws Error ("unknown line type '...'
+/// ...").
 [[nodiscard]] unsigned parse_line_types(const std::string& text);
-/// The text parse_line_types reads back as `types`: "all", "none" or the names in order.
+/// The text parse_line_types reads back as `types`: "all" (and ",band", ",shadow" when set),
+/// "none" or the names in order.
 [[nodiscard]] std::string format_line_types(unsigned types);
 
 /// `--edges classic`: the Sobel thresholds.
@@ -90,7 +99,8 @@ struct LineSettings {
 };
 
 /// Throws Error for line types a mode cannot draw when they are asked for by name: depth lines
-/// with the ink lines ("the ink mode finds no depth lines ...").
+/// with the ink lines ("the ink mode finds no depth lines ..."), band and shadow lines with the
+/// others.
 void check_line_settings(const LineSettings& lines);
 
 }  // namespace toonray

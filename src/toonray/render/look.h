@@ -24,6 +24,10 @@ struct LookFrame {
     /// Whether colours vary inside one surface and band: textured materials or vertex colours.
     /// Only then does the cel look give an edge signal other than 0.
     bool varying_albedo = false;
+    /// Whether a band's colour is its own: the cel look's levels. A tone look shows every band
+    /// at its full colour (its ink, drawn over the picture, gives the darkness), so refinement
+    /// does not compare bands.
+    bool bands_shade = true;
 };
 
 /// The fields (SurfaceFields bits) a look reads after shading, beyond what lines and layers ask
@@ -69,9 +73,12 @@ struct RefineKey {
     std::uint64_t ids;    ///< object (high half) and material
     std::uint64_t shade;  ///< hit, band and accents (high half) and the edge signal
 };
-[[nodiscard]] inline RefineKey refine_key(const SurfaceSamples& s, std::size_t i) {
+/// `band_mask` is 0xff, or 0 when bands do not change the colour (LookFrame::bands_shade).
+[[nodiscard]] inline RefineKey refine_key(const SurfaceSamples& s, std::size_t i,
+                                          std::uint64_t band_mask = 0xff) {
     const std::uint64_t shade = static_cast<std::uint64_t>(s.found[i]) << 16 |
-                                static_cast<std::uint64_t>(s.band[i]) << 8 | s.accents[i];
+                                (static_cast<std::uint64_t>(s.band[i]) & band_mask) << 8 |
+                                s.accents[i];
     return {static_cast<std::uint64_t>(s.object[i]) << 32 | s.material[i], shade << 32 | s.edge[i]};
 }
 

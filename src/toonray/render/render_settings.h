@@ -3,6 +3,8 @@
 /// besides the picture.
 
 #include "toonray/core/math.h"
+#include "toonray/ink/draw.h"
+#include "toonray/ink/tone.h"
 #include "toonray/render/line_settings.h"
 #include "toonray/render/shading.h"
 
@@ -28,6 +30,9 @@ struct RenderSettings {
     Vec3f background{1.0f};   ///< colour of pixels that see nothing
     ShadingSettings shading;  ///< ramp, shadows, specular, rim, textures
     LineSettings lines;
+    /// The tone look (ink/tone.h): cel, or hatching or screentone drawn as ink over every
+    /// band's full colour (the ink mode only).
+    ink::ToneSettings tone;
     SamplingSettings sampling;
     int threads = 0;  ///< 0 = all hardware threads
     /// Fill the per-pixel layers of FrameLayers (render/frame_layers.h). The picture is the
@@ -39,6 +44,11 @@ struct RenderSettings {
     /// With strokes: also chain the hidden lines, with the number of surfaces hiding them.
     /// They are drawn only where a line style says so.
     bool hidden_lines = false;
+    /// The frame's number in its sequence (sketchy strokes boil with it; 0 for a single frame).
+    int frame = 0;
+    /// The brushes line styles name, read by the frame layer (frame/frame_renderer.h); null
+    /// when no style names one.
+    const ink::BrushSet* brushes = nullptr;
 };
 
 /// Sub-samples per pixel side for a sample count: 1, 4, 9, 16 -> 1, 2, 3, 4. Throws Error

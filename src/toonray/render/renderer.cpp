@@ -48,12 +48,40 @@ bool keeps_strokes(const Scene& scene, const RenderSettings& settings) {
     return settings.lines.mode == LineMode::Ink || settings.strokes || !scene.polylines.empty();
 }
 
+// A tone look is drawn as ink under the ink lines; the other modes draw the cel look
+// (frame/settings.h, check_settings, refuses it there).
+bool tone_look(const RenderSettings& settings) {
+    return settings.tone.mode != ink::ToneMode::Cel && settings.lines.mode == LineMode::Ink;
+}
+
+// The band of a point as the frame's shading finds it, for the tone's strokes: the light terms
+// of a hit there seen from the eye, toon shadows included.
+class ShadedBands final : public ink::ToneShading {
+public:
+    ShadedBands(const ShadingContext& shading, const Vec3f& eye) : shading_(shading), eye_(eye) {}
+
+    std::uint8_t band(std::uint32_t prim, float u, float v, const Vec3f& p) const override {
+        Vec3f dir = p - eye_;
+        const float t = length(dir);
+        if (!(t > 0.0f)) return 0;
+        dir = dir / t;
+        const Hit hit{t, prim, u, v};
+        return light_terms(shading_, hit, eye_, dir, shading_normal(shading_.scene, hit, dir)).band;
+    }
+    bool bands_follow_corners() const override { return !shading_.settings.shadows; }
+
+private:
+    const ShadingContext& shading_;
+    Vec3f eye_;
+};
+
 }  // namespace
 
 std::uint64_t layer_bytes_per_pixel(LineMode mode) {
     // cel, distance, view depth, both normals, ids, band, light, position, uv, refined, lines,
     // and the line types of the mode (classic 2, robust 5 and the polylines, ink 6).
-    const std::uint64_t types = mode == LineMode::Classic ? 3 : (mode == LineMode::Robust ? 6 : 6);
+    // Ink: each type but tone (8), and the tone layer.
+    const std::uint64_t types = mode == LineMode::Classic ? 3 : (mode == LineMode::Robust ? 6 : 9);
     return sizeof(Rgb8) + 2 * sizeof(float) + 2 * sizeof(Vec3f) + 2 * sizeof(std::uint32_t) + 1 +
            sizeof(float) + sizeof(Vec3f) + sizeof(Vec2f) + 1 + sizeof(float) +
            types * sizeof(float);
@@ -86,7 +114,8 @@ std::uint64_t Renderer::held_bytes() const {
                           bytes_of(l.geometric_normal) + bytes_of(l.object) + bytes_of(l.material) +
                           bytes_of(l.band) + bytes_of(l.light) + bytes_of(l.position) +
                           bytes_of(l.uv) + bytes_of(l.refined) + bytes_of(l.lines) +
-                          bytes_of(ink_.coverage) + bytes_of(ink_.style);
+                          bytes_of(l.tone) + bytes_of(ink_.coverage) + bytes_of(ink_.style) +
+                          bytes_of(ink_.tone_coverage) + bytes_of(ink_.tone_style);
     for (const LineLayer& type : l.line_types) bytes += bytes_of(type.coverage);
     for (const auto* step : {classic_.get(), robust_.get(), ink_lines_.get()})
         bytes += step->held_frame_bytes();
@@ -141,10 +170,15 @@ const ImageRgb8& Renderer::render(const Scene& scene, const TriangleAccel& accel
     if (!settings.layers) {  // nothing of an earlier frame's layers stays
         layers_.cel.reshape(0, 0);
         layers_.lines.reshape(0, 0);
+        layers_.tone.reshape(0, 0);
     }
-    if (keeps_strokes(scene, settings)) {
-        ink::draw_ink_lines(scene, accel, camera, settings.width, settings.height,
-                            ink_settings(settings), settings.threads, ink_);
+    if (keeps_strokes(scene, settings) || tone_look(settings)) {
+        const ShadedBands bands(shading, view.eye);
+        ink::InkSettings ink = ink_settings(settings);
+        ink.lights = lights;
+        if (tone_look(settings)) ink.tone_shading = &bands;
+        ink::draw_ink_lines(scene, accel, camera, settings.width, settings.height, ink,
+                            settings.threads, ink_);
         layers_.strokes = &ink_;
     } else {
         layers_.strokes = nullptr;
@@ -168,8 +202,15 @@ void Renderer::render_buckets(const FrameContext& frame, const ShadingContext& s
     bool textured = false;
     for (std::uint32_t m = 0; m < frame.scene.materials.size(); ++m)
         textured = textured || material_texture(shading, m) != nullptr;
-    const LookFrame look{frame.scene, settings.shading, settings.background,
-                         textured || frame.scene.has_colours()};
+    // A tone look shows each band at its full colour: the tone's ink gives its darkness.
+    ShadingSettings full;
+    if (tone_look(settings)) {
+        full = settings.shading;
+        std::fill(full.ramp.levels.begin(), full.ramp.levels.end(), 1.0f);
+    }
+    const LookFrame look{frame.scene, tone_look(settings) ? full : settings.shading,
+                         settings.background, textured || frame.scene.has_colours(),
+                         !tone_look(settings)};
     SamplerFrame sampling{frame.accel,
                           shading,
                           look,

@@ -94,6 +94,7 @@ void BucketSampler::trace_first(const SamplerFrame& frame) {
     // One sample a pixel: nothing to refine, no keys to compare; else refinement compares the
     // first samples' keys.
     const bool keys = sub_ > 1;
+    const std::uint64_t band_mask = frame.look.bands_shade ? 0xff : 0;
     first_.resize(static_cast<std::size_t>(tw) * th,
                   frame.first_fields | (keys ? kSurfaceKeys : 0u),
                   static_cast<int>(frame.shading.lights.size()));
@@ -126,10 +127,19 @@ void BucketSampler::trace_first(const SamplerFrame& frame) {
                 shade_into(frame, cols, dirs_.data() + at, hits_.data() + at, hit_found_.get() + at,
                            first_, to);
                 if (!keys) continue;
-                for (int i = 0; i < cols; ++i) {
-                    const RefineKey key = refine_key(first_, to + i);
-                    key_ids_[to + i] = key.ids;
-                    key_shade_[to + i] = key.shade;
+                // Two loops, so that the cel look's keys take no mask.
+                if (band_mask == 0xff) {
+                    for (int i = 0; i < cols; ++i) {
+                        const RefineKey key = refine_key(first_, to + i);
+                        key_ids_[to + i] = key.ids;
+                        key_shade_[to + i] = key.shade;
+                    }
+                } else {
+                    for (int i = 0; i < cols; ++i) {
+                        const RefineKey key = refine_key(first_, to + i, band_mask);
+                        key_ids_[to + i] = key.ids;
+                        key_shade_[to + i] = key.shade;
+                    }
                 }
             }
         }
