@@ -186,13 +186,24 @@ class ProgressAndCancel(unittest.TestCase):
 
     def test_cancel_from_another_thread_and_the_next_frame_is_whole(self):
         scene = self.big_scene()
-        settings = {"sampling.samples": 16, "sampling.adaptive": False, "sampling.tile_size": 8}
+        # The frame of the test above, which reports progress more than twice: the cancel comes
+        # from another thread while the frame is known to be rendering, whatever the machine's
+        # speed.
+        settings = {"sampling.samples": 16, "sampling.adaptive": False, "sampling.tile_size": 8,
+                    "render.threads": 1}
         renderer = toonray.Renderer()
-        timer = threading.Timer(0.2, renderer.cancel)
-        timer.start()
+        cancels = []
+
+        def cancel_from_another_thread(fraction):
+            if fraction < 1.0 and not cancels:
+                canceller = threading.Thread(target=renderer.cancel)
+                canceller.start()
+                canceller.join()
+                cancels.append(fraction)
+
         with self.assertRaises(toonray.Cancelled):
-            renderer.render(scene, 800, 600, settings)
-        timer.join()
+            renderer.render(scene, 1280, 960, settings, progress=cancel_from_another_thread)
+        self.assertEqual(len(cancels), 1)
         small = {"lines.mode": "robust"}
         self.assertEqual(renderer.render(scene, 96, 64, small).png(),
                          toonray.Renderer().render(scene, 96, 64, small).png())
