@@ -25,9 +25,9 @@ COLOUR_KEYS = {"image.background", "lines.colour"}
 # Keys unset by default (None): a checkbox turns them on, with this value to start from.
 OPTIONAL_DEFAULTS = {"scene.auto_smooth": 30.0}
 
-SECTIONS = (("shading", "Shading"), ("lines", "Lines"), ("sampling", "Sampling"),
-            ("image", "Image"), ("render", "Performance"), ("output", "SVG"),
-            ("scene", "Scene"), ("limits", "Limits"))
+SECTIONS = (("shading", "Shading"), ("tone", "Tone"), ("lines", "Lines"),
+            ("sampling", "Sampling"), ("image", "Image"), ("render", "Performance"),
+            ("output", "SVG"), ("scene", "Scene"), ("limits", "Limits"))
 
 _settings_keys = []  # [(key, kind)], in the table's order, filled by register()
 

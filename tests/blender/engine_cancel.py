@@ -119,6 +119,14 @@ with tempfile.TemporaryDirectory() as folder:
           and sets[0].use_dash and sets[0].dash == "4,2" and not sets[0].use_taper,
           "and its rule becomes the line set again")
 
+# Every section of the settings document has its panel in the Render properties.
+from toonray_blender import properties  # noqa: E402
+
+sections = {section for section, _ in properties.SECTIONS}
+missing = sorted({key.split(".", 1)[0] for key, _ in properties.setting_keys()} - sections)
+check(not missing, "every section of the settings has a panel (without one: %s)" % missing)
+check(hasattr(bpy.types, "TOONRAY_PT_render_tone"), "the tone look has its panel")
+
 if failures:
     sys.exit(1)
 print("engine_cancel: all passed")
