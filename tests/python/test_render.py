@@ -43,6 +43,17 @@ def two_cubes():
 
 
 class Frames(unittest.TestCase):
+    def test_tone_looks_have_their_coverage_layer(self):
+        scene, _, _ = two_cubes()
+        cel = toonray.render(scene, 120, 80, {})
+        self.assertEqual(cel.layers["tone.coverage"].max(), 0.0)
+        for mode in ("hatch", "screentone"):
+            frame = toonray.render(scene, 120, 80, {"tone.mode": mode})
+            coverage = frame.layers["tone.coverage"]
+            self.assertGreater(coverage.max(), 0.0, mode)
+            self.assertLessEqual(coverage.max(), 1.0, mode)
+            self.assertFalse((frame.image == cel.image).all(), mode)
+
     def test_picture_layers_and_ids(self):
         scene, left, right = two_cubes()
         # Lines 10 pixels wide at 720 lines: over a pixel here.
