@@ -276,6 +276,50 @@ double correlation_shift(const ImageF& a, const ImageF& b, int x0, int x1, int y
 
 }  // namespace
 
+TEST(Tone, ScreentoneDotsCoverTheirCellsDarknessWithinThreePercent) {
+    // Screen-locked cells 8 pixels wide on the pixel grid: at 720 lines the spacing is in
+    // pixels, rows at 0 degrees, and the cells are centred on the image's centre (480, 360).
+    const Scene s = lit_sphere();
+    RenderSettings settings = tone_settings(ink::ToneMode::Screentone, 960, 720);
+    settings.tone.spacing = 8.0f;
+    settings.tone.angle = 0.0f;
+    Frame f;
+    const FrameLayers& l = f.render(s, kSphereCamera, kSideLight, settings);
+    const ToonRamp& ramp = settings.shading.ramp;
+    const int g = 8, x_first = 480 - g / 2 - g * (480 / g - 1),
+              y_first = 360 - g / 2 - g * (360 / g - 1);
+    std::vector<int> cells(ramp.levels.size(), 0);
+    double worst = 0.0;
+    for (int y0 = y_first; y0 + 2 * g <= l.tone.height(); y0 += g)
+        for (int x0 = x_first; x0 + 2 * g <= l.tone.width(); x0 += g) {
+            // A cell whose neighbours are in its band too: the dots that spill into it are as
+            // large as its own spills out.
+            const int band = l.band(x0, y0);
+            bool uniform = l.object(x0, y0) != kNoIndex;
+            for (int y = y0 - g; uniform && y < y0 + 2 * g; ++y)
+                for (int x = x0 - g; uniform && x < x0 + 2 * g; ++x)
+                    uniform = l.band(x, y) == band && l.object(x, y) != kNoIndex;
+            if (!uniform) continue;
+            double sum = 0.0;
+            for (int y = y0; y < y0 + g; ++y)
+                for (int x = x0; x < x0 + g; ++x) sum += l.tone(x, y);
+            const double darkness = 1.0 - ramp.levels[static_cast<std::size_t>(band)];
+            const double error = std::abs(sum / (g * g) - darkness);
+            EXPECT_LE(error, 0.03 * std::max(darkness, 0.01))
+                << "cell at " << x0 << "," << y0 << " band " << band;
+            if (darkness > 0.0) worst = std::max(worst, error / darkness);
+            ++cells[static_cast<std::size_t>(band)];
+        }
+    int bands = 0;
+    for (std::size_t b = 0; b < cells.size(); ++b) {
+        std::printf("screentone cells: band %zu (darkness %.2f): %d cells\n", b,
+                    1.0 - ramp.levels[b], cells[b]);
+        bands += cells[b] >= 20 ? 1 : 0;
+    }
+    std::printf("screentone cells: the worst is %.2f%% from its darkness\n", 100.0 * worst);
+    EXPECT_GE(bands, 3) << "too few bands with whole cells to measure";
+}
+
 TEST(Tone, ObjectAnchoredHatchingMovesWithTheGeometryAndScreenAnchoredStaysPut) {
     // The camera pans along x by `pan` world units: the square, all at one depth, moves on the
     // image by the same number of pixels everywhere, which its projection gives exactly.
