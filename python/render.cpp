@@ -157,7 +157,7 @@ std::shared_ptr<FrameData> PyRenderer::render(PyScene& py_scene, int width, int 
             try {
                 const FrameLayers& result = renderer_.render_layers(scene, camera, lights, options,
                                                                     frame->warnings, &progress);
-                keep_frame(result, scene, options, *frame);
+                keep_frame(result, *renderer_.drawn_scene(), options, *frame);
             } catch (...) {
                 failure = std::current_exception();
             }

@@ -3,10 +3,12 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <string>
 #include <vector>
 
+#include "support/instance_scenes.h"
 #include "support/test_scenes.h"
 #include "support/test_support.h"
 #include "toonray/frame/feature_images.h"
@@ -141,4 +143,39 @@ TEST(ToneFrames, SettingsRoundTripThroughToml) {
     EXPECT_EQ(settings_toml(back), settings_toml(s));
     // Unset, the anchor is the mode's own and written as a comment.
     EXPECT_NE(settings_toml(Settings{}).find("# anchor is not set"), std::string::npos);
+}
+
+TEST(ToneFrames, InstancesTakeTheToneAsTheFlattenedSceneDoes) {
+    // Tone is found on a scene's own triangles: a scene with instances is drawn flattened under
+    // a tone look, so each instance is toned as its copy in the flattened scene.
+    const Scene instanced = test_support::instanced_test_scene();
+    const Scene flat = flatten_instances(instanced);
+    for (const char* mode : {"hatch", "screentone"}) {
+        FrameOptions o = options_for({{"tone.mode", mode}});
+        o.keep_layers = true;
+        const SceneFrame frame = test_support::scene_frame(
+            instanced, test_support::instanced_test_camera(), o.settings.width, o.settings.height);
+        Warnings warnings;
+        FrameRenderer with_instances, flattened;
+        const FrameLayers& a =
+            with_instances.render_layers(instanced, frame.camera, frame.lights, o, warnings);
+        const FrameLayers& b =
+            flattened.render_layers(flat, frame.camera, frame.lights, o, warnings);
+        auto same = [](const auto& p, const auto& q) {
+            return p.width() == q.width() && p.height() == q.height() &&
+                   std::equal(p.data(), p.data() + p.width() * p.height(), q.data());
+        };
+        EXPECT_TRUE(same(a.image, b.image)) << mode;
+        EXPECT_TRUE(same(a.tone, b.tone)) << mode;
+        EXPECT_EQ(with_instances.drawn_scene()->triangle_count(), flat.triangle_count()) << mode;
+        // And the instances are toned: some of their pixels are under the tone.
+        std::vector<std::uint8_t> instance_object(instanced.objects.size(), 0);
+        for (const Instance& instance : instanced.instances) instance_object[instance.object] = 1;
+        double on_instances = 0.0;
+        for (int y = 0; y < a.tone.height(); ++y)
+            for (int x = 0; x < a.tone.width(); ++x)
+                if (a.object(x, y) != kNoIndex && instance_object[a.object(x, y)])
+                    on_instances += a.tone(x, y);
+        EXPECT_GT(on_instances, 50.0) << mode;
+    }
 }

@@ -151,12 +151,21 @@ const FrameLayers& FrameRenderer::render_layers(const Scene& scene, const Camera
     const RenderSettings settings = options.render_settings();
     // Validate the camera before any work so a bad one fails with nothing done.
     validate_camera(camera);
-    const TriangleAccel& accel = accel_.update(scene, options.bvh);
+    // Tone strokes and dots are found on the scene's own triangles, so under a tone look the
+    // instances are drawn flattened (each copy its own triangles, as a flat scene would be).
+    drawn_ = &scene;
+    if (!scene.instances.empty() && settings.lines.mode == LineMode::Ink &&
+        settings.tone.mode != ink::ToneMode::Cel) {
+        flattened_ = flatten_instances(scene);
+        drawn_ = &flattened_;
+    }
+    const Scene& drawn = *drawn_;
+    const TriangleAccel& accel = accel_.update(drawn, options.bvh);
     const TextureSet* textures =
-        settings.shading.textures ? &textures_.load(scene, warnings) : nullptr;
+        settings.shading.textures ? &textures_.load(drawn, warnings) : nullptr;
     RenderSettings with_brushes = settings;
     if (read_brushes(settings.lines.ink.styles, brushes_)) with_brushes.brushes = &brushes_;
-    renderer_.render(scene, accel, camera, lights, with_brushes, textures, progress);
+    renderer_.render(drawn, accel, camera, lights, with_brushes, textures, progress);
     return renderer_.layers();
 }
 

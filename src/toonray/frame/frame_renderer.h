@@ -113,8 +113,14 @@ public:
 
     [[nodiscard]] const Renderer& renderer() const { return renderer_; }
     [[nodiscard]] const AnimationAccel& accel() const { return accel_; }
+    /// The scene the last frame drew, whose triangles its strokes' segments name: the one
+    /// given, or under a tone look its instances flattened (tone strokes and dots are found on
+    /// a scene's own triangles). Null before the first frame.
+    [[nodiscard]] const Scene* drawn_scene() const { return drawn_; }
 
 private:
+    Scene flattened_;  ///< under a tone look, the last frame's scene with its instances flattened
+    const Scene* drawn_ = nullptr;
     AnimationAccel accel_;
     TextureCache textures_;
     ink::BrushSet brushes_;  ///< the line styles' brushes, read once
