@@ -145,13 +145,17 @@ TEST(ToneFrames, SettingsRoundTripThroughToml) {
     EXPECT_NE(settings_toml(Settings{}).find("# anchor is not set"), std::string::npos);
 }
 
-TEST(ToneFrames, InstancesTakeTheToneAsTheFlattenedSceneDoes) {
-    // Tone is found on a scene's own triangles: a scene with instances is drawn flattened under
-    // a tone look, so each instance is toned as its copy in the flattened scene.
+TEST(ToneFrames, InstancesAreTonedAndLinedAsInTheFlattenedScene) {
+    // Tone, band and shadow lines are found on a scene's own triangles: a scene with instances
+    // is drawn flattened for them, so each instance is toned (or lined) as its copy in the
+    // flattened scene.
     const Scene instanced = test_support::instanced_test_scene();
     const Scene flat = flatten_instances(instanced);
-    for (const char* mode : {"hatch", "screentone"}) {
-        FrameOptions o = options_for({{"tone.mode", mode}});
+    for (const char* mode : {"hatch", "screentone", "band lines"}) {
+        const bool lines = std::string(mode) == "band lines";
+        FrameOptions o =
+            lines ? options_for({{"lines.types", "all,band,shadow"}, {"shading.shadows", "true"}})
+                  : options_for({{"tone.mode", mode}});
         o.keep_layers = true;
         const SceneFrame frame = test_support::scene_frame(
             instanced, test_support::instanced_test_camera(), o.settings.width, o.settings.height);
@@ -167,15 +171,17 @@ TEST(ToneFrames, InstancesTakeTheToneAsTheFlattenedSceneDoes) {
         };
         EXPECT_TRUE(same(a.image, b.image)) << mode;
         EXPECT_TRUE(same(a.tone, b.tone)) << mode;
+        EXPECT_TRUE(same(a.lines, b.lines)) << mode;
         EXPECT_EQ(with_instances.drawn_scene()->triangle_count(), flat.triangle_count()) << mode;
-        // And the instances are toned: some of their pixels are under the tone.
+        // And the instances are toned (or have band lines): some of their pixels are covered.
+        const ImageF& covered = lines ? a.line_type("band")->coverage : a.tone;
         std::vector<std::uint8_t> instance_object(instanced.objects.size(), 0);
         for (const Instance& instance : instanced.instances) instance_object[instance.object] = 1;
         double on_instances = 0.0;
         for (int y = 0; y < a.tone.height(); ++y)
             for (int x = 0; x < a.tone.width(); ++x)
                 if (a.object(x, y) != kNoIndex && instance_object[a.object(x, y)])
-                    on_instances += a.tone(x, y);
+                    on_instances += covered(x, y);
         EXPECT_GT(on_instances, 50.0) << mode;
     }
 }

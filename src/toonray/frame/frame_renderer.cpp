@@ -151,11 +151,13 @@ const FrameLayers& FrameRenderer::render_layers(const Scene& scene, const Camera
     const RenderSettings settings = options.render_settings();
     // Validate the camera before any work so a bad one fails with nothing done.
     validate_camera(camera);
-    // Tone strokes and dots are found on the scene's own triangles, so under a tone look the
-    // instances are drawn flattened (each copy its own triangles, as a flat scene would be).
+    // Tone strokes and dots, band and shadow lines are found on the scene's own triangles, so
+    // under a tone look or with those lines the instances are drawn flattened (each copy its
+    // own triangles, as a flat scene would be).
     drawn_ = &scene;
     if (!scene.instances.empty() && settings.lines.mode == LineMode::Ink &&
-        settings.tone.mode != ink::ToneMode::Cel) {
+        (settings.tone.mode != ink::ToneMode::Cel ||
+         (settings.lines.types & (kLineBand | kLineShadow)) != 0)) {
         flattened_ = flatten_instances(scene);
         drawn_ = &flattened_;
     }

@@ -114,12 +114,12 @@ public:
     [[nodiscard]] const Renderer& renderer() const { return renderer_; }
     [[nodiscard]] const AnimationAccel& accel() const { return accel_; }
     /// The scene the last frame drew, whose triangles its strokes' segments name: the one
-    /// given, or under a tone look its instances flattened (tone strokes and dots are found on
-    /// a scene's own triangles). Null before the first frame.
+    /// given, or under a tone look or with band or shadow lines its instances flattened (those
+    /// are found on a scene's own triangles). Null before the first frame.
     [[nodiscard]] const Scene* drawn_scene() const { return drawn_; }
 
 private:
-    Scene flattened_;  ///< under a tone look, the last frame's scene with its instances flattened
+    Scene flattened_;  ///< the last frame's scene with its instances flattened, when drawn so
     const Scene* drawn_ = nullptr;
     AnimationAccel accel_;
     TextureCache textures_;
