@@ -5,11 +5,11 @@
 
 #include <gtest/gtest.h>
 
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <numbers>
-#include <regex>
 #include <string>
 #include <vector>
 
@@ -36,15 +36,31 @@ std::vector<std::vector<Point2>> group_paths(const std::string& svg, const std::
     if (start == std::string::npos) return paths;
     const std::size_t end = svg.find("</g>", start);
     const std::string body = svg.substr(start, end - start);
-    const std::regex path(R"re(d="([^"]*)")re");
-    const std::regex number(R"(-?\d+\.\d+)");
-    for (auto it = std::sregex_iterator(body.begin(), body.end(), path);
-         it != std::sregex_iterator(); ++it) {
-        const std::string d = (*it)[1];
+    // Each path's d="..." and its numbers with a decimal point (the SVG writes every
+    // coordinate so), read by hand: std::regex trips g++ 12's maybe-uninitialized warning in
+    // the sanitizer build.
+    for (std::size_t at = body.find("d=\""); at != std::string::npos; at = body.find("d=\"", at)) {
+        at += 3;
+        const std::size_t close = body.find('"', at);
+        const std::string d = body.substr(at, close - at);
+        at = close;
         std::vector<float> values;
-        for (auto n = std::sregex_iterator(d.begin(), d.end(), number); n != std::sregex_iterator();
-             ++n)
-            values.push_back(std::stof(n->str()));
+        for (std::size_t i = 0; i < d.size();) {
+            std::size_t j = i + (d[i] == '-' ? 1 : 0);
+            if (j >= d.size() || !std::isdigit(static_cast<unsigned char>(d[j]))) {
+                ++i;
+                continue;
+            }
+            while (j < d.size() && std::isdigit(static_cast<unsigned char>(d[j]))) ++j;
+            const bool decimal = j + 1 < d.size() && d[j] == '.' &&
+                                 std::isdigit(static_cast<unsigned char>(d[j + 1]));
+            if (decimal) {
+                ++j;
+                while (j < d.size() && std::isdigit(static_cast<unsigned char>(d[j]))) ++j;
+                values.push_back(std::stof(d.substr(i, j - i)));
+            }
+            i = j;
+        }
         std::vector<Point2> points;
         for (std::size_t i = 0; i + 1 < values.size(); i += 2)
             points.push_back({values[i], values[i + 1]});
