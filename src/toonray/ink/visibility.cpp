@@ -204,8 +204,13 @@ std::vector<EdgePiece> split_by_visibility(std::span<const FeatureSegment> segme
                 // between two samples is found by bisection.
                 const float image_length = portable::hypot(c.b.x - c.a.x, c.b.y - c.a.y);
                 const float span = c.s_hi - c.s_lo;
+                // A piece whose image is not finite (coordinates beyond a float's range) is
+                // sampled once, and no piece more than a million times.
+                const float steps = image_length * span / settings.step;
                 const int n =
-                    std::max(1, static_cast<int>(std::ceil(image_length * span / settings.step)));
+                    std::isfinite(steps)
+                        ? std::max(1, static_cast<int>(std::min(std::ceil(steps), 1.0e6f)))
+                        : 1;
                 auto sample_s = [&](int k) {
                     return c.s_lo + span * (static_cast<float>(k) + 0.5f) / static_cast<float>(n);
                 };
