@@ -290,8 +290,9 @@ TEST(Tone, ScreentoneDotsCoverTheirCellsDarknessWithinThreePercent) {
               y_first = 360 - g / 2 - g * (360 / g - 1);
     std::vector<int> cells(ramp.levels.size(), 0);
     double worst = 0.0;
-    for (int y0 = y_first; y0 + 2 * g <= l.tone.height(); y0 += g)
-        for (int x0 = x_first; x0 + 2 * g <= l.tone.width(); x0 += g) {
+    // From the second cell: every cell looked at has its neighbours in the image.
+    for (int y0 = y_first + g; y0 + 2 * g <= l.tone.height(); y0 += g)
+        for (int x0 = x_first + g; x0 + 2 * g <= l.tone.width(); x0 += g) {
             // A cell whose neighbours are in its band too: the dots that spill into it are as
             // large as its own spills out.
             const int band = l.band(x0, y0);
