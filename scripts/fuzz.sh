@@ -1,23 +1,25 @@
 #!/usr/bin/env bash
-# Builds the libFuzzer targets (fuzz/, clang with ASan + UBSan) and runs each for a while.
+# Builds the libFuzzer targets (fuzz/) in build-clang/ (the `clang` preset: clang-14 with ASan,
+# UBSan and libFuzzer's coverage; scripts/sanitize.sh runs the unit tests in the same build) and
+# runs each for a while.
 #
 #   scripts/fuzz.sh [SECONDS] [TARGET...]
 #
 # SECONDS per target (default 60); TARGETs default to all: obj mtl camera note_script midi
-# camera_path options png render shading line_style settings. Before fuzzing, every target replays its seeds and the inputs
-# that once crashed it (tests/robustness/data/fuzz/TARGET). Fails (exit 1) on any crash, leak,
-# timeout (an input running over TOONRAY_FUZZ_TIMEOUT, 10 s) or out-of-memory (over 2 GiB) and leaves the input in
-# BUILD_DIR/artifacts/TARGET/; replay it with `BUILD_DIR/fuzz_TARGET FILE`. Ends with a summary:
-# per target the time, executions, executions per second, corpus size and result.
+# camera_path options png render shading gltf glb line_style settings tone. Before fuzzing,
+# every target replays its seeds and the inputs that once crashed it
+# (tests/robustness/data/fuzz/TARGET). Fails (exit 1) on any crash, leak, timeout (an input
+# running over TOONRAY_FUZZ_TIMEOUT, 10 s) or out-of-memory (over 2 GiB) and leaves the input in
+# build-clang/artifacts/TARGET/; replay it with `build-clang/fuzz/fuzz_TARGET FILE`. Ends with a
+# summary: per target the time, executions, executions per second, corpus size and result.
 #
-# CI (scripts/test.sh) runs every target for 45 s, two at a time. For long runs on a shared
+# CI (scripts/test.sh) runs every target for 20 s, two at a time. For long runs on a shared
 # machine, take only idle CPU: `TOONRAY_FUZZ_TIMEOUT=60 nice -n 19 scripts/fuzz.sh 1800 obj render midi`.
 #
-# Environment: TOONRAY_FUZZ_BUILD_DIR (default build-fuzz), TOONRAY_FUZZ_PARALLEL (targets run
-# at once, default: the number of cores), TOONRAY_FUZZ_TIMEOUT (seconds one input may run,
-# default 10; libFuzzer measures wall time, so a niced run on a busy machine wants 60),
-# CXX (default clang++-14, else clang++).
-# The working corpus grows in BUILD_DIR/corpus/TARGET and is kept between runs; the committed
+# Environment: TOONRAY_FUZZ_PARALLEL (targets run at once, default: the number of cores),
+# TOONRAY_FUZZ_TIMEOUT (seconds one input may run, default 10; libFuzzer measures wall time, so
+# a niced run on a busy machine wants 60).
+# The working corpus grows in build-clang/corpus/TARGET and is kept between runs; the committed
 # seeds in fuzz/corpus/TARGET are never written.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -27,25 +29,24 @@ shift || true
 all_targets=(obj mtl camera note_script midi camera_path options png render shading gltf glb line_style settings tone)
 targets=("$@")
 [ ${#targets[@]} -gt 0 ] || targets=("${all_targets[@]}")
-build=${TOONRAY_FUZZ_BUILD_DIR:-build-fuzz}
+build=build-clang
 parallel=${TOONRAY_FUZZ_PARALLEL:-$(nproc)}
 timeout=${TOONRAY_FUZZ_TIMEOUT:-10}
 
-if [ -z "${CXX:-}" ]; then
-  if command -v clang++-14 >/dev/null; then CXX=clang++-14; else CXX=clang++; fi
-fi
-command -v "$CXX" >/dev/null || {
-  echo "fuzz: $CXX not found; install clang-14 libclang-rt-14-dev llvm-14 (scripts/install-deps.sh does)" >&2
+command -v clang++-14 >/dev/null || {
+  echo "fuzz: clang++-14 not found; install clang-14 libclang-rt-14-dev llvm-14 (scripts/install-deps.sh does)" >&2
   exit 1
 }
 
-echo "fuzz: building the fuzzers in $build with $CXX"
+echo "fuzz: building the fuzzers in $build (the clang preset, as scripts/sanitize.sh)"
 mkdir -p "$build"
 # Runs of different targets may share the build directory (a long run of some targets while
 # others are fuzzed); one build at a time, so that two ninjas never write the same files.
 exec 9>"$build/build.lock"
 flock 9
-cmake -S fuzz -B "$build" -G Ninja -DCMAKE_CXX_COMPILER="$CXX" >/dev/null
+launcher=()
+if command -v ccache >/dev/null; then launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache); fi
+cmake --preset clang "${launcher[@]}" >/dev/null
 # Build output only on failure: the build is long and its warnings are the main build's.
 if ! ninja -C "$build" -j "$(nproc)" $(printf 'fuzz_%s ' "${targets[@]}") >"$build/build.log" 2>&1; then
   tail -50 "$build/build.log" >&2
@@ -79,7 +80,7 @@ run_target() {
   local start result=ok
   start=$(date +%s)
   # Only the first directory (the working corpus) receives new inputs.
-  "$build/fuzz_$t" -max_total_time="$seconds" -max_len=8192 -timeout="$timeout" -rss_limit_mb=2048 -malloc_limit_mb=2048 \
+  "$build/fuzz/fuzz_$t" -max_total_time="$seconds" -max_len=8192 -timeout="$timeout" -rss_limit_mb=2048 -malloc_limit_mb=2048 \
     -print_final_stats=1 -artifact_prefix="$artifacts/" "${dict[@]}" "${inputs[@]}" >"$log" 2>&1 || result=FAILED
   local elapsed=$(($(date +%s) - start)) runs rate
   runs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)

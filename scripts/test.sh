@@ -1,18 +1,16 @@
 #!/usr/bin/env bash
 # The README's test command (and CI's): installs dependencies, builds, and runs every test; then
-# the portability checks of docs/cluster.md ("Mixed clusters"): a clang-14 build and its unit
-# tests, the aarch64 cross build and its unit tests under qemu, and the same frames from every
-# build and x86 kernel, byte for byte (scripts/compare-frames.sh); then the hardening checks of
+# the portability checks of docs/cluster.md ("Mixed clusters"): the aarch64 cross build and its
+# unit tests under qemu, and the same frames from every build and x86 kernel, byte for byte
+# (scripts/compare-frames.sh); then the clang-14 build, which is also the hardening build of
 # docs/robustness.md: the unit-test suite under ASan + UBSan (scripts/sanitize.sh) and every
 # fuzz target for a short while (scripts/fuzz.sh), which also replays the inputs that once
 # crashed them. Every build treats warnings as errors (TOONRAY_WARNINGS_AS_ERRORS).
 #
-# Environment: TOONRAY_BUILD_DIR (default build), TOONRAY_ASAN_BUILD_DIR (build-asan),
-# TOONRAY_FUZZ_BUILD_DIR (build-fuzz); TOONRAY_TEST_PORTABILITY=0 skips the clang, aarch64 and
-# frame comparison stages (the presets' build-clang and build-aarch64); TOONRAY_FUZZ_SECONDS, each target's fuzzing time (default
-# 45: thirteen targets, two at a time, about 5 minutes); TOONRAY_TEST_HARDENING=0 skips the
-# sanitizer and fuzz stages (15 to 20 minutes on an idle 2-core machine, mostly building) for a
-# quick local run.
+# Environment: TOONRAY_BUILD_DIR (default build); TOONRAY_TEST_PORTABILITY=0 skips the aarch64
+# and frame comparison stages (the aarch64 preset's build-aarch64); TOONRAY_FUZZ_SECONDS, each
+# target's fuzzing time (default 20: fifteen targets, two at a time, under 3 minutes);
+# TOONRAY_TEST_HARDENING=0 skips the clang stage (build-clang) for a quick local run.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -35,12 +33,7 @@ stage_done "the tests"
 if [ "${TOONRAY_TEST_PORTABILITY:-1}" != 0 ]; then
   launcher=()
   if command -v ccache >/dev/null; then launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache); fi
-  # (a) clang 14: the whole project and the unit tests (the presets leave out slurm|blender).
-  cmake --preset clang "${launcher[@]}" >/dev/null
-  cmake --build --preset clang --parallel "$(nproc)"
-  ctest --preset clang --parallel "$(nproc)"
-  stage_done "the clang-14 build and unit tests"
-  # (b) aarch64: cross g++ and every unit test under qemu-aarch64 (the preset leaves out
+  # (a) aarch64: cross g++ and every unit test under qemu-aarch64 (the preset leaves out
   # slurm|blender, as the others do; PortableMath.FloatCorrectlyRounded, whose long double
   # reference is software quad precision on aarch64 and too slow under emulation; and
   # Batch.MemoryStaysFlatOverThousandsOfFrames, which fails under qemu-aarch64: peak RSS grows
@@ -49,22 +42,23 @@ if [ "${TOONRAY_TEST_PORTABILITY:-1}" != 0 ]; then
   # which test no CPU-dependent arithmetic of their own: BatchCli.InterruptStopsCleanlyAndResume-
   # Completes (227 s: waits for frames to start and stop) and the two ink visibility checks
   # against brute-force rays (126 and 134 s; the ink frames themselves are compared byte for
-  # byte with x86's in stage (c)).
+  # byte with x86's in stage (b)).
   cmake --preset aarch64 "${launcher[@]}" >/dev/null
   cmake --build --preset aarch64 --parallel "$(nproc)"
   ctest --preset aarch64 --parallel "$(nproc)"
   stage_done "the aarch64 cross build and its tests under qemu"
-  # (c) The same frames from every x86 kernel the CPU runs and from the aarch64 build under
+  # (b) The same frames from every x86 kernel the CPU runs and from the aarch64 build under
   # qemu-aarch64, byte for byte.
   bash scripts/compare-frames.sh "${TOONRAY_BUILD_DIR:-build}" build-aarch64
   stage_done "the frame comparison"
 fi
 
 if [ "${TOONRAY_TEST_HARDENING:-1}" = 0 ]; then
-  echo "test: sanitizer and fuzz stages skipped (TOONRAY_TEST_HARDENING=0)"
+  echo "test: the clang stage (sanitizers and fuzzing) skipped (TOONRAY_TEST_HARDENING=0)"
   exit 0
 fi
+# One clang-14 build for the unit tests under the sanitizers and for the fuzzers.
 bash scripts/sanitize.sh
-stage_done "the sanitizer build and tests"
-bash scripts/fuzz.sh "${TOONRAY_FUZZ_SECONDS:-45}"
-stage_done "the fuzzer build and fuzzing"
+stage_done "the clang-14 build (ASan + UBSan) and its unit tests"
+bash scripts/fuzz.sh "${TOONRAY_FUZZ_SECONDS:-20}"
+stage_done "fuzzing"
