@@ -120,6 +120,14 @@ TEST(Settings, ErrorsNameTheFileThePlaceAndTheKey) {
     EXPECT_EQ(error("lines = 3\n"), "bad.toml:1:1: unknown key 'lines'");
     const std::string syntax = error("[lines\nwidth = 2\n");
     EXPECT_EQ(syntax.rfind("bad.toml:1:", 0), 0u) << syntax;
+    // Characters the TOML reader mishandles are refused before it sees them (found by fuzzing).
+    EXPECT_EQ(error("[lines]\nwidth = 2 # \xc3\xa9\n"),
+              "bad.toml:2:13: a character that is not ASCII (settings documents are ASCII; a "
+              ".style file can name other objects)");
+    EXPECT_EQ(error(std::string("[\0\x13]\n", 5)),
+              "bad.toml:1:2: control character 0x00 (TOML allows none but the tab)");
+    EXPECT_EQ(error("[lines]\r\n\twidth = 2\x7f\n"),
+              "bad.toml:2:11: control character 0x7f (TOML allows none but the tab)");
 }
 
 TEST(Settings, OutputsRecordOnlyWhatCanChangeThePicture) {
