@@ -60,6 +60,8 @@ struct MeshData {
     std::vector<Vec2f> uvs;
     std::vector<std::uint32_t> materials;
     const void* scene = nullptr;  ///< the PyScene it belongs to (its material ids are that scene's)
+    /// Its index in the scene's meshes (Scene::meshes) once an instance placed it.
+    std::uint32_t scene_mesh = kNoIndex;
 };
 
 /// The module's Scene: the library's scene with its own camera and lights.

@@ -13,6 +13,7 @@
 #include "toonray/anim/frame_scheduler.h"
 #include "toonray/core/error.h"
 #include "toonray/core/limits.h"
+#include "toonray/core/saturating.h"
 #include "toonray/frame/feature_exr.h"
 #include "toonray/frame/frame_renderer.h"
 #include "toonray/io/png.h"
@@ -119,6 +120,8 @@ std::shared_ptr<FrameData> PyRenderer::render(PyScene& py_scene, int width, int 
     options.keep_strokes = svg;
     (void)plan_frame_jobs(options, 1, 1);
     check_scene_limits(py_scene.scene, limits());
+    // Instances count into the memory estimate, as a glTF file's do when it is loaded.
+    check_memory(add_saturated(limits().reserved_memory, scene_bytes(py_scene.scene)), "the scene");
     const SceneSetup setup = settings.scene_setup();
     const CameraSpec camera = view ? view->spec(width, height) : py_scene.frame_camera(setup);
     validate_camera(camera);

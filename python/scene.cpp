@@ -117,16 +117,28 @@ std::shared_ptr<MeshData> make_mesh(PyScene& self, const py::object& positions,
     return mesh;
 }
 
-std::uint32_t add_instance(PyScene& self, const MeshData& mesh, const py::object& matrix,
+MeshArrays arrays_of(const MeshData& mesh) {
+    return MeshArrays{mesh.positions, mesh.triangles, mesh.normals, mesh.uvs, mesh.materials};
+}
+
+// An instance of `mesh`: the mesh is stored in the scene once, at its first instance.
+std::uint32_t add_instance(PyScene& self, MeshData& mesh, const py::object& matrix,
                            const std::optional<std::string>& name) {
     self.check_not_rendering();
     if (mesh.scene != &self)
         throw py::value_error("add_instance: the mesh belongs to another scene");
-    // Instances are copies of their mesh for now: the accelerator is one level.
-    return append_mesh(
-        self.scene,
-        MeshArrays{mesh.positions, mesh.triangles, mesh.normals, mesh.uvs, mesh.materials},
-        affine_of(matrix), name ? *name : mesh.name);
+    const Affine a = affine_of(matrix);
+    std::array<double, 16> rows{};
+    for (std::size_t r = 0; r < 3; ++r)
+        for (std::size_t c = 0; c < 4; ++c) rows[4 * r + c] = a[r][c];
+    rows[15] = 1.0;
+    const Affine3 to_world = Affine3::from_row_major(rows);
+    if (mesh.scene_mesh == kNoIndex)
+        mesh.scene_mesh = self.scene.add_mesh(
+            instance_mesh(arrays_of(mesh), self.scene.materials.size(), mesh.name));
+    const std::uint32_t instance =
+        self.scene.add_instance(mesh.scene_mesh, to_world, name ? *name : mesh.name);
+    return self.scene.instances[instance].object;
 }
 
 SensorFit sensor_fit(const std::string& text) {
@@ -347,26 +359,29 @@ void bind_scene(py::module_& m) {
             "and materials (t,) of material indices.")
         .def(
             "add_instance",
-            [](PyScene& self, const MeshData& mesh, const py::object& matrix,
+            [](PyScene& self, MeshData& mesh, const py::object& matrix,
                const std::optional<std::string>& name) {
                 return add_instance(self, mesh, matrix, name);
             },
             py::arg("mesh"), py::arg("matrix") = py::none(), py::arg("name") = py::none(),
             "Places `mesh` with a 4x4 matrix (mesh to world; None: identity) as an object named "
-            "`name` (default: the mesh's); returns the object's index.")
+            "`name` (default: the mesh's); returns the object's index. The mesh is stored once "
+            "however often it is placed: an instance is a transform and a name.")
         .def(
             "add_object",
             [](PyScene& self, const py::object& positions, const py::object& triangles,
                const py::object& normals, const py::object& uvs, const py::object& materials,
                std::string name, const py::object& matrix) {
+                self.check_not_rendering();
                 const auto mesh =
                     make_mesh(self, positions, triangles, normals, uvs, materials, name);
-                return add_instance(self, *mesh, matrix, std::nullopt);
+                return append_mesh(self.scene, arrays_of(*mesh), affine_of(matrix), mesh->name);
             },
             py::arg("positions"), py::arg("triangles"), py::arg("normals") = py::none(),
             py::arg("uvs") = py::none(), py::arg("materials") = py::none(),
             py::arg("name") = "object", py::arg("matrix") = py::none(),
-            "add_mesh and one add_instance of it; returns the object's index.")
+            "A mesh placed once, as the scene's own triangles (moved by `matrix`; the "
+            "`positions` and `triangles` arrays hold them); returns the object's index.")
         .def_property(
             "camera",
             [](const PyScene& self) -> std::optional<PyCamera> {
@@ -392,10 +407,20 @@ void bind_scene(py::module_& m) {
         .def_property_readonly("objects", [](const PyScene& self) { return self.scene.objects; })
         .def_readonly("warnings", &PyScene::warnings,
                       "What loading reported without failing (a missing MTL file, ...)")
-        .def_property_readonly("triangle_count",
-                               [](const PyScene& self) { return self.scene.triangle_count(); })
+        .def_property_readonly(
+            "triangle_count", [](const PyScene& self) { return self.scene.triangle_count(); },
+            "The scene's own triangles (loaded files' and add_object's), which the arrays "
+            "below hold; instances' are in instanced_triangle_count.")
         .def_property_readonly("vertex_count",
                                [](const PyScene& self) { return self.scene.positions.size(); })
+        .def_property_readonly(
+            "instance_count", [](const PyScene& self) { return self.scene.instances.size(); },
+            "How many instances add_instance (or a glTF file) placed.")
+        .def_property_readonly(
+            "instanced_triangle_count",
+            [](const PyScene& self) { return self.scene.instanced_triangle_count(); },
+            "The instances' triangles, each counted once per instance (triangle_count and the "
+            "arrays are the scene's own).")
         .def_property_readonly(
             "positions",
             [](const PyScene& self) {

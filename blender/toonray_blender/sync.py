@@ -283,7 +283,7 @@ def sync_depsgraph(tr, depsgraph, camera=None, clip=None):
             out.occluders.append(obj.name)
     out.material_pass_index = materials.pass_index
     out.material_names = materials.names
-    out.triangles = scene.triangle_count
+    out.triangles = scene.triangle_count + scene.instanced_triangle_count
     out.meshes = sum(1 for m in meshes.meshes.values() if m is not None)
     if geometry_bounds:
         allb = np.concatenate(geometry_bounds)

@@ -89,21 +89,53 @@ class Frames(unittest.TestCase):
         # The instance placed at half size is smaller in the picture.
         self.assertGreater((ids == left).sum(), 2 * (ids == right).sum())
 
-    def test_instances_are_their_mesh_moved(self):
+    def test_instances_store_their_mesh_once(self):
         scene, left, right = two_cubes()
-        positions = scene.positions
-        objects = scene.triangle_objects
-        self.assertEqual(scene.triangle_count, 24)
-        self.assertTrue((objects[:12] == left).all() and (objects[12:] == right).all())
-        p, _ = cube()
-        np.testing.assert_array_equal(positions[:8], p + np.float32([-1, 0, 0]))
-        np.testing.assert_array_equal(positions[8:], p * 0.5 + np.float32([1, 0, 0]))
-        # A mirrored instance keeps its faces facing out: the same picture as the plain one.
-        a, b = toonray.Scene(), toonray.Scene()
-        for s, m in ((a, np.eye(4)), (b, np.diag([-1.0, 1.0, 1.0, 1.0]))):
-            s.add_object(p, _, name="c", matrix=m)
-            s.camera = toonray.Camera((0, -4, 0.5), (0, 0, 0), up=(0, 0, 1))
-        self.assertEqual(toonray.render(a, 64, 64).png(), toonray.render(b, 64, 64).png())
+        self.assertEqual(scene.instance_count, 2)
+        self.assertEqual(scene.instanced_triangle_count, 24)
+        # Nothing of the instances is copied into the scene's own triangles.
+        self.assertEqual(scene.triangle_count, 0)
+        self.assertEqual(scene.positions.shape, (0, 3))
+        # A mesh never placed is not in the scene at all.
+        scene.add_mesh(*cube(), name="unused")
+        self.assertEqual(scene.instanced_triangle_count, 24)
+
+    def test_instances_draw_as_their_mesh_moved(self):
+        # The same cubes placed once each as the scene's own triangles (add_object moves the
+        # arrays into the world) draw the same picture: instances are traced in the mesh's own
+        # coordinates, so a pixel whose sample grazes an edge may fall on its other side.
+        instanced, left, right = two_cubes()
+        flat = toonray.Scene()
+        red = flat.add_material(toonray.Material("red", kd=(0.9, 0.1, 0.1)))
+        p, t = cube()
+        materials = np.full(12, red, dtype=np.uint32)
+        self.assertEqual(flat.add_object(p, t, materials=materials, name="left",
+                                         matrix=translation(-1, 0, 0)), left)
+        self.assertEqual(flat.add_object(p, t, materials=materials, name="cube",
+                                         matrix=translation(1, 0, 0, scale=0.5)), right)
+        flat.camera = instanced.camera
+        np.testing.assert_array_equal(flat.positions[:8], p + np.float32([-1, 0, 0]))
+        a = toonray.render(instanced, 120, 80, {"lines.width": 4})
+        b = toonray.render(flat, 120, 80, {"lines.width": 4})
+        self.assertEqual(a.object_ids.shape, b.object_ids.shape)
+        self.assertGreater((a.object_ids == b.object_ids).mean(), 0.99)
+        self.assertGreater((a.image == b.image).all(axis=2).mean(), 0.99)
+        self.assertEqual({s.object for s in a.strokes}, {s.object for s in b.strokes})
+        # A mirrored instance or object keeps its faces facing out: the same picture as the
+        # plain one (the cube is symmetric).
+        pictures = []
+        for instance in (False, True):
+            for m in (np.eye(4), np.diag([-1.0, 1.0, 1.0, 1.0])):
+                s = toonray.Scene()
+                if instance:
+                    s.add_instance(s.add_mesh(p, t, name="c"), m)
+                else:
+                    s.add_object(p, t, name="c", matrix=m)
+                s.camera = toonray.Camera((0, -4, 0.5), (0, 0, 0), up=(0, 0, 1))
+                pictures.append(toonray.render(s, 64, 64).image)
+        self.assertTrue((pictures[0] == pictures[1]).all())
+        self.assertGreater((pictures[2] == pictures[3]).all(axis=2).mean(), 0.99)
+        self.assertGreater((pictures[0] == pictures[2]).all(axis=2).mean(), 0.99)
 
     def test_strokes_and_svg(self):
         scene, left, right = two_cubes()
@@ -166,6 +198,21 @@ class Frames(unittest.TestCase):
             toonray.render(scene, 100, 100, {"limits.image_pixels": "9999"})
         # The limits are the settings', for each render: the next one is not limited.
         toonray.render(scene, 32, 32)
+
+    def test_limits_count_an_instanced_mesh_once(self):
+        scene = toonray.Scene()
+        p, t = cube()
+        mesh = scene.add_mesh(p, t)
+        for i in range(10):
+            scene.add_instance(mesh, translation(2 * i, 0, 0))
+        self.assertEqual(scene.instanced_triangle_count, 120)
+        frame = toonray.render(scene, 96, 32, {"limits.triangles": "12"})
+        self.assertEqual(len(np.unique(frame.object_ids)), 11)  # 10 cubes and the background
+        scene.add_object(p, t)
+        with self.assertRaises(toonray.LimitError) as caught:
+            toonray.render(scene, 96, 32, {"limits.triangles": "12"})
+        self.assertEqual(str(caught.exception), "the scene has 24 triangles, more than the limit "
+                                                "of 12 (limits.triangles raises it)")
 
 
 class ProgressAndCancel(unittest.TestCase):

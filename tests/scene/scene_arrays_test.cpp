@@ -185,3 +185,45 @@ TEST(CheckSceneLimits, TrianglesAndPositions) {
         EXPECT_STREQ(e.what(), "the scene has 4 vertex positions, more than the limit of 3");
     }
 }
+
+TEST(CheckSceneLimits, AnInstancedMeshCountsOnce) {
+    Scene s = with_material();
+    const std::uint32_t mesh =
+        s.add_mesh(instance_mesh(Square{}.arrays(), s.materials.size(), "square"));
+    for (int i = 0; i < 100; ++i)
+        s.add_instance(mesh, Affine3::translation({static_cast<float>(i), 0, 0}), "copy");
+    EXPECT_EQ(s.instanced_triangle_count(), 200u);
+    Limits limits;
+    limits.max_triangles = 2;
+    limits.max_vertices = 4;
+    EXPECT_NO_THROW(check_scene_limits(s, limits));
+    // The scene's own triangles count as well as the meshes'.
+    append_mesh(s, Square{}.arrays(), kIdentityAffine, "own");
+    try {
+        check_scene_limits(s, limits);
+        FAIL() << "no limit error";
+    } catch (const LimitError& e) {
+        EXPECT_STREQ(e.what(), "the scene has 4 triangles, more than the limit of 2");
+    }
+}
+
+TEST(InstanceMesh, IsWhatTheIdentityAppends) {
+    const Square square;
+    Scene appended = with_material();
+    append_mesh(appended, square.arrays(), kIdentityAffine, "a");
+    const auto mesh = instance_mesh(square.arrays(), appended.materials.size(), "a");
+    EXPECT_EQ(mesh->positions, appended.positions);
+    EXPECT_EQ(mesh->normals, appended.normals);
+    ASSERT_EQ(mesh->texcoords.size(), appended.texcoords.size());
+    for (std::size_t i = 0; i < mesh->texcoords.size(); ++i)
+        EXPECT_TRUE(mesh->texcoords[i].x == appended.texcoords[i].x &&
+                    mesh->texcoords[i].y == appended.texcoords[i].y);
+    EXPECT_EQ(mesh->tri_positions, appended.tri_positions);
+    EXPECT_EQ(mesh->tri_normals, appended.tri_normals);
+    EXPECT_EQ(mesh->tri_texcoords, appended.tri_texcoords);
+    EXPECT_EQ(mesh->tri_material, appended.tri_material);
+    // A scene with these materials takes it; the materials are checked against the count given.
+    Scene s = with_material();
+    EXPECT_EQ(s.add_mesh(mesh), 0u);
+    EXPECT_THROW((void)instance_mesh(square.arrays(), 1, "a"), Error);
+}

@@ -1,5 +1,6 @@
 #include "toonray/scene/scene_arrays.h"
 
+#include <algorithm>
 #include <cmath>
 #include <fmt/format.h>
 
@@ -140,15 +141,29 @@ std::uint32_t append_mesh(Scene& scene, const MeshArrays& mesh, const Affine& m,
     return object;
 }
 
+std::shared_ptr<const TriangleMesh> instance_mesh(const MeshArrays& mesh,
+                                                  std::size_t material_count,
+                                                  std::string_view name) {
+    // append_mesh's material check needs the materials to exist; their contents do not matter.
+    Scene scene;
+    scene.materials.assign(std::max<std::size_t>(material_count, 1), Material{"(default)"});
+    append_mesh(scene, mesh, kIdentityAffine, std::string(name));
+    return std::make_shared<const TriangleMesh>(std::move(static_cast<TriangleMesh&>(scene)));
+}
+
 void check_scene_limits(const Scene& scene, const Limits& limits) {
-    if (scene.triangle_count() > limits.max_triangles)
+    // What is stored: an instanced mesh once, however often it is placed.
+    std::uint64_t positions = scene.positions.size();
+    for (const auto& mesh : scene.meshes) positions += mesh->positions.size();
+    const std::uint64_t triangles = scene.stored_triangle_count();
+    if (triangles > limits.max_triangles)
         throw LimitError(Limit::Triangles,
                          fmt::format("the scene has {} triangles, more than the limit of {}",
-                                     scene.triangle_count(), limits.max_triangles));
-    if (scene.positions.size() > limits.max_vertices)
+                                     triangles, limits.max_triangles));
+    if (positions > limits.max_vertices)
         throw LimitError(Limit::Vertices,
                          fmt::format("the scene has {} vertex positions, more than the limit of {}",
-                                     scene.positions.size(), limits.max_vertices));
+                                     positions, limits.max_vertices));
 }
 
 }  // namespace toonray

@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <string>
 #include <string_view>
@@ -48,9 +49,17 @@ void check_mesh(const MeshArrays& mesh, std::size_t material_count, std::string_
 std::uint32_t append_mesh(Scene& scene, const MeshArrays& mesh, const Affine& to_world,
                           std::string name);
 
-/// Throws LimitError when `scene` has more triangles or vertex positions than `limits` allow
-/// (max_triangles, max_vertices), in the words of the loaders: "the scene has N triangles, more
-/// than the limit of M".
+/// `mesh` (checked with check_mesh against `material_count` materials) as a mesh for instances
+/// (Scene::add_mesh), in its own coordinates: the triangles append_mesh would append to an empty
+/// scene with the identity transform, so that an instance of it placed by M and the mesh
+/// appended by M are the same triangles (the instance's are transformed as it is traced).
+[[nodiscard]] std::shared_ptr<const TriangleMesh> instance_mesh(const MeshArrays& mesh,
+                                                                std::size_t material_count,
+                                                                std::string_view name);
+
+/// Throws LimitError when `scene` stores more triangles or vertex positions than `limits` allow
+/// (max_triangles, max_vertices; an instanced mesh counts once), in the words of the loaders:
+/// "the scene has N triangles, more than the limit of M".
 void check_scene_limits(const Scene& scene, const Limits& limits);
 
 }  // namespace toonray
