@@ -7,7 +7,7 @@
 //
 // Usage: toonray_ink_bench [--repeats N] [--size WxH] [--out DIR] [--quick] [--previous PREV.obj]
 //        [--lines-only] scene.obj ...
-//        toonray_ink_bench --make-scan OUT.obj
+//        toonray_ink_bench --make-scan OUT.obj [--scan-splits N]
 // With --previous, each scene is also timed as the next frame of an animation after PREV.obj
 // (ink at 1 sample, the intersection lines of unmoved triangles kept from PREV.obj).
 // With no scenes: tests/data/teapot.obj. --quick runs each stage once and checks that the
@@ -17,7 +17,9 @@
 // --toggle-collect='*next_frame_lines*' the frames after PREV.obj. --make-scan writes the
 // 70k-triangle scan of docs/ink.md: tests/data/spot.obj with each triangle split into 4 at its
 // edges' midpoints (shared), then into 3 at its centroid (70,272 triangles, shared vertices, no
-// normals), with a camera block.
+// normals), with a camera block. --scan-splits N splits into 4 N times before the split into 3
+// (default 1): 2 gives 281,088 triangles, 3 gives 1,124,352, 4 gives 4,497,408, 5 gives
+// 17,989,632 (the sizes docs/performance.md measures the ink lines at).
 
 #include <fmt/format.h>
 
@@ -104,7 +106,7 @@ std::string ms(double s) { return fmt::format("{:.1f} ms", s * 1e3); }
 
 // --make-scan: a scan-like mesh from spot.obj (see the top of this file), computed in double
 // and written with six decimals.
-void make_scan(const fs::path& out_path) {
+void make_scan(const fs::path& out_path, int splits) {
     using P = std::array<double, 3>;
     std::vector<P> v;
     std::vector<std::array<std::size_t, 3>> faces;
@@ -134,11 +136,16 @@ void make_scan(const fs::path& out_path) {
         return it->second;
     };
     std::vector<std::array<std::size_t, 3>> quarters;
-    for (const auto& [a, b, c] : faces) {
-        const std::size_t ab = midpoint(a, b), bc = midpoint(b, c), ca = midpoint(c, a);
-        for (const auto& q : {std::array{a, ab, ca}, std::array{ab, b, bc}, std::array{ca, bc, c},
-                              std::array{ab, bc, ca}})
-            quarters.push_back(q);
+    for (int split = 0; split < splits; ++split) {
+        quarters.clear();
+        for (const auto& [a, b, c] : faces) {
+            const std::size_t ab = midpoint(a, b), bc = midpoint(b, c), ca = midpoint(c, a);
+            for (const auto& q : {std::array{a, ab, ca}, std::array{ab, b, bc},
+                                  std::array{ca, bc, c}, std::array{ab, bc, ca}})
+                quarters.push_back(q);
+        }
+        faces = quarters;
+        midpoints.clear();
     }
     auto fixed6 = [](const char* tag, const P& p) {  // as printf's %.6f rounds
         char buffer[128];
@@ -411,6 +418,8 @@ int run(const Options& options) {
 int main(int argc, char** argv) {
     using namespace toonray::bench;
     Options options;
+    std::optional<fs::path> make_scan_path;
+    int scan_splits = 1;
     try {
         for (int i = 1; i < argc; ++i) {
             const std::string arg = argv[i];
@@ -428,12 +437,16 @@ int main(int argc, char** argv) {
             } else if (arg == "--out") options.out = value();
             else if (arg == "--quick") options.quick = true;
             else if (arg == "--lines-only") options.lines_only = true;
-            else if (arg == "--make-scan") {
-                make_scan(value());
-                return 0;
-            } else if (arg == "--previous") options.previous = value();
+            else if (arg == "--make-scan") make_scan_path = value();
+            else if (arg == "--scan-splits") scan_splits = std::stoi(value());
+            else if (arg == "--previous") options.previous = value();
             else if (!arg.empty() && arg[0] == '-') throw toonray::Error("unknown option " + arg);
             else options.scenes.emplace_back(arg);
+        }
+        if (make_scan_path) {
+            if (scan_splits < 1 || scan_splits > 5) throw toonray::Error("--scan-splits: 1 to 5");
+            make_scan(*make_scan_path, scan_splits);
+            return 0;
         }
         if (options.scenes.empty())
             options.scenes.emplace_back(TOONRAY_BENCH_DATA_DIR "/teapot.obj");
