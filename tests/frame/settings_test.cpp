@@ -126,6 +126,12 @@ TEST(Settings, ErrorsNameTheFileThePlaceAndTheKey) {
               ".style file can name other objects)");
     EXPECT_EQ(error(std::string("[\0\x13]\n", 5)),
               "bad.toml:1:2: control character 0x00 (TOML allows none but the tab)");
+    // A document that breaks one of the TOML reader's own checks is refused (found by fuzzing:
+    // with the checks off, clang may compile the reader as if they always held).
+    const std::string unfinished = error("[\nshadows = true\n");
+    EXPECT_EQ(unfinished.rfind("bad.toml: not a TOML document the reader can read (its check '", 0),
+              0u)
+        << unfinished;
     EXPECT_EQ(error("[lines]\r\n\twidth = 2\x7f\n"),
               "bad.toml:2:11: control character 0x7f (TOML allows none but the tab)");
 }

@@ -6,7 +6,27 @@
 #include <fmt/format.h>
 #include <map>
 
+#include <stdexcept>
+
+// toml++ states its parser's invariants with TOML_ASSERT_ASSUME: an assertion that aborts in a
+// build without NDEBUG, and in an optimised build an assumption that clang may compile as if it
+// always held (undefined behaviour when it does not). Fuzzing found documents that break one
+// (a table header whose '[' is followed by a line end). Here every invariant is checked and a
+// broken one throws, so such a document is refused instead.
+namespace toonray::detail {
+struct TomlInvariantBroken : std::runtime_error {
+    using std::runtime_error::runtime_error;
+};
+[[noreturn]] inline void toml_invariant_broken(const char* what) {
+    throw TomlInvariantBroken(what);
+}
+}  // namespace toonray::detail
+#pragma push_macro("NDEBUG")
+#undef NDEBUG
+#define TOML_ASSERT(expr) \
+    ((expr) ? static_cast<void>(0) : ::toonray::detail::toml_invariant_broken(#expr))
 #include <toml++/toml.h>
+#pragma pop_macro("NDEBUG")
 
 #include "toonray/core/error.h"
 #include "toonray/core/parse.h"
@@ -185,6 +205,11 @@ void read_settings(std::string_view text, std::string_view source, Settings& set
         table = toml::parse(text, source);
     } catch (const toml::parse_error& e) {
         throw Error(fmt::format("{}: {}", place(source, e.source()), e.description()));
+    } catch (const detail::TomlInvariantBroken& e) {
+        throw Error(
+            fmt::format("{}: not a TOML document the reader can read (its check '{}' "
+                        "failed; a table header may be unfinished)",
+                        source, e.what()));
     }
     read_table(table, "", source, settings);
 }
