@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "ink/ink_scenes.h"
+#include "toonray/ink/strokes.h"
 
 namespace toonray {
 namespace {
@@ -197,6 +198,48 @@ TEST(Visibility, SameForAnyThreadCount) {
             EXPECT_EQ(one[i].invisibility, many[i].invisibility);
         }
     }
+}
+
+TEST(Visibility, WithoutHiddenPiecesTheVisibleStrokesAreTheSame) {
+    // When nothing draws hidden lines, visibility keeps only the pieces chaining would draw:
+    // the strokes must not change. Random scenes have sub-pixel pieces between pieces of the
+    // other visibility, which chaining's rule settles (checked below, so the rule is exercised).
+    int settled_pieces = 0;
+    for (std::uint32_t seed : {11u, 12u, 13u}) {
+        Scene s = test_support::random_scene(300, seed);
+        const Frame f(std::move(s),
+                      CameraSpec{Vec3f(2.5f, 1.5f, 3.5f), Vec3f(1.8f, 1.1f, 2.5f),
+                                 normalize(Vec3f(-0.2f, 1.0f, -0.1f))},
+                      320, 240);
+        ink::VisibilitySettings settings;
+        settings.max_invisibility = 1;
+        const auto all = ink::split_by_visibility(f.segments, f.context(), settings, 2);
+        settings.keep_hidden = false;
+        const ink::ChainSettings chain;
+        settings.min_piece = chain.min_piece;
+        const auto drawn = ink::split_by_visibility(f.segments, f.context(), settings, 2);
+        EXPECT_LT(drawn.size(), all.size());
+        for (const ink::EdgePiece& p : drawn) EXPECT_TRUE(p.visible());
+        std::vector<char> visible;
+        for (std::size_t i = 0; i < all.size();) {
+            std::size_t j = i + 1;
+            while (j < all.size() && all[j].segment == all[i].segment) ++j;
+            ink::settle_sub_pixel_pieces(std::span(all).subspan(i, j - i), chain.min_piece,
+                                         visible);
+            for (std::size_t k = 0; k < visible.size(); ++k)
+                settled_pieces += static_cast<bool>(visible[k]) != all[i + k].visible();
+            i = j;
+        }
+        const auto a = ink::chain_pieces(all, chain, {});
+        const auto b = ink::chain_pieces(drawn, chain, {});
+        ASSERT_EQ(a.size(), b.size()) << seed;
+        for (std::size_t i = 0; i < a.size(); ++i) {
+            EXPECT_EQ(a[i].points, b[i].points) << seed << " stroke " << i;
+            EXPECT_EQ(a[i].closed, b[i].closed);
+            EXPECT_EQ(a[i].type, b[i].type);
+        }
+    }
+    EXPECT_GT(settled_pieces, 0);
 }
 
 TEST(Visibility, LinesOnTheFarSideOfClosedSolidsAreHiddenWithoutRays) {

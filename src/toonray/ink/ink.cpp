@@ -228,6 +228,9 @@ void draw_ink_lines(const Scene& scene, const TriangleAccel& accel, const Camera
     VisibilitySettings visibility = settings.visibility;
     if (!settings.chain.hidden)
         visibility.max_invisibility = std::min(visibility.max_invisibility, 1);
+    // Hidden pieces only when something draws them: the chain's rules keep none otherwise.
+    visibility.keep_hidden = chain.hidden;
+    visibility.min_piece = chain.min_piece;
     out.pieces = split_by_visibility(
         out.segments, VisibilityContext{scene, out.mesh, accel, view, &out.instances}, visibility,
         threads);

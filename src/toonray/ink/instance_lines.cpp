@@ -689,7 +689,10 @@ void add_instance_segments(const Scene& scene, const TriangleAccel& accel, const
 
     // Per instance, in chunks of instances joined in order.
     const Vec3f eye = view.eye();
-    std::vector<FeatureSegment> lines = gather_chunks<FeatureSegment>(
+    // The instances' lines are most of a crowd's segments: they are moved into `segments` last,
+    // once the rest is found, into room made for everything (append_parts), so that they are
+    // held about once rather than twice.
+    std::vector<std::vector<FeatureSegment>> lines = chunk_outputs<FeatureSegment>(
         static_cast<int>(count), 16, threads,
         [&](int i0, int i1, std::vector<FeatureSegment>& out) {
             std::vector<FeatureSegment> smooth;
@@ -705,9 +708,9 @@ void add_instance_segments(const Scene& scene, const TriangleAccel& accel, const
                                   options, out, smooth, edges_found);
             }
         });
-    segments.insert(segments.end(), lines.begin(), lines.end());
     if (!settings.intersections) {
         cache.pairs.clear();
+        append_parts(lines, segments);
         return;
     }
 
@@ -762,6 +765,7 @@ void add_instance_segments(const Scene& scene, const TriangleAccel& accel, const
     });
     cache.pairs = std::move(found);
 
+    std::vector<FeatureSegment> crossing_lines;
     for (const InstanceLineCache::Pair& pair : cache.pairs) {
         if (pair.crossings.empty()) continue;
         const Placement pa = place(scene, pair.a, pair.mesh_a.get(), eye);
@@ -769,17 +773,17 @@ void add_instance_segments(const Scene& scene, const TriangleAccel& accel, const
         for (const PairCrossing& pc : pair.crossings) {
             const bool hidden = pa.turned_away(pc.t) || pb.turned_away(pc.u);
             if (hidden && !settings.certainly_hidden) continue;
-            segments.push_back(crossing_segment(pc.crossing, pc.t, pc.u, pair.a, pair.b,
-                                                pair.mesh_a->welded, pair.mesh_b->welded, hidden));
+            crossing_lines.push_back(crossing_segment(pc.crossing, pc.t, pc.u, pair.a, pair.b,
+                                                      pair.mesh_a->welded, pair.mesh_b->welded,
+                                                      hidden));
         }
     }
     // The own triangles against each instance (in instance order). The own triangles' rule
     // for faces turned away is not applied here: those crossings are traced and found hidden.
     const Bvh& own_tree = accel.bvh();
-    if (own_tree.nodes.empty()) return;
-    const BBox own_box = grown(own_tree.nodes[0].bounds);
-    std::vector<std::vector<FeatureSegment>> own_pairs(count);
-    parallel_for(static_cast<int>(count), 16, threads, [&](int i0, int i1) {
+    std::vector<std::vector<FeatureSegment>> own_pairs(own_tree.nodes.empty() ? 0 : count);
+    const BBox own_box = own_tree.nodes.empty() ? BBox{} : grown(own_tree.nodes[0].bounds);
+    parallel_for(static_cast<int>(own_pairs.size()), 16, threads, [&](int i0, int i1) {
         std::vector<WorldTriangle> ta, tb;
         for (int i = i0; i < i1; ++i) {
             const auto b = static_cast<std::uint32_t>(i);
@@ -801,6 +805,10 @@ void add_instance_segments(const Scene& scene, const TriangleAccel& accel, const
             }
         }
     });
+    std::size_t more = crossing_lines.size();
+    for (const auto& part : own_pairs) more += part.size();
+    append_parts(lines, segments, more);
+    segments.insert(segments.end(), crossing_lines.begin(), crossing_lines.end());
     for (const auto& part : own_pairs) segments.insert(segments.end(), part.begin(), part.end());
 }
 

@@ -139,21 +139,8 @@ std::vector<Stroke> chain_pieces(std::span<const EdgePiece> pieces, const ChainS
     for (std::size_t i = 0; i < pieces.size();) {
         std::size_t j = i + 1;
         while (j < pieces.size() && pieces[j].segment == pieces[i].segment) ++j;
-        visible.clear();
-        for (std::size_t k = i; k < j; ++k) visible.push_back(pieces[k].visible());
+        settle_sub_pixel_pieces(pieces.subspan(i, j - i), settings.min_piece, visible);
         const std::size_t n = j - i;
-        if (n > 1)
-            for (std::size_t k = 0; k < n; ++k) {
-                const EdgePiece& p = pieces[i + k];
-                if (distance(p.s0, p.s1) >= settings.min_piece) continue;
-                const bool before = k > 0 ? visible[k - 1] : visible[k + 1];
-                const bool after = k + 1 < n ? visible[k + 1] : visible[k - 1];
-                // Only when cut from both sides, and contiguous with them (not cut by clipping).
-                const bool contiguous = (k == 0 || pieces[i + k - 1].t1 == p.t0) &&
-                                        (k + 1 == n || pieces[i + k + 1].t0 == p.t1);
-                if (before == after && before != static_cast<bool>(visible[k]) && contiguous)
-                    visible[k] = before;
-            }
         for (std::size_t k = 0; k < n; ++k) {
             const EdgePiece& p = pieces[i + k];
             if (!visible[k] && !settings.hidden) continue;

@@ -157,6 +157,25 @@ bool clip_to_view(const FeatureSegment& seg, const ScreenProjection& view, float
 
 }  // namespace
 
+void settle_sub_pixel_pieces(std::span<const EdgePiece> pieces, float min_piece,
+                             std::vector<char>& visible) {
+    const std::size_t n = pieces.size();
+    visible.clear();
+    for (const EdgePiece& p : pieces) visible.push_back(p.visible());
+    if (n < 2) return;
+    for (std::size_t k = 0; k < n; ++k) {
+        const EdgePiece& p = pieces[k];
+        if (portable::hypot(p.s0.x - p.s1.x, p.s0.y - p.s1.y) >= min_piece) continue;
+        const bool before = k > 0 ? visible[k - 1] : visible[k + 1];
+        const bool after = k + 1 < n ? visible[k + 1] : visible[k - 1];
+        // Only when cut from both sides, and contiguous with them (not cut by clipping).
+        const bool contiguous =
+            (k == 0 || pieces[k - 1].t1 == p.t0) && (k + 1 == n || pieces[k + 1].t0 == p.t1);
+        if (before == after && before != static_cast<bool>(visible[k]) && contiguous)
+            visible[k] = before;
+    }
+}
+
 std::vector<EdgePiece> split_by_visibility(std::span<const FeatureSegment> segments,
                                            const VisibilityContext& context,
                                            const VisibilitySettings& settings, int threads) {
@@ -166,6 +185,7 @@ std::vector<EdgePiece> split_by_visibility(std::span<const FeatureSegment> segme
         [&](int i0, int i1, std::vector<EdgePiece>& out) {
             out.reserve(static_cast<std::size_t>(i1 - i0));
             std::vector<float> cuts;
+            std::vector<char> settled;
             std::vector<int> states, sample_states;
             std::vector<Vec3f> dirs, points;
             std::vector<Hit> hits;
@@ -177,6 +197,7 @@ std::vector<EdgePiece> split_by_visibility(std::span<const FeatureSegment> segme
                 ClippedSegment c;
                 if (!clip_to_view(seg, view, settings.margin, c)) continue;
                 if (seg.certainly_hidden && settings.max_invisibility <= 1) {
+                    if (!settings.keep_hidden) continue;
                     // Hidden, and how deep does not matter: no rays.
                     EdgePiece piece;
                     piece.segment = static_cast<std::uint32_t>(i);
@@ -289,6 +310,7 @@ std::vector<EdgePiece> split_by_visibility(std::span<const FeatureSegment> segme
                 }
                 states.push_back(previous);
                 cuts.push_back(c.s_hi);
+                const std::size_t first = out.size();
                 for (std::size_t k = 0; k < states.size(); ++k) {
                     EdgePiece piece;
                     piece.segment = static_cast<std::uint32_t>(i);
@@ -314,6 +336,26 @@ std::vector<EdgePiece> split_by_visibility(std::span<const FeatureSegment> segme
                         piece.key1 = seg.key1;
                     }
                     out.push_back(piece);
+                }
+                if (!settings.keep_hidden) {
+                    // The visibility chaining would give each piece; then only the visible ones.
+                    // Tone strokes are drawn where they are seen, without chaining's rule: their
+                    // hidden pieces are dropped before it (ink.cpp).
+                    const auto mine = std::span(out).subspan(first);
+                    if (seg.type == EdgeType::Tone) {
+                        settled.clear();
+                        for (const EdgePiece& p : mine) settled.push_back(p.visible());
+                    } else {
+                        settle_sub_pixel_pieces(mine, settings.min_piece, settled);
+                    }
+                    std::size_t kept = first;
+                    for (std::size_t k = 0; k < mine.size(); ++k) {
+                        if (!settled[k]) continue;
+                        out[kept] = mine[k];
+                        out[kept].invisibility = 0;
+                        ++kept;
+                    }
+                    out.resize(kept);
                 }
             }
         });

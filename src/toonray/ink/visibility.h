@@ -27,6 +27,12 @@ struct VisibilitySettings {
     int max_invisibility = 255;
     /// Segments are clipped to the image grown by this many pixels on each side.
     float margin = 4.0f;
+    /// Whether hidden pieces are returned. Without them (when nothing draws hidden lines) a
+    /// crowd's pieces take a third of the memory; each segment's pieces then first take the
+    /// visibility of their neighbours as chaining would (settle_sub_pixel_pieces, with
+    /// `min_piece`), so that the visible lines are the same.
+    bool keep_hidden = true;
+    float min_piece = 1.0f;
 };
 
 /// A part of a feature segment with one visibility.
@@ -42,6 +48,13 @@ struct EdgePiece {
     int invisibility = 0;  ///< occluding surfaces, at most VisibilitySettings::max_invisibility
     [[nodiscard]] bool visible() const { return invisibility == 0; }
 };
+
+/// Chaining's rule for one segment's pieces (in order along it): a piece whose image is shorter
+/// than `min_piece` pixels, cut from both sides by pieces of the other visibility (or at an end
+/// of the segment, from its one side) and contiguous with them, takes their visibility.
+/// `visible` gets each piece's visibility after the rule.
+void settle_sub_pixel_pieces(std::span<const EdgePiece> pieces, float min_piece,
+                             std::vector<char>& visible);
 
 struct InstanceLineCache;
 
