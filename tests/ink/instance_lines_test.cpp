@@ -196,6 +196,75 @@ TEST(InstanceLines, StrokesTakeTheirInstancesObject) {
         }
 }
 
+bool same_piece(const EdgePiece& a, const EdgePiece& b) {
+    return a.segment == b.segment &&
+           std::bit_cast<std::uint32_t>(a.t0) == std::bit_cast<std::uint32_t>(b.t0) &&
+           std::bit_cast<std::uint32_t>(a.t1) == std::bit_cast<std::uint32_t>(b.t1) &&
+           bits(a.p0) == bits(b.p0) && bits(a.p1) == bits(b.p1) && a.key0 == b.key0 &&
+           a.key1 == b.key1 && a.type == b.type && a.invisibility == b.invisibility &&
+           std::memcmp(&a.s0, &b.s0, sizeof a.s0) == 0 &&
+           std::memcmp(&a.s1, &b.s1, sizeof a.s1) == 0;
+}
+
+// Visibility run chunk by chunk as the instances' segments are found gives the pieces that
+// visibility over all of them gives, with only the segments a piece lies on, numbered after
+// the segments already in the list.
+TEST(InstanceLines, VisibilityAsTheSegmentsAreFoundKeepsTheirPiecesOnly) {
+    // Four rows of the test scene's instances: more than one chunk of instances.
+    Scene scene = test_support::instanced_test_scene();
+    const std::size_t row = scene.instances.size();
+    for (int k = 1; k < 4; ++k)
+        for (std::size_t i = 0; i < row; ++i) {
+            Affine3 moved = scene.instances[i].to_world;
+            moved.m[2][3] -= 14.0 * k;
+            scene.add_instance(scene.instances[i].mesh, moved, scene.instances[i].object);
+        }
+    const TriangleAccel accel = build_scene_accel(scene);
+    const WeldedMesh own = weld_vertices(scene);
+    std::size_t dropped = 0, hidden_pieces = 0;
+    for (const Vec3f& eye : {Vec3f(9, 9, 16), Vec3f(-14, 5, 6), Vec3f(2, 3, -15)}) {
+        const CameraSpec camera = test_support::looking_at(eye, Vec3f(0, 1, 0));
+        const ViewPlane plane = make_view_plane(camera, 320, 200);
+        const ScreenProjection view(plane, 320, 200);
+        for (const bool keep_hidden : {false, true}) {
+            VisibilitySettings visibility;
+            visibility.keep_hidden = keep_hidden;
+            visibility.max_invisibility = keep_hidden ? 3 : 1;
+            // All the segments, then visibility over them.
+            InstanceLineCache all_cache;
+            const auto all = instance_lines(scene, accel, camera, all_cache);
+            ASSERT_FALSE(all.empty());
+            const std::vector<EdgePiece> pieces = split_by_visibility(
+                all, VisibilityContext{scene, own, accel, view, &all_cache}, visibility, 2);
+            // Visibility as they are found, after two segments already in the list.
+            InstanceLineCache cache;
+            std::vector<FeatureSegment> found(2, all.front());
+            InstanceVisibility early{visibility, {}};
+            add_instance_segments(scene, accel, own, plane, view, 4.0f, {}, 2, cache, found, {},
+                                  &early);
+            ASSERT_EQ(early.pieces.size(), pieces.size());
+            std::vector<std::uint32_t> number(all.size(), kNoIndex);
+            std::uint32_t next = 2;
+            for (const EdgePiece& p : pieces)
+                if (number[p.segment] == kNoIndex) number[p.segment] = next++;
+            ASSERT_EQ(found.size(), next);
+            for (std::size_t i = 0; i < all.size(); ++i)
+                if (number[i] != kNoIndex) {
+                    ASSERT_TRUE(same_segment(found[number[i]], all[i])) << i;
+                }
+            for (std::size_t k = 0; k < pieces.size(); ++k) {
+                EdgePiece expected = pieces[k];
+                expected.segment = number[expected.segment];
+                ASSERT_TRUE(same_piece(early.pieces[k], expected)) << k;
+                hidden_pieces += !expected.visible();
+            }
+            dropped += all.size() + 2 - found.size();
+        }
+    }
+    EXPECT_GT(dropped, 100u);       // segments without a piece were left out
+    EXPECT_GT(hidden_pieces, 10u);  // and hidden pieces kept when asked for
+}
+
 TEST(InstanceLines, MeshWorkIsKeptAcrossFrames) {
     Scene scene = test_support::instanced_test_scene();
     const CameraSpec camera = test_support::instanced_test_camera();

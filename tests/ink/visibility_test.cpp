@@ -242,6 +242,25 @@ TEST(Visibility, WithoutHiddenPiecesTheVisibleStrokesAreTheSame) {
     EXPECT_GT(settled_pieces, 0);
 }
 
+TEST(Visibility, SegmentsWithoutPiecesAreDropped) {
+    std::vector<ink::FeatureSegment> segments(5);
+    for (std::size_t i = 0; i < segments.size(); ++i)
+        segments[i].p0 = Vec3f(static_cast<float>(i), 0, 0);
+    std::vector<ink::EdgePiece> pieces(4);
+    const std::uint32_t on[] = {1, 1, 3, 4};
+    for (std::size_t k = 0; k < pieces.size(); ++k) pieces[k].segment = on[k];
+    ink::drop_segments_without_pieces(segments, pieces);
+    ASSERT_EQ(segments.size(), 3u);
+    EXPECT_EQ(segments[0].p0.x, 1.0f);
+    EXPECT_EQ(segments[1].p0.x, 3.0f);
+    EXPECT_EQ(segments[2].p0.x, 4.0f);
+    const std::uint32_t renumbered[] = {0, 0, 1, 2};
+    for (std::size_t k = 0; k < pieces.size(); ++k) EXPECT_EQ(pieces[k].segment, renumbered[k]);
+    std::vector<ink::EdgePiece> none;
+    ink::drop_segments_without_pieces(segments, none);
+    EXPECT_TRUE(segments.empty());
+}
+
 TEST(Visibility, LinesOnTheFarSideOfClosedSolidsAreHiddenWithoutRays) {
     Scene s;
     test_support::add_box(s, Vec3f(-1.0f), Vec3f(0.0f), 0);

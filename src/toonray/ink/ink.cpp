@@ -6,7 +6,7 @@
 #include <tuple>
 
 #include "toonray/core/error.h"
-
+#include "toonray/ink/chunks.h"
 #include "toonray/ink/light_lines.h"
 #include "toonray/ink/polylines.h"
 #include "toonray/ink/sketch.h"
@@ -171,6 +171,17 @@ void draw_ink_lines(const Scene& scene, const TriangleAccel& accel, const Camera
     const ViewPlane plane = make_view_plane(camera, width, height);
     const ScreenProjection view(plane, width, height);
 
+    ChainSettings chain = settings.chain;
+    chain.hidden = chain.hidden || settings.styles.draws_hidden();
+    // Styles only need hidden from visible; how deep a line is hidden is counted for the SVG's
+    // hidden layer (settings.chain.hidden) only.
+    VisibilitySettings visibility = settings.visibility;
+    if (!settings.chain.hidden)
+        visibility.max_invisibility = std::min(visibility.max_invisibility, 1);
+    // Hidden pieces only when something draws them: the chain's rules keep none otherwise.
+    visibility.keep_hidden = chain.hidden;
+    visibility.min_piece = chain.min_piece;
+
     auto start = std::chrono::steady_clock::now();
     out.mesh = weld_vertices(scene);
     FeatureEdgeSettings edges = settings.edges;
@@ -180,8 +191,13 @@ void draw_ink_lines(const Scene& scene, const TriangleAccel& accel, const Camera
     edges.band_thresholds = settings.band_thresholds;
     out.segments = find_feature_edges(scene, out.mesh, accel.bvh(), plane.eye, edges, threads,
                                       &out.intersections);
+    // The instances' segments come with their pieces (their visibility is timed with the
+    // edges), and only those that keep a piece.
+    const std::size_t first_instance_segment = out.segments.size();
+    InstanceVisibility instance_visibility{visibility, {}};
     add_instance_segments(scene, accel, out.mesh, plane, view, settings.visibility.margin, edges,
-                          threads, out.instances, out.segments);
+                          threads, out.instances, out.segments, {}, &instance_visibility);
+    const std::size_t end_instance_segment = out.segments.size();
     add_polyline_segments(scene, out.segments);
     const LightingModel lighting{settings.lights, settings.band_thresholds};
     const std::vector<std::uint8_t> closed = closed_objects(out.intersections);
@@ -221,19 +237,16 @@ void draw_ink_lines(const Scene& scene, const TriangleAccel& accel, const Camera
     out.timings.tone = seconds_since(start);
 
     start = std::chrono::steady_clock::now();
-    ChainSettings chain = settings.chain;
-    chain.hidden = chain.hidden || settings.styles.draws_hidden();
-    // Styles only need hidden from visible; how deep a line is hidden is counted for the SVG's
-    // hidden layer (settings.chain.hidden) only.
-    VisibilitySettings visibility = settings.visibility;
-    if (!settings.chain.hidden)
-        visibility.max_invisibility = std::min(visibility.max_invisibility, 1);
-    // Hidden pieces only when something draws them: the chain's rules keep none otherwise.
-    visibility.keep_hidden = chain.hidden;
-    visibility.min_piece = chain.min_piece;
-    out.pieces = split_by_visibility(
-        out.segments, VisibilityContext{scene, out.mesh, accel, view, &out.instances}, visibility,
-        threads);
+    const VisibilityContext context{scene, out.mesh, accel, view, &out.instances};
+    const std::span<const FeatureSegment> all(out.segments);
+    out.pieces =
+        split_by_visibility(all.first(first_instance_segment), context, visibility, threads);
+    std::vector<std::vector<EdgePiece>> later(2);
+    later[0] = std::move(instance_visibility.pieces);
+    later[1] = split_by_visibility(all.subspan(end_instance_segment), context, visibility, threads);
+    for (EdgePiece& piece : later[1])
+        piece.segment += static_cast<std::uint32_t>(end_instance_segment);
+    append_parts(later, out.pieces);
     // Tone is drawn where it is seen only: its hidden pieces are not strokes.
     if (tone)
         std::erase_if(out.pieces,

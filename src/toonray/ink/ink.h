@@ -63,6 +63,8 @@ struct InkTimings {
 /// Everything one frame's ink lines produce; kept between frames so buffers are reused.
 struct InkLines {
     WeldedMesh mesh;
+    /// The feature segments (the instances' only where a piece lies on them: a crowd's are
+    /// mostly hidden or outside the image) and their pieces, in segment order.
     std::vector<FeatureSegment> segments;
     std::vector<EdgePiece> pieces;
     std::vector<Stroke> strokes;

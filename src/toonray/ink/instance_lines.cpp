@@ -647,7 +647,7 @@ void add_instance_segments(const Scene& scene, const TriangleAccel& accel, const
                            const ViewPlane& plane, const ScreenProjection& view, float margin,
                            const FeatureEdgeSettings& settings, int threads,
                            InstanceLineCache& cache, std::vector<FeatureSegment>& segments,
-                           const InstanceLineOptions& options) {
+                           const InstanceLineOptions& options, InstanceVisibility* visibility) {
     cache.of_instance.clear();
     if (scene.instances.empty()) {
         cache.meshes.clear();
@@ -687,13 +687,37 @@ void add_instance_segments(const Scene& scene, const TriangleAccel& accel, const
     for (std::size_t i = 0; i < count; ++i)
         world[i] = grown(scene.instances[i].to_world.box(cache.of_instance[i]->box));
 
+    // With visibility: a part's segments keep only those a piece lies on (in order), and its
+    // pieces are numbered within the part until the parts are joined.
+    const VisibilityContext context{scene, own, accel, view, &cache};
+    auto keep_drawn = [&](std::vector<FeatureSegment>& part, std::vector<EdgePiece>& pieces,
+                          int part_threads) {
+        pieces = split_by_visibility(part, context, visibility->settings, part_threads);
+        drop_segments_without_pieces(part, pieces);
+        part.shrink_to_fit();
+    };
+    // Appends the parts' pieces to visibility->pieces, numbered as `segments` will hold the
+    // parts' segments from index `first` on.
+    auto join_pieces = [&](std::vector<std::vector<EdgePiece>>& pieces,
+                           const std::vector<std::vector<FeatureSegment>>& parts,
+                           std::size_t first) {
+        for (std::size_t c = 0; c < parts.size(); ++c) {
+            for (EdgePiece& piece : pieces[c]) piece.segment += static_cast<std::uint32_t>(first);
+            first += parts[c].size();
+        }
+        append_parts(pieces, visibility->pieces);
+    };
+
     // Per instance, in chunks of instances joined in order.
     const Vec3f eye = view.eye();
     // The instances' lines are most of a crowd's segments: they are moved into `segments` last,
     // once the rest is found, into room made for everything (append_parts), so that they are
     // held about once rather than twice.
+    constexpr int kInstancesPerChunk = 16;
+    std::vector<std::vector<EdgePiece>> piece_parts(
+        visibility ? (count + kInstancesPerChunk - 1) / kInstancesPerChunk : 0);
     std::vector<std::vector<FeatureSegment>> lines = chunk_outputs<FeatureSegment>(
-        static_cast<int>(count), 16, threads,
+        static_cast<int>(count), kInstancesPerChunk, threads,
         [&](int i0, int i1, std::vector<FeatureSegment>& out) {
             std::vector<FeatureSegment> smooth;
             std::vector<std::pair<std::uint32_t, FeatureSegment>> edges_found;
@@ -707,7 +731,10 @@ void add_instance_segments(const Scene& scene, const TriangleAccel& accel, const
                 instance_segments(place(scene, u, cache.of_instance[u], eye), volume, settings,
                                   options, out, smooth, edges_found);
             }
+            if (visibility)
+                keep_drawn(out, piece_parts[static_cast<std::size_t>(i0 / kInstancesPerChunk)], 1);
         });
+    if (visibility) join_pieces(piece_parts, lines, segments.size());
     if (!settings.intersections) {
         cache.pairs.clear();
         append_parts(lines, segments);
@@ -805,11 +832,17 @@ void add_instance_segments(const Scene& scene, const TriangleAccel& accel, const
             }
         }
     });
-    std::size_t more = crossing_lines.size();
-    for (const auto& part : own_pairs) more += part.size();
-    append_parts(lines, segments, more);
-    segments.insert(segments.end(), crossing_lines.begin(), crossing_lines.end());
-    for (const auto& part : own_pairs) segments.insert(segments.end(), part.begin(), part.end());
+    std::vector<std::vector<FeatureSegment>> crossings{std::move(crossing_lines)};
+    append_parts(own_pairs, crossings[0]);
+    std::size_t first_crossing = segments.size();
+    for (const auto& part : lines) first_crossing += part.size();
+    if (visibility) {
+        std::vector<std::vector<EdgePiece>> crossing_pieces(1);
+        keep_drawn(crossings[0], crossing_pieces[0], threads);
+        join_pieces(crossing_pieces, crossings, first_crossing);
+    }
+    append_parts(lines, segments, crossings[0].size());
+    append_parts(crossings, segments);
 }
 
 }  // namespace toonray::ink

@@ -14,6 +14,7 @@
 #include "toonray/core/affine.h"
 #include "toonray/ink/feature_edges.h"
 #include "toonray/ink/screen.h"
+#include "toonray/ink/visibility.h"
 #include "toonray/scene/scene.h"
 
 namespace toonray::ink {
@@ -48,6 +49,17 @@ struct InstanceLineOptions {
     bool view_culling = true;
 };
 
+/// Visibility run on the instances' segments as they are found, a chunk of instances at a
+/// time: a crowd's segments are mostly hidden or outside the image, and this way they are never
+/// all held at once.
+struct InstanceVisibility {
+    VisibilitySettings settings;
+    /// Out: the pieces of the segments appended, in segment order, numbering the segments as
+    /// `segments` does (split_by_visibility's pieces of them, with `scene`, `own`, `accel`,
+    /// `view` and the cache as context).
+    std::vector<EdgePiece> pieces;
+};
+
 /// Appends the feature segments of `scene`'s instances seen through `plane` (projected by
 /// `view`; visibility keeps what lies within `margin` pixels of the image) to `segments`, in a
 /// fixed order whatever the thread count: per instance in index order its mesh edges, then its
@@ -56,12 +68,14 @@ struct InstanceLineOptions {
 /// binary tree) and instances, by pair. Segments on an instance's triangles name it in
 /// FeatureSegment::face_instance and in their endpoint keys. Instances and parts of meshes
 /// whose boxes lie outside the view (grown by a margin beyond visibility's) give none: their
-/// segments would be clipped away. Updates the cache.
+/// segments would be clipped away. Updates the cache. With `visibility`, only the segments
+/// that keep a piece are appended, and their pieces go to visibility->pieces.
 void add_instance_segments(const Scene& scene, const TriangleAccel& accel, const WeldedMesh& own,
                            const ViewPlane& plane, const ScreenProjection& view, float margin,
                            const FeatureEdgeSettings& settings, int threads,
                            InstanceLineCache& cache, std::vector<FeatureSegment>& segments,
-                           const InstanceLineOptions& options = {});
+                           const InstanceLineOptions& options = {},
+                           InstanceVisibility* visibility = nullptr);
 
 /// The welded mesh of instance `instance`'s mesh, as add_instance_segments last welded it.
 [[nodiscard]] const WeldedMesh& instance_welded_mesh(const InstanceLineCache& cache,

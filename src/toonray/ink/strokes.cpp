@@ -78,32 +78,40 @@ struct EndGroups {
 EndGroups group_ends(const std::vector<Link>& links) {
     EndGroups out;
     const std::size_t count = links.size() * 2;
+    auto key_of = [&](std::size_t e) -> const EndpointKey& {
+        return e % 2 ? links[e / 2].key1 : links[e / 2].key0;
+    };
     out.end_group.assign(count, kNoIndex);
-    // Keys to group numbers in an open-addressing table (linear probing, at most half full).
-    std::size_t table_size = 16;
-    while (table_size < 2 * count) table_size *= 2;
-    std::vector<std::uint32_t> table(table_size, kNoIndex);
-    std::vector<EndpointKey> keys;
     std::vector<std::uint32_t> sizes;
-    for (std::size_t e = 0; e < count; ++e) {
-        const Link& link = links[e / 2];
-        const EndpointKey& key = e % 2 ? link.key1 : link.key0;
-        if (!has_key(key)) continue;
-        std::size_t slot = hash_words(key.a ^ ((key.instance + 1) * 0x9e3779b9u), key.b,
-                                      key.c ^ ((key.c_instance + 1) * 0x85ebca6bu)) &
-                           (table_size - 1);
-        while (table[slot] != kNoIndex && keys[table[slot]] != key)
-            slot = (slot + 1) & (table_size - 1);
-        if (table[slot] == kNoIndex) {
-            table[slot] = static_cast<std::uint32_t>(keys.size());
-            keys.push_back(key);
-            sizes.push_back(0);
+    {
+        // Keys to group numbers in an open-addressing table (linear probing, at most half
+        // full). A group is known by its first end, whose key is the group's: a crowd's ink
+        // lines have millions of groups, and an end's number is a quarter of its key's size.
+        // The table goes before the lists are made.
+        std::size_t table_size = 16;
+        while (table_size < 2 * count) table_size *= 2;
+        std::vector<std::uint32_t> table(table_size, kNoIndex);
+        std::vector<std::uint32_t> first_end;
+        for (std::size_t e = 0; e < count; ++e) {
+            const EndpointKey& key = key_of(e);
+            if (!has_key(key)) continue;
+            std::size_t slot = hash_words(key.a ^ ((key.instance + 1) * 0x9e3779b9u), key.b,
+                                          key.c ^ ((key.c_instance + 1) * 0x85ebca6bu)) &
+                               (table_size - 1);
+            while (table[slot] != kNoIndex && key_of(first_end[table[slot]]) != key)
+                slot = (slot + 1) & (table_size - 1);
+            if (table[slot] == kNoIndex) {
+                table[slot] = static_cast<std::uint32_t>(first_end.size());
+                first_end.push_back(static_cast<std::uint32_t>(e));
+                sizes.push_back(0);
+            }
+            out.end_group[e] = table[slot];
+            ++sizes[table[slot]];
         }
-        out.end_group[e] = table[slot];
-        ++sizes[table[slot]];
     }
-    out.offsets.assign(keys.size() + 1, 0);
-    for (std::size_t g = 0; g < keys.size(); ++g) out.offsets[g + 1] = out.offsets[g] + sizes[g];
+    out.offsets.assign(sizes.size() + 1, 0);
+    for (std::size_t g = 0; g < sizes.size(); ++g) out.offsets[g + 1] = out.offsets[g] + sizes[g];
+    std::vector<std::uint32_t>().swap(sizes);
     out.ends.resize(out.offsets.back());
     std::vector<std::uint32_t> fill(out.offsets.begin(), out.offsets.end() - 1);
     for (std::size_t e = 0; e < count; ++e)

@@ -361,4 +361,17 @@ std::vector<EdgePiece> split_by_visibility(std::span<const FeatureSegment> segme
         });
 }
 
+void drop_segments_without_pieces(std::vector<FeatureSegment>& segments,
+                                  std::vector<EdgePiece>& pieces) {
+    std::size_t kept = 0;
+    for (std::size_t i = 0; i < pieces.size();) {
+        const std::uint32_t segment = pieces[i].segment;
+        segments[kept] = segments[segment];
+        for (; i < pieces.size() && pieces[i].segment == segment; ++i)
+            pieces[i].segment = static_cast<std::uint32_t>(kept);
+        ++kept;
+    }
+    segments.resize(kept);
+}
+
 }  // namespace toonray::ink

@@ -105,4 +105,10 @@ using TriangleKey = std::uint64_t;
                                                          const VisibilitySettings& settings,
                                                          int threads);
 
+/// Removes the segments that no piece lies on, keeping the others in order, and renumbers the
+/// pieces' segments to match (the pieces are in segment order, as split_by_visibility gives
+/// them). Then the segments of lines that are not drawn need not be held.
+void drop_segments_without_pieces(std::vector<FeatureSegment>& segments,
+                                  std::vector<EdgePiece>& pieces);
+
 }  // namespace toonray::ink
