@@ -80,16 +80,16 @@ std::vector<Out> copied(const Array<T>& a) {
     return out;
 }
 
-Affine affine_of(const py::object& matrix) {
-    if (matrix.is_none()) return kIdentityAffine;
+Affine3 affine_of(const py::object& matrix) {
+    if (matrix.is_none()) return {};
     const Array<double> m = Array<double>::ensure(matrix);
     if (!m || m.ndim() != 2 || m.shape(0) != 4 || m.shape(1) != 4)
         throw py::value_error("matrix: expected a 4x4 array (rows: m[row][column])");
     if (m.at(3, 0) != 0.0 || m.at(3, 1) != 0.0 || m.at(3, 2) != 0.0 || m.at(3, 3) != 1.0)
         throw Error("matrix: the last row must be 0 0 0 1 (an affine transform)");
-    Affine a{};
+    Affine3 a;
     for (int r = 0; r < 3; ++r)
-        for (int c = 0; c < 4; ++c) a[r][c] = m.at(r, c);
+        for (int c = 0; c < 4; ++c) a.m[r][c] = m.at(r, c);
     return a;
 }
 
@@ -127,12 +127,7 @@ std::uint32_t add_instance(PyScene& self, MeshData& mesh, const py::object& matr
     self.check_not_rendering();
     if (mesh.scene != &self)
         throw py::value_error("add_instance: the mesh belongs to another scene");
-    const Affine a = affine_of(matrix);
-    std::array<double, 16> rows{};
-    for (std::size_t r = 0; r < 3; ++r)
-        for (std::size_t c = 0; c < 4; ++c) rows[4 * r + c] = a[r][c];
-    rows[15] = 1.0;
-    const Affine3 to_world = Affine3::from_row_major(rows);
+    const Affine3 to_world = affine_of(matrix);
     if (mesh.scene_mesh == kNoIndex)
         mesh.scene_mesh = self.scene.add_mesh(
             instance_mesh(arrays_of(mesh), self.scene.materials.size(), mesh.name));

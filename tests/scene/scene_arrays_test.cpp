@@ -12,6 +12,12 @@ using namespace toonray;
 
 namespace {
 
+Affine3 rows(const std::array<std::array<double, 4>, 3>& m) {
+    Affine3 a;
+    a.m = m;
+    return a;
+}
+
 // A unit square in z = 0 as two triangles, wound to face +z.
 struct Square {
     std::vector<Vec3f> positions{{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
@@ -51,8 +57,8 @@ std::string error_of(const Scene& scene, const MeshArrays& mesh) {
 TEST(AppendMesh, TheIdentityCopiesTheArraysExactly) {
     const Square square;
     Scene s = with_material();
-    EXPECT_EQ(append_mesh(s, square.arrays(), kIdentityAffine, "a"), 1u);
-    EXPECT_EQ(append_mesh(s, square.arrays(), kIdentityAffine, "b"), 2u);
+    EXPECT_EQ(append_mesh(s, square.arrays(), Affine3{}, "a"), 1u);
+    EXPECT_EQ(append_mesh(s, square.arrays(), Affine3{}, "b"), 2u);
     ASSERT_EQ(s.positions.size(), 8u);
     for (std::size_t i = 0; i < 4; ++i) {
         EXPECT_EQ(s.positions[i], square.positions[i]);
@@ -74,7 +80,7 @@ TEST(AppendMesh, TransformsPositionsAndNormals) {
     square.normals.assign(4, normalize(Vec3f(1, 0, 1)));
     Scene s = with_material();
     // Scale x by 2 and y by 4, then move by (10, 20, 30).
-    const Affine m{{{2, 0, 0, 10}, {0, 4, 0, 20}, {0, 0, 1, 30}}};
+    const Affine3 m = rows({{{2, 0, 0, 10}, {0, 4, 0, 20}, {0, 0, 1, 30}}});
     append_mesh(s, square.arrays(), m, "moved");
     EXPECT_EQ(s.positions[2], Vec3f(12, 24, 30));
     // By the inverse transpose: the plane x / 2 + z = c has normal (1/2, 0, 1), normalised.
@@ -86,7 +92,7 @@ TEST(AppendMesh, TransformsPositionsAndNormals) {
     }
     // A quarter turn about x takes +z to -y.
     Scene turned = with_material();
-    append_mesh(turned, Square{}.arrays(), Affine{{{1, 0, 0, 0}, {0, 0, -1, 0}, {0, 1, 0, 0}}},
+    append_mesh(turned, Square{}.arrays(), rows({{{1, 0, 0, 0}, {0, 0, -1, 0}, {0, 1, 0, 0}}}),
                 "turned");
     EXPECT_EQ(turned.normals[0], Vec3f(0, -1, 0));
     EXPECT_LT(face_normal(turned, 0).y, 0.0f);
@@ -95,9 +101,9 @@ TEST(AppendMesh, TransformsPositionsAndNormals) {
 TEST(AppendMesh, AMirrorKeepsTheWindingFacingTheNormals) {
     const Square square;
     Scene s = with_material();
-    append_mesh(s, square.arrays(), kIdentityAffine, "plain");
+    append_mesh(s, square.arrays(), Affine3{}, "plain");
     // Mirrored in z: the square faces -z now, and so must its normals and its winding.
-    append_mesh(s, square.arrays(), Affine{{{1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, -1, 0}}}, "mirror");
+    append_mesh(s, square.arrays(), rows({{{1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, -1, 0}}}), "mirror");
     EXPECT_GT(face_normal(s, 0).z, 0.0f);
     EXPECT_LT(face_normal(s, 2).z, 0.0f);
     EXPECT_LT(face_normal(s, 3).z, 0.0f);
@@ -117,7 +123,7 @@ TEST(AppendMesh, PerCornerAttributesAndZeroNormals) {
     square.normals[3] = Vec3f(0, 0, 0);
     square.uvs.assign(6, Vec2f{0.5f, 0.5f});
     Scene s = with_material();
-    append_mesh(s, square.arrays(), kIdentityAffine, "corners");
+    append_mesh(s, square.arrays(), Affine3{}, "corners");
     EXPECT_EQ(s.normals.size(), 6u);
     EXPECT_EQ(s.tri_normals[0], (std::array<std::uint32_t, 3>{0, 1, 2}));
     EXPECT_EQ(s.tri_texcoords[1], (std::array<std::uint32_t, 3>{3, 4, 5}));
@@ -152,10 +158,10 @@ TEST(AppendMesh, BadMeshesAndTransformsAreErrors) {
     Scene scene = with_material();
     const Square square;
     EXPECT_THROW(append_mesh(scene, square.arrays(),
-                             Affine{{{1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, 0, 0}}}, "flat"),
+                             rows({{{1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, 0, 0}}}), "flat"),
                  Error);
     EXPECT_THROW(append_mesh(scene, square.arrays(),
-                             Affine{{{1, 0, 0, NAN}, {0, 1, 0, 0}, {0, 0, 1, 0}}}, "nan"),
+                             rows({{{1, 0, 0, NAN}, {0, 1, 0, 0}, {0, 0, 1, 0}}}), "nan"),
                  Error);
     // Nothing was added by the failed calls.
     EXPECT_EQ(scene.triangle_count(), 0u);
@@ -164,7 +170,7 @@ TEST(AppendMesh, BadMeshesAndTransformsAreErrors) {
 
 TEST(CheckSceneLimits, TrianglesAndPositions) {
     Scene s = with_material();
-    append_mesh(s, Square{}.arrays(), kIdentityAffine, "square");
+    append_mesh(s, Square{}.arrays(), Affine3{}, "square");
     Limits limits;
     EXPECT_NO_THROW(check_scene_limits(s, limits));
     limits.max_triangles = 1;
@@ -198,7 +204,7 @@ TEST(CheckSceneLimits, AnInstancedMeshCountsOnce) {
     limits.max_vertices = 4;
     EXPECT_NO_THROW(check_scene_limits(s, limits));
     // The scene's own triangles count as well as the meshes'.
-    append_mesh(s, Square{}.arrays(), kIdentityAffine, "own");
+    append_mesh(s, Square{}.arrays(), Affine3{}, "own");
     try {
         check_scene_limits(s, limits);
         FAIL() << "no limit error";
@@ -210,7 +216,7 @@ TEST(CheckSceneLimits, AnInstancedMeshCountsOnce) {
 TEST(InstanceMesh, IsWhatTheIdentityAppends) {
     const Square square;
     Scene appended = with_material();
-    append_mesh(appended, square.arrays(), kIdentityAffine, "a");
+    append_mesh(appended, square.arrays(), Affine3{}, "a");
     const auto mesh = instance_mesh(square.arrays(), appended.materials.size(), "a");
     EXPECT_EQ(mesh->positions, appended.positions);
     EXPECT_EQ(mesh->normals, appended.normals);

@@ -1,8 +1,9 @@
 #pragma once
-/// Affine transforms of 3D points in double precision: instance placements (scene/scene.h) and
-/// glTF node matrices. Products are summed in double and rounded to float once, so that a point
-/// transformed here has the same bits whoever transforms it (an instance's triangle when it is
-/// shaded, the same triangle flattened into the scene's own arrays).
+/// Affine transforms of 3D points in double precision: instance placements (scene/scene.h),
+/// meshes appended by a transform (scene/scene_arrays.h) and glTF node matrices. Products are
+/// summed in double and rounded to float once, so that a point transformed here has the same
+/// bits whoever transforms it (an instance's triangle when it is shaded, the same triangle
+/// flattened into the scene's own arrays).
 
 #include <array>
 #include <cmath>

@@ -57,8 +57,10 @@ void check_mesh(const MeshArrays& mesh, std::size_t material_count, std::string_
                                     name, t, mesh.materials[t], material_count));
 }
 
-std::uint32_t append_mesh(Scene& scene, const MeshArrays& mesh, const Affine& m, std::string name) {
+std::uint32_t append_mesh(Scene& scene, const MeshArrays& mesh, const Affine3& to_world,
+                          std::string name) {
     check_mesh(mesh, scene.materials.size(), name);
+    const auto& m = to_world.m;
     for (const auto& row : m)
         for (double v : row)
             if (!std::isfinite(v))
@@ -86,12 +88,7 @@ std::uint32_t append_mesh(Scene& scene, const MeshArrays& mesh, const Affine& m,
 
     scene.objects.push_back(std::move(name));
     scene.positions.reserve(scene.positions.size() + mesh.positions.size());
-    for (const Vec3f& p : mesh.positions) {
-        Vec3f out;
-        for (int r = 0; r < 3; ++r)
-            out[r] = static_cast<float>(m[r][0] * p.x + m[r][1] * p.y + m[r][2] * p.z + m[r][3]);
-        scene.positions.push_back(out);
-    }
+    for (const Vec3f& p : mesh.positions) scene.positions.push_back(to_world.point(p));
     // Zero normals (degenerate faces) have no direction: their triangles take the face's.
     std::vector<char> zero_normal(mesh.normals.size(), 0);
     scene.normals.reserve(scene.normals.size() + mesh.normals.size());
@@ -147,7 +144,7 @@ std::shared_ptr<const TriangleMesh> instance_mesh(const MeshArrays& mesh,
     // append_mesh's material check needs the materials to exist; their contents do not matter.
     Scene scene;
     scene.materials.assign(std::max<std::size_t>(material_count, 1), Material{"(default)"});
-    append_mesh(scene, mesh, kIdentityAffine, std::string(name));
+    append_mesh(scene, mesh, Affine3{}, std::string(name));
     return std::make_shared<const TriangleMesh>(std::move(static_cast<TriangleMesh&>(scene)));
 }
 

@@ -10,6 +10,7 @@
 #include <string>
 #include <string_view>
 
+#include "toonray/core/affine.h"
 #include "toonray/core/limits.h"
 #include "toonray/core/math.h"
 #include "toonray/scene/scene.h"
@@ -28,12 +29,6 @@ struct MeshArrays {
     std::span<const std::uint32_t> materials;
 };
 
-/// An affine transform from a mesh's coordinates to the world, 3 rows of a 4x4 matrix whose
-/// last row is 0 0 0 1: p' = M (p, 1).
-using Affine = std::array<std::array<double, 4>, 3>;
-
-inline constexpr Affine kIdentityAffine{{{1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, 1, 0}}};
-
 /// Checks a mesh on its own: every index within the positions, attribute counts of none, one
 /// per position or one per corner, finite values, materials below `material_count`. Throws
 /// Error("mesh 'NAME': what is wrong").
@@ -46,7 +41,7 @@ void check_mesh(const MeshArrays& mesh, std::size_t material_count, std::string_
 /// triangle's corners so that its winding still faces where its normals do. Throws Error for a
 /// transform that is not finite or is singular, and Error or LimitError when the scene would
 /// need more than 32-bit indices.
-std::uint32_t append_mesh(Scene& scene, const MeshArrays& mesh, const Affine& to_world,
+std::uint32_t append_mesh(Scene& scene, const MeshArrays& mesh, const Affine3& to_world,
                           std::string name);
 
 /// `mesh` (checked with check_mesh against `material_count` materials) as a mesh for instances
