@@ -268,7 +268,20 @@ std::vector<PairCrossing> find_crossings(const Bvh& bvh,
     const std::uint32_t prims = static_cast<std::uint32_t>(bvh.prim_indices.size());
     constexpr float inf = std::numeric_limits<float>::infinity();
     Slots slots(prims + kLanes);
+    // The triangles come in the tree's order, which scatters them over the per-triangle
+    // arrays: what a slot reads is fetched ahead (the fill is bound by those misses).
+    constexpr std::uint32_t kAhead = 16;
     for (std::uint32_t i = 0; i < prims + kLanes; ++i) {
+        if (i + kAhead < prims) {
+            const std::uint32_t ahead = bvh.prim_indices[i + kAhead];
+            __builtin_prefetch(&live[ahead]);
+            __builtin_prefetch(&mesh.tri_vertices[ahead]);
+            __builtin_prefetch(&tri_corners[ahead]);
+            __builtin_prefetch(reinterpret_cast<const char*>(&tri_corners[ahead]) + 32);
+        }
+        if (i + kAhead / 2 < prims)
+            for (std::uint32_t v : mesh.tri_vertices[bvh.prim_indices[i + kAhead / 2]])
+                __builtin_prefetch(&mesh.vertex_position[v]);
         const std::uint32_t t = i < prims ? bvh.prim_indices[i] : kNoIndex;
         if (t == kNoIndex || !live[t]) {
             for (int a = 0; a < 3; ++a) {
@@ -576,7 +589,18 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
     };
     const EdgeBands edge_bands{scene, mesh, settings, eye, corner_normals};
     // One segment per edge that is a line: each is classified first, and made only if drawn.
+    // The edges come by vertex, their faces from all over the per-triangle arrays: those of an
+    // edge a few ahead are fetched while this one is classified.
+    constexpr std::size_t kAhead = 8;
+    const std::size_t side_count = edge_first.back();
     for (std::size_t e = 0; e < edge_count; ++e) {
+        if (e + kAhead < edge_count) {
+            const std::uint32_t first = edge_first[e + kAhead];
+            for (std::uint32_t k = first; k < std::min<std::size_t>(first + 2, side_count); ++k) {
+                __builtin_prefetch(&normal[sides[k].tri]);
+                __builtin_prefetch(&scene.tri_material[sides[k].tri]);
+            }
+        }
         const std::uint32_t i = edge_first[e], j = edge_first[e + 1];
         const Side& s0 = sides[i];
         const Vec3f p0 = scene.positions[mesh.vertex_position[s0.lo]];
