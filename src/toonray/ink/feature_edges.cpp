@@ -260,8 +260,8 @@ int candidate_mask(const Slots& slots, std::uint32_t i, std::uint32_t j) {
 // itself once, so each triangle pair is met once, in the leaf pair that holds it. The node pairs
 // are first expanded breadth-first into enough independent tasks for the threads. Triangles
 // that share a corner position (in any object) touch there and are not tested.
-std::vector<PairCrossing> find_crossings(const Bvh& bvh,
-                                         const std::vector<std::array<Vec3f, 3>>& tri_corners,
+template <class CornersOf>
+std::vector<PairCrossing> find_crossings(const Bvh& bvh, const CornersOf& corners_of,
                                          const WeldedMesh& mesh,
                                          const std::vector<std::uint8_t>& live,
                                          const std::vector<std::uint8_t>* stale, int threads) {
@@ -276,8 +276,7 @@ std::vector<PairCrossing> find_crossings(const Bvh& bvh,
             const std::uint32_t ahead = bvh.prim_indices[i + kAhead];
             __builtin_prefetch(&live[ahead]);
             __builtin_prefetch(&mesh.tri_vertices[ahead]);
-            __builtin_prefetch(&tri_corners[ahead]);
-            __builtin_prefetch(reinterpret_cast<const char*>(&tri_corners[ahead]) + 32);
+            corners_of.prefetch(ahead);
         }
         if (i + kAhead / 2 < prims)
             for (std::uint32_t v : mesh.tri_vertices[bvh.prim_indices[i + kAhead / 2]])
@@ -296,7 +295,7 @@ std::vector<PairCrossing> find_crossings(const Bvh& bvh,
             slots.corner[k][i] = mesh.vertex_position[mesh.tri_vertices[t][k]];
         slots.stale[i] = !stale || (*stale)[t] ? kNoIndex : 0;
         BBox box;
-        for (const Vec3f& p : tri_corners[t]) box.extend(p);
+        for (const Vec3f& p : corners_of(t)) box.extend(p);
         for (int a = 0; a < 3; ++a) {
             slots.lo[a][i] = box.lo[a];
             slots.hi[a][i] = box.hi[a];
@@ -359,7 +358,7 @@ std::vector<PairCrossing> find_crossings(const Bvh& bvh,
                 std::uint32_t t = bvh.prim_indices[i], u = bvh.prim_indices[k];
                 if (u < t) std::swap(t, u);
                 PairCrossing found{t, u, {}};
-                if (intersect_triangles(tri_corners[t], tri_corners[u], found.crossing))
+                if (intersect_triangles(corners_of(t), corners_of(u), found.crossing))
                     out.push_back(found);
             }
         }
@@ -429,6 +428,15 @@ std::vector<PairCrossing> find_crossings(const Bvh& bvh,
     found.insert(found.end(), deeper.begin(), deeper.end());
     return found;
 }
+
+template std::vector<PairCrossing> find_crossings(const Bvh&, const StoredCorners&,
+                                                  const WeldedMesh&,
+                                                  const std::vector<std::uint8_t>&,
+                                                  const std::vector<std::uint8_t>*, int);
+template std::vector<PairCrossing> find_crossings(const Bvh&, const IndexedCorners&,
+                                                  const WeldedMesh&,
+                                                  const std::vector<std::uint8_t>&,
+                                                  const std::vector<std::uint8_t>*, int);
 
 namespace {
 
@@ -522,18 +530,17 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
     std::vector<double> volume(objects, 0.0);
     std::vector<BBox> object_box(objects);
 
-    // Per triangle, in one pass: its corners (kept by the cache for the next frame), unit
-    // normal (zero when degenerate: the triangle is not usable), whether it has a normal at
-    // every corner, and its object's box and volume.
-    std::vector<std::array<Vec3f, 3>> tri_corners;
+    // Per triangle, in one pass: its unit normal (zero when degenerate: the triangle is not
+    // usable), whether it has a normal at every corner, and its object's box and volume. The
+    // corners are read from the scene where needed, not stored: at a million triangles a copy
+    // is 40 MB more at the frame's peak, whose first touch costs more than the reads.
     std::vector<Vec3f> normal;
     std::vector<std::uint8_t> corner_normals, usable_triangle;
-    tri_corners.reserve(n);
     normal.reserve(n);
     corner_normals.reserve(n);
     usable_triangle.reserve(n);
     for (std::size_t t = 0; t < n; ++t) {
-        const auto& p = tri_corners.emplace_back(corners(scene, t));
+        const auto p = corners(scene, t);
         usable_triangle.push_back(normal.emplace_back(face_normal(p)) != Vec3f(0.0f));
         corner_normals.push_back(has_corner_normals(scene, t));
         const std::uint32_t o = scene.tri_object[t];
@@ -569,7 +576,7 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
     std::vector<std::uint8_t> turned_away(n, 0);
     for (std::size_t t = 0; t < n; ++t) {
         const int out = outward[scene.tri_object[t]];
-        const float facing = dot(normal[t], eye - tri_corners[t][0]);
+        const float facing = dot(normal[t], eye - scene.positions[scene.tri_positions[t][0]]);
         turned_away[t] = out != 0 && usable(t) && (out > 0 ? facing < 0 : facing > 0);
     }
 
@@ -648,7 +655,7 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
         std::vector<float> g_value(scene.positions.size());
         for (std::size_t t = 0; t < n; ++t) {
             if (!usable(t) || !corner_normals[t]) continue;
-            const auto& p = tri_corners[t];
+            const auto p = corners(scene, t);
             float g[3];
             for (int k = 0; k < 3; ++k) {
                 const std::uint32_t position = scene.tri_positions[t][k],
@@ -703,20 +710,23 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
             stale.assign(n, 1);
             if (same_count)
                 for (std::size_t t = 0; t < n; ++t) {
-                    const auto& now = tri_corners[t];
+                    const auto now = corners(scene, t);
                     stale[t] = !cache->tested[t] ||
                                !std::equal(now.begin(), now.end(), cache->corners[t].begin(), same);
                 }
         }
-        std::vector<PairCrossing> found = find_crossings(bvh, tri_corners, mesh, live_triangle,
-                                                         cache ? &stale : nullptr, threads);
+        std::vector<PairCrossing> found =
+            find_crossings(bvh, IndexedCorners{scene.positions, scene.tri_positions}, mesh,
+                           live_triangle, cache ? &stale : nullptr, threads);
         if (cache) {
             // The cache's crossings of triangles that are not stale and take part now; then
             // the cache is this frame's.
             for (const PairCrossing& c : cache->crossings)
                 if (!stale[c.t] && !stale[c.u] && live_triangle[c.t] && live_triangle[c.u])
                     found.push_back(c);
-            cache->corners.swap(tri_corners);  // not read below
+            // Written after the search, into memory it has freed.
+            cache->corners.resize(n);
+            for (std::size_t t = 0; t < n; ++t) cache->corners[t] = corners(scene, t);
             cache->tested = live_triangle;
         }
         // In the order of the triangle pairs, whatever the tree.

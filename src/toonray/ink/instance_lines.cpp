@@ -356,7 +356,8 @@ std::shared_ptr<const MeshLines> make_mesh_lines(std::shared_ptr<const TriangleM
 
     // The crossings within the mesh, among its usable triangles.
     if (settings.intersections && !ml.tree.nodes.empty()) {
-        ml.crossings = find_crossings(ml.tree, ml.corners, ml.welded, usable, nullptr, threads);
+        ml.crossings =
+            find_crossings(ml.tree, StoredCorners{ml.corners}, ml.welded, usable, nullptr, threads);
         std::sort(ml.crossings.begin(), ml.crossings.end(),
                   [](const PairCrossing& x, const PairCrossing& y) {
                       return std::tie(x.t, x.u) < std::tie(y.t, y.u);

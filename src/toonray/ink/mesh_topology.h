@@ -108,12 +108,34 @@ struct MeshTopology {
     }
 };
 
+/// The corners of triangle t, as find_crossings reads them: stored per triangle...
+struct StoredCorners {
+    std::span<const std::array<Vec3f, 3>> corners;
+    [[nodiscard]] const std::array<Vec3f, 3>& operator()(std::uint32_t t) const {
+        return corners[t];
+    }
+    void prefetch(std::uint32_t t) const {
+        __builtin_prefetch(&corners[t]);
+        __builtin_prefetch(reinterpret_cast<const char*>(&corners[t]) + 32);
+    }
+};
+/// ...or through the triangles' position indices (a mesh's own arrays: nothing is copied).
+struct IndexedCorners {
+    std::span<const Vec3f> positions;
+    std::span<const std::array<std::uint32_t, 3>> triangles;
+    [[nodiscard]] std::array<Vec3f, 3> operator()(std::uint32_t t) const {
+        const auto& v = triangles[t];
+        return {positions[v[0]], positions[v[1]], positions[v[2]]};
+    }
+    void prefetch(std::uint32_t t) const { __builtin_prefetch(&triangles[t]); }
+};
+
 /// Every pair of triangles that take part (`live`) and cross, as intersect_triangles finds them,
 /// with (when `stale` is given) at least one stale triangle; in no particular order. `bvh` is
-/// built over the triangles whose corners are `tri_corners`; triangles sharing a corner
-/// position (mesh.vertex_position) are not tested.
-std::vector<PairCrossing> find_crossings(const Bvh& bvh,
-                                         const std::vector<std::array<Vec3f, 3>>& tri_corners,
+/// built over the triangles whose corners `corners_of` gives (StoredCorners or IndexedCorners);
+/// triangles sharing a corner position (mesh.vertex_position) are not tested.
+template <class CornersOf>
+std::vector<PairCrossing> find_crossings(const Bvh& bvh, const CornersOf& corners_of,
                                          const WeldedMesh& mesh,
                                          const std::vector<std::uint8_t>& live,
                                          const std::vector<std::uint8_t>* stale, int threads);
