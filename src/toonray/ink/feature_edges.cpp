@@ -207,8 +207,8 @@ namespace {
 // What the intersection search reads per BVH primitive slot, one array per value so that four
 // neighbouring slots are tested at once: the triangle's box (empty, lo = +inf and hi = -inf,
 // when it takes no part, so that it overlaps nothing), its corners' positions (canonical: equal
-// for equal coordinates, across objects) and whether it is stale (all bits set) or not (zero).
-// kLanes more slots pad the end so that loads of four never read past it.
+// for equal coordinates, across objects) and, when only pairs with a stale triangle are
+// searched, whether it is stale (all bits set) or not (zero). kLanes more slots pad the end so that loads of four never read past it.
 constexpr std::uint32_t kLanes = 4;
 // Pairs of subtrees of at most this many slots each are tested slot against slot (measured:
 // fewer instructions than 8 or 32 on the scan and the piano).
@@ -216,15 +216,15 @@ constexpr std::uint32_t kSmallSubtree = 16;
 struct Slots {
     std::unique_ptr<float[]> lo[3], hi[3];
     std::unique_ptr<std::uint32_t[]> corner[3];
-    std::unique_ptr<std::uint32_t[]> stale;
+    std::unique_ptr<std::uint32_t[]> stale;  // null when every triangle is
 
-    explicit Slots(std::size_t count) {  // values left for the caller to write
+    Slots(std::size_t count, bool some_fresh) {  // values left for the caller to write
         for (int a = 0; a < 3; ++a) {
             lo[a] = std::make_unique_for_overwrite<float[]>(count);
             hi[a] = std::make_unique_for_overwrite<float[]>(count);
             corner[a] = std::make_unique_for_overwrite<std::uint32_t[]>(count);
         }
-        stale = std::make_unique_for_overwrite<std::uint32_t[]>(count);
+        if (some_fresh) stale = std::make_unique_for_overwrite<std::uint32_t[]>(count);
     }
 };
 
@@ -248,8 +248,10 @@ int candidate_mask(const Slots& slots, std::uint32_t i, std::uint32_t j) {
         for (const __m128i& o : other) shared = _mm_or_si128(shared, _mm_cmpeq_epi32(mine, o));
     }
     const __m128i stale =
-        _mm_or_si128(_mm_set1_epi32(static_cast<int>(slots.stale[i])),
-                     _mm_loadu_si128(reinterpret_cast<const __m128i*>(&slots.stale[j])));
+        slots.stale
+            ? _mm_or_si128(_mm_set1_epi32(static_cast<int>(slots.stale[i])),
+                           _mm_loadu_si128(reinterpret_cast<const __m128i*>(&slots.stale[j])))
+            : _mm_set1_epi32(-1);
     return overlap & _mm_movemask_ps(_mm_castsi128_ps(_mm_andnot_si128(shared, stale)));
 }
 
@@ -267,7 +269,7 @@ std::vector<PairCrossing> find_crossings(const Bvh& bvh, const CornersOf& corner
                                          const std::vector<std::uint8_t>* stale, int threads) {
     const std::uint32_t prims = static_cast<std::uint32_t>(bvh.prim_indices.size());
     constexpr float inf = std::numeric_limits<float>::infinity();
-    Slots slots(prims + kLanes);
+    Slots slots(prims + kLanes, stale != nullptr);
     // The triangles come in the tree's order, which scatters them over the per-triangle
     // arrays: what a slot reads is fetched ahead (the fill is bound by those misses).
     constexpr std::uint32_t kAhead = 16;
@@ -288,12 +290,12 @@ std::vector<PairCrossing> find_crossings(const Bvh& bvh, const CornersOf& corner
                 slots.hi[a][i] = -inf;
                 slots.corner[a][i] = kNoIndex;
             }
-            slots.stale[i] = 0;
+            if (stale) slots.stale[i] = 0;
             continue;
         }
         for (int k = 0; k < 3; ++k)
             slots.corner[k][i] = mesh.vertex_position[mesh.tri_vertices[t][k]];
-        slots.stale[i] = !stale || (*stale)[t] ? kNoIndex : 0;
+        if (stale) slots.stale[i] = (*stale)[t] ? kNoIndex : 0;
         BBox box;
         for (const Vec3f& p : corners_of(t)) box.extend(p);
         for (int a = 0; a < 3; ++a) {
@@ -306,24 +308,24 @@ std::vector<PairCrossing> find_crossings(const Bvh& bvh, const CornersOf& corner
         return BBox{Vec3f(slots.lo[0][i], slots.lo[1][i], slots.lo[2][i]),
                     Vec3f(slots.hi[0][i], slots.hi[1][i], slots.hi[2][i])};
     };
-    // Per node: the box of its live triangles (empty without), and whether one is stale.
-    // Boxes of live triangles only: nodes of faces turned away from the eye shrink or vanish,
-    // and fewer pairs of nodes overlap.
+    // Per node: the box of its live triangles (empty without), and whether one is stale (with
+    // `stale` only). Boxes of live triangles only: nodes of faces turned away from the eye
+    // shrink or vanish, and fewer pairs of nodes overlap.
     std::vector<BBox> live_box(bvh.nodes.size());
-    std::vector<std::uint8_t> node_stale(bvh.nodes.size(), 0);
+    std::vector<std::uint8_t> node_stale(stale ? bvh.nodes.size() : 0, 0);
     for (std::size_t i = bvh.nodes.size(); i-- > 0;) {  // children come after parents
         const BvhNode& node = bvh.nodes[i];
         if (node.is_leaf()) {
             for (std::uint32_t k = node.first; k < node.first + node.count; ++k) {
                 if (!live_slot(k)) continue;
                 live_box[i].extend(slot_box(k));
-                node_stale[i] |= slots.stale[k] != 0;
+                if (stale) node_stale[i] |= slots.stale[k] != 0;
             }
             continue;
         }
         live_box[i] = live_box[node.first];
         live_box[i].extend(live_box[node.first + 1]);
-        node_stale[i] = node_stale[node.first] | node_stale[node.first + 1];
+        if (stale) node_stale[i] = node_stale[node.first] | node_stale[node.first + 1];
     }
     // Per node: its slots, when they are a contiguous range (a subtree's leaves follow each
     // other in the BVHs built here; kNoIndex otherwise). Pairs of small subtrees are tested
@@ -367,7 +369,7 @@ std::vector<PairCrossing> find_crossings(const Bvh& bvh, const CornersOf& corner
     // Opens one node pair: tests the triangles of two leaves (or of one leaf with itself), or
     // pushes the child pairs whose boxes may overlap.
     auto expand = [&](NodePair pair, std::vector<NodePair>& next, std::vector<PairCrossing>& out) {
-        if (!node_stale[pair.first] && !node_stale[pair.second]) return;
+        if (stale && !node_stale[pair.first] && !node_stale[pair.second]) return;
         const BBox& box_a = live_box[pair.first];
         const BBox& box_b = live_box[pair.second];
         if (!overlap(box_a, box_b)) return;  // also when either has no live triangle
@@ -590,9 +592,9 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
         return Vec3f(0.0f);
     };
     auto smooth_across = [&](const Side& s0, const Side& s1) {
-        if (!corner_normals[s0.tri] || !corner_normals[s1.tri]) return false;
-        return corner_normal(s0.tri, s0.lo) == corner_normal(s1.tri, s1.lo) &&
-               corner_normal(s0.tri, s0.hi) == corner_normal(s1.tri, s1.hi);
+        if (!corner_normals[s0.tri()] || !corner_normals[s1.tri()]) return false;
+        return corner_normal(s0.tri(), s0.lo) == corner_normal(s1.tri(), s1.lo) &&
+               corner_normal(s0.tri(), s0.hi) == corner_normal(s1.tri(), s1.hi);
     };
     const EdgeBands edge_bands{scene, mesh, settings, eye, corner_normals};
     // One segment per edge that is a line: each is classified first, and made only if drawn.
@@ -604,8 +606,8 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
         if (e + kAhead < edge_count) {
             const std::uint32_t first = edge_first[e + kAhead];
             for (std::uint32_t k = first; k < std::min<std::size_t>(first + 2, side_count); ++k) {
-                __builtin_prefetch(&normal[sides[k].tri]);
-                __builtin_prefetch(&scene.tri_material[sides[k].tri]);
+                __builtin_prefetch(&normal[sides[k].tri()]);
+                __builtin_prefetch(&scene.tri_material[sides[k].tri()]);
             }
         }
         const std::uint32_t i = edge_first[e], j = edge_first[e + 1];
@@ -617,22 +619,23 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
             if (!settings.borders) continue;
         } else {
             const Side& s1 = sides[i + 1];
-            const Vec3f n0 = normal[s0.tri];
+            const Vec3f n0 = normal[s0.tri()];
             // Consistently wound neighbours run the shared side in opposite directions.
-            const Vec3f n1 = s0.forward != s1.forward ? normal[s1.tri] : -normal[s1.tri];
+            const Vec3f n1 = s0.forward() != s1.forward() ? normal[s1.tri()] : -normal[s1.tri()];
             const float d0 = dot(n0, eye - p0), d1 = dot(n1, eye - p0);
             const bool front0 = d0 > 0, front1 = d1 > 0;
             if (settings.silhouettes && front0 != front1 &&
                 !(settings.smooth_contours && smooth_across(s0, s1)))
                 type = EdgeType::Silhouette;
             else if (settings.creases && dot(n0, n1) < cos_crease) type = EdgeType::Crease;
-            else if (settings.materials && scene.tri_material[s0.tri] != scene.tri_material[s1.tri])
+            else if (settings.materials &&
+                     scene.tri_material[s0.tri()] != scene.tri_material[s1.tri()])
                 type = EdgeType::Material;
             else if (settings.bands && !smooth_across(s0, s1) &&
-                     bands_differ(edge_bands, s0.lo, s0.hi, s0.tri, s1.tri, n0, n1))
+                     bands_differ(edge_bands, s0.lo, s0.hi, s0.tri(), s1.tri(), n0, n1))
                 type = EdgeType::Band;
             else continue;
-            const int out = outward[scene.tri_object[s0.tri]];
+            const int out = outward[scene.tri_object[s0.tri()]];
             certainly_hidden =
                 out != 0 && front0 == (out < 0) && front1 == (out < 0) && d0 != 0 && d1 != 0;
             if (certainly_hidden && !settings.certainly_hidden) continue;
@@ -642,7 +645,7 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
         seg.p1 = scene.positions[mesh.vertex_position[s0.hi]];
         seg.key0 = {s0.lo, kNoIndex, kNoIndex};
         seg.key1 = {s0.hi, kNoIndex, kNoIndex};
-        seg.faces = {s0.tri, j - i > 1 ? sides[i + 1].tri : kNoIndex};
+        seg.faces = {s0.tri(), j - i > 1 ? sides[i + 1].tri() : kNoIndex};
         seg.type = type;
         seg.certainly_hidden = certainly_hidden;
     }
@@ -698,32 +701,33 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
         std::vector<std::uint8_t> live_triangle(n);
         for (std::size_t t = 0; t < n; ++t)
             live_triangle[t] = usable(t) && (settings.certainly_hidden || !turned_away[t]);
-        // With a cache, a pair is tested only if one of its triangles is stale: its corners
-        // changed since the cache's frame, or it did not take part then.
+        // With a cache of the same triangles, a pair is tested only if one of its triangles
+        // is stale: its corners changed since the cache's frame, or it did not take part then.
+        // Without one, every triangle is.
         std::vector<std::uint8_t> stale;
-        if (cache) {
-            const bool same_count = cache->corners.size() == n && cache->tested.size() == n;
+        const bool some_fresh = cache && cache->corners.size() == n && cache->tested.size() == n;
+        if (some_fresh) {
             auto same = [](const Vec3f& a, const Vec3f& b) {
                 return std::bit_cast<std::array<std::uint32_t, 3>>(a) ==
                        std::bit_cast<std::array<std::uint32_t, 3>>(b);
             };
-            stale.assign(n, 1);
-            if (same_count)
-                for (std::size_t t = 0; t < n; ++t) {
-                    const auto now = corners(scene, t);
-                    stale[t] = !cache->tested[t] ||
-                               !std::equal(now.begin(), now.end(), cache->corners[t].begin(), same);
-                }
+            stale.resize(n);
+            for (std::size_t t = 0; t < n; ++t) {
+                const auto now = corners(scene, t);
+                stale[t] = !cache->tested[t] ||
+                           !std::equal(now.begin(), now.end(), cache->corners[t].begin(), same);
+            }
         }
         std::vector<PairCrossing> found =
             find_crossings(bvh, IndexedCorners{scene.positions, scene.tri_positions}, mesh,
-                           live_triangle, cache ? &stale : nullptr, threads);
+                           live_triangle, some_fresh ? &stale : nullptr, threads);
         if (cache) {
             // The cache's crossings of triangles that are not stale and take part now; then
             // the cache is this frame's.
-            for (const PairCrossing& c : cache->crossings)
-                if (!stale[c.t] && !stale[c.u] && live_triangle[c.t] && live_triangle[c.u])
-                    found.push_back(c);
+            if (some_fresh)
+                for (const PairCrossing& c : cache->crossings)
+                    if (!stale[c.t] && !stale[c.u] && live_triangle[c.t] && live_triangle[c.u])
+                        found.push_back(c);
             // Written after the search, into memory it has freed.
             cache->corners.resize(n);
             for (std::size_t t = 0; t < n; ++t) cache->corners[t] = corners(scene, t);

@@ -16,11 +16,20 @@
 
 namespace toonray::ink {
 
-// A side of a usable triangle: from welded vertex lo to hi (lo < hi).
+// A side of a usable triangle: from welded vertex lo to hi (lo < hi). 12 bytes: whether it runs
+// forward shares a word with the triangle (a million triangles have three million sides).
 struct Side {
-    std::uint32_t lo, hi, tri;
-    bool forward;  // lo -> hi in the triangle's winding
+    std::uint32_t lo, hi;
+    std::uint32_t tri_forward;  // the triangle, and kForward when lo -> hi is its winding
+
+    static constexpr std::uint32_t kForward = 0x80000000u;
+    Side() = default;
+    Side(std::uint32_t lo_, std::uint32_t hi_, std::uint32_t tri_, bool forward_)
+        : lo(lo_), hi(hi_), tri_forward(tri_ | (forward_ ? kForward : 0u)) {}
+    [[nodiscard]] std::uint32_t tri() const { return tri_forward & ~kForward; }
+    [[nodiscard]] bool forward() const { return (tri_forward & kForward) != 0; }
 };
+static_assert(sizeof(Side) == 12);
 
 struct MeshTopology {
     // What it was made from.
@@ -92,7 +101,7 @@ struct MeshTopology {
                 const Side* j = i + 1;
                 while (j < last && j->hi == i->hi) ++j;
                 edge_first.push_back(static_cast<std::uint32_t>(i - sides.get()));
-                if (j - i != 2 || i[0].forward == i[1].forward) open[tri_object[i->tri]] = 1;
+                if (j - i != 2 || i[0].forward() == i[1].forward()) open[tri_object[i->tri()]] = 1;
                 i = j;
             }
         }
