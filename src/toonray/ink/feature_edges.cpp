@@ -204,21 +204,24 @@ bool intersect_triangles(const std::array<Vec3f, 3>& a, const std::array<Vec3f, 
 
 namespace {
 
-// What the intersection search reads per BVH primitive slot, one array per value so that four
-// neighbouring slots are tested at once: the triangle's box (empty, lo = +inf and hi = -inf,
-// when it takes no part, so that it overlaps nothing), its corners' positions (canonical: equal
-// for equal coordinates, across objects) and, when only pairs with a stale triangle are
-// searched, whether it is stale (all bits set) or not (zero). kLanes more slots pad the end so that loads of four never read past it.
+// What the intersection search reads per triangle that takes part, in the tree's order (its
+// slots), one array per value so that four neighbouring slots are tested at once: the
+// triangle, its box, its corners' positions (canonical: equal for equal coordinates, across
+// objects) and, when only pairs with a stale triangle are searched, whether it is stale (all
+// bits set) or not (zero). kLanes more slots pad the end so that loads of four never read past
+// it; their boxes are empty (lo = +inf, hi = -inf), so that they overlap nothing.
 constexpr std::uint32_t kLanes = 4;
 // Pairs of subtrees of at most this many slots each are tested slot against slot (measured:
 // fewer instructions than 8 or 32 on the scan and the piano).
 constexpr std::uint32_t kSmallSubtree = 16;
 struct Slots {
+    std::unique_ptr<std::uint32_t[]> tri;
     std::unique_ptr<float[]> lo[3], hi[3];
     std::unique_ptr<std::uint32_t[]> corner[3];
     std::unique_ptr<std::uint32_t[]> stale;  // null when every triangle is
 
     Slots(std::size_t count, bool some_fresh) {  // values left for the caller to write
+        tri = std::make_unique_for_overwrite<std::uint32_t[]>(count);
         for (int a = 0; a < 3; ++a) {
             lo[a] = std::make_unique_for_overwrite<float[]>(count);
             hi[a] = std::make_unique_for_overwrite<float[]>(count);
@@ -269,11 +272,22 @@ std::vector<PairCrossing> find_crossings(const Bvh& bvh, const CornersOf& corner
                                          const std::vector<std::uint8_t>* stale, int threads) {
     const std::uint32_t prims = static_cast<std::uint32_t>(bvh.prim_indices.size());
     constexpr float inf = std::numeric_limits<float>::infinity();
-    Slots slots(prims + kLanes, stale != nullptr);
+    // Only the triangles that take part have slots (about half of them, without hidden lines:
+    // those facing the eye), so that the tests of small subtrees see no dead lanes. A tree
+    // range [first, end) holds slots [slot_of[first], slot_of[end]).
+    std::vector<std::uint32_t> slot_of(prims + 1);
+    std::uint32_t taking_part = 0;
+    for (std::uint32_t i = 0; i < prims; ++i) {
+        slot_of[i] = taking_part;
+        const std::uint32_t t = bvh.prim_indices[i];
+        taking_part += t != kNoIndex && live[t] ? 1 : 0;
+    }
+    slot_of[prims] = taking_part;
+    Slots slots(taking_part + kLanes, stale != nullptr);
     // The triangles come in the tree's order, which scatters them over the per-triangle
     // arrays: what a slot reads is fetched ahead (the fill is bound by those misses).
     constexpr std::uint32_t kAhead = 16;
-    for (std::uint32_t i = 0; i < prims + kLanes; ++i) {
+    for (std::uint32_t i = 0; i < prims; ++i) {
         if (i + kAhead < prims) {
             const std::uint32_t ahead = bvh.prim_indices[i + kAhead];
             __builtin_prefetch(&live[ahead]);
@@ -283,27 +297,28 @@ std::vector<PairCrossing> find_crossings(const Bvh& bvh, const CornersOf& corner
         if (i + kAhead / 2 < prims)
             for (std::uint32_t v : mesh.tri_vertices[bvh.prim_indices[i + kAhead / 2]])
                 __builtin_prefetch(&mesh.vertex_position[v]);
-        const std::uint32_t t = i < prims ? bvh.prim_indices[i] : kNoIndex;
-        if (t == kNoIndex || !live[t]) {
-            for (int a = 0; a < 3; ++a) {
-                slots.lo[a][i] = inf;
-                slots.hi[a][i] = -inf;
-                slots.corner[a][i] = kNoIndex;
-            }
-            if (stale) slots.stale[i] = 0;
-            continue;
-        }
+        if (slot_of[i + 1] == slot_of[i]) continue;  // takes no part
+        const std::uint32_t t = bvh.prim_indices[i], at = slot_of[i];
+        slots.tri[at] = t;
         for (int k = 0; k < 3; ++k)
-            slots.corner[k][i] = mesh.vertex_position[mesh.tri_vertices[t][k]];
-        if (stale) slots.stale[i] = (*stale)[t] ? kNoIndex : 0;
+            slots.corner[k][at] = mesh.vertex_position[mesh.tri_vertices[t][k]];
+        if (stale) slots.stale[at] = (*stale)[t] ? kNoIndex : 0;
         BBox box;
         for (const Vec3f& p : corners_of(t)) box.extend(p);
         for (int a = 0; a < 3; ++a) {
-            slots.lo[a][i] = box.lo[a];
-            slots.hi[a][i] = box.hi[a];
+            slots.lo[a][at] = box.lo[a];
+            slots.hi[a][at] = box.hi[a];
         }
     }
-    auto live_slot = [&](std::uint32_t i) { return slots.lo[0][i] != inf; };
+    for (std::uint32_t at = taking_part; at < taking_part + kLanes; ++at) {
+        slots.tri[at] = kNoIndex;
+        for (int a = 0; a < 3; ++a) {
+            slots.lo[a][at] = inf;
+            slots.hi[a][at] = -inf;
+            slots.corner[a][at] = kNoIndex;
+        }
+        if (stale) slots.stale[at] = 0;
+    }
     auto slot_box = [&](std::uint32_t i) {
         return BBox{Vec3f(slots.lo[0][i], slots.lo[1][i], slots.lo[2][i]),
                     Vec3f(slots.hi[0][i], slots.hi[1][i], slots.hi[2][i])};
@@ -316,8 +331,7 @@ std::vector<PairCrossing> find_crossings(const Bvh& bvh, const CornersOf& corner
     for (std::size_t i = bvh.nodes.size(); i-- > 0;) {  // children come after parents
         const BvhNode& node = bvh.nodes[i];
         if (node.is_leaf()) {
-            for (std::uint32_t k = node.first; k < node.first + node.count; ++k) {
-                if (!live_slot(k)) continue;
+            for (std::uint32_t k = slot_of[node.first]; k < slot_of[node.first + node.count]; ++k) {
                 live_box[i].extend(slot_box(k));
                 if (stale) node_stale[i] |= slots.stale[k] != 0;
             }
@@ -334,8 +348,8 @@ std::vector<PairCrossing> find_crossings(const Bvh& bvh, const CornersOf& corner
     for (std::size_t i = bvh.nodes.size(); i-- > 0;) {
         const BvhNode& node = bvh.nodes[i];
         if (node.is_leaf()) {
-            range_first[i] = node.first;
-            range_count[i] = node.count;
+            range_first[i] = slot_of[node.first];
+            range_count[i] = slot_of[node.first + node.count] - slot_of[node.first];
             continue;
         }
         const std::uint32_t l = node.first, r = node.first + 1;
@@ -357,7 +371,7 @@ std::vector<PairCrossing> find_crossings(const Bvh& bvh, const CornersOf& corner
             for (; mask; mask &= mask - 1) {
                 const std::uint32_t k =
                     j + static_cast<std::uint32_t>(std::countr_zero(static_cast<unsigned>(mask)));
-                std::uint32_t t = bvh.prim_indices[i], u = bvh.prim_indices[k];
+                std::uint32_t t = slots.tri[i], u = slots.tri[k];
                 if (u < t) std::swap(t, u);
                 PairCrossing found{t, u, {}};
                 if (intersect_triangles(corners_of(t), corners_of(u), found.crossing))
@@ -379,8 +393,7 @@ std::vector<PairCrossing> find_crossings(const Bvh& bvh, const CornersOf& corner
         const std::uint32_t b0 = range_first[pair.second], bn = range_count[pair.second];
         if (pair.first == pair.second) {
             if (a.is_leaf() || an <= kSmallSubtree) {
-                for (std::uint32_t i = a0; i + 1 < a0 + an; ++i)
-                    if (live_slot(i)) test_slots(i, i + 1, a0 + an, out);
+                for (std::uint32_t i = a0; i + 1 < a0 + an; ++i) test_slots(i, i + 1, a0 + an, out);
             } else {
                 next.push_back({a.first, a.first});
                 next.push_back({a.first + 1, a.first + 1});
@@ -390,7 +403,7 @@ std::vector<PairCrossing> find_crossings(const Bvh& bvh, const CornersOf& corner
         }
         if ((a.is_leaf() && b.is_leaf()) || (an <= kSmallSubtree && bn <= kSmallSubtree)) {
             for (std::uint32_t i = a0; i < a0 + an; ++i)
-                if (live_slot(i) && overlap(slot_box(i), box_b)) test_slots(i, b0, b0 + bn, out);
+                if (overlap(slot_box(i), box_b)) test_slots(i, b0, b0 + bn, out);
             return;
         }
         // Open the inner node with the larger box (or the only inner one).
