@@ -26,8 +26,8 @@ struct alignas(32) PrimRef {
 
 constexpr int kMaxBins = 64;
 constexpr int kMaxLeaf = 128;
-// Nodes with at least this many primitives are binned and partitioned by several tasks, in
-// chunks of kChunk; subtrees of at least kTaskSize primitives become tasks of their own. These
+// Nodes with at least this many primitives are binned by several tasks, in chunks of kChunk;
+// subtrees of at least kTaskSize primitives become tasks of their own. These
 // are fixed numbers, so the tree never depends on the thread count.
 constexpr std::size_t kParallelSplit = 1u << 15;
 constexpr std::size_t kChunk = 1u << 13;
@@ -194,8 +194,7 @@ struct NodeChunk {
 
 struct Task {
     NodeChunk* chunk;
-    std::uint32_t node;    // index in chunk->nodes
-    std::uint32_t buffer;  // which of the two PrimRef arrays holds the range
+    std::uint32_t node;  // index in chunk->nodes
     std::size_t begin, end;
     Box4 bounds, centres;
 };
@@ -224,26 +223,26 @@ struct GoesLeft {
     }
 };
 
-// Moves src[begin, end) into dst, those going left from `left_at` on and the others from
-// `right_at` on, in their order, and bounds the centres of both sides. No branch depends on the
-// side: it would be mispredicted about as often as not (the bounds by blends; a second pass
-// over each side for them, without blends, measured more instructions and more mispredicted
-// loop exits).
+// Partitions refs[begin, end) in place, those going left first (Lomuto's scheme: each
+// primitive is swapped to the end of the left side, which advances when it goes left), and
+// bounds the centres of both sides. In place, a build touches half the memory a second buffer
+// would (32 bytes a primitive less, whose first touch costs more than the swaps), and no branch
+// depends on the side: it would be mispredicted about as often as not. The order within each
+// side is not kept, which changes no split: bins are minima, maxima and counts.
 template <int A>
-void partition_range(const PrimRef* src, PrimRef* dst, std::size_t begin, std::size_t end,
-                     std::size_t left_at, std::size_t right_at, GoesLeft<A> left, Box4& lc,
+void partition_range(PrimRef* refs, std::size_t begin, std::size_t end, GoesLeft<A> left, Box4& lc,
                      Box4& rc) {
     __m128 llo = lc.lo, lhi = lc.hi, rlo = rc.lo, rhi = rc.hi;
+    std::size_t left_end = begin;
     for (std::size_t i = begin; i < end; ++i) {
-        const __m128 lo = src[i].lo, hi = src[i].hi;
+        const __m128 lo = refs[i].lo, hi = refs[i].hi;
         const __m128 c = _mm_add_ps(lo, hi);
         const __m128 m = _mm_castsi128_ps(left.mask(c));
         const std::size_t goes_left = static_cast<std::size_t>(_mm_movemask_ps(m) & 1);
-        const std::size_t at = goes_left ? left_at : right_at;
-        dst[at].lo = lo;
-        dst[at].hi = hi;
-        left_at += goes_left;
-        right_at += goes_left ^ 1;
+        refs[i] = refs[left_end];
+        refs[left_end].lo = lo;
+        refs[left_end].hi = hi;
+        left_end += goes_left;
         llo = _mm_min_ps(llo, _mm_blendv_ps(kPosInf, c, m));
         lhi = _mm_max_ps(lhi, _mm_blendv_ps(kNegInf, c, m));
         rlo = _mm_min_ps(rlo, _mm_blendv_ps(c, kPosInf, m));
@@ -258,19 +257,19 @@ struct Builder {
     int bins;
     int max_leaf;
     int block_shift;              // log2 of the block size
-    PrimRef* buffers[2];          // the primitives, and where partitions move them (ping-pong)
+    PrimRef* refs;                // the primitives, partitioned in place
     std::uint32_t* prim_indices;  // leaves write their primitives' ids here
     float* leaf_areas;            // and, when not null, their boxes' half areas
     tbb::task_group tasks;
     std::mutex chunks_mutex;
     std::vector<std::unique_ptr<NodeChunk>> chunks;
 
-    Builder(const Bvh::Config& c, PrimRef* refs, PrimRef* scratch, std::uint32_t* ids, float* areas)
+    Builder(const Bvh::Config& c, PrimRef* refs_, std::uint32_t* ids, float* areas)
         : config(c),
           bins(std::clamp(c.bin_count, 2, kMaxBins)),
           max_leaf(std::clamp(c.max_leaf_size, 1, kMaxLeaf)),
           block_shift(0),
-          buffers{refs, scratch},
+          refs(refs_),
           prim_indices(ids),
           leaf_areas(areas) {
         while ((1 << block_shift) < std::clamp(c.block_size, 1, 64)) ++block_shift;
@@ -297,12 +296,11 @@ struct Builder {
         return static_cast<float>((n + (1u << block_shift) - 1) >> block_shift);
     }
 
-    // Bins t's primitives into `out`. A node of kParallelSplit primitives or more is binned in
-    // chunks of kChunk, whose bins are left in `chunk_bins` for its partition.
+    // Bins t's primitives into `out`. A node of kParallelSplit primitives or more is binned by
+    // several tasks, in chunks of kChunk (`chunk_bins` holds their bins).
     void bin(const Task& t, const Binner& binner, int bins, Bins& out,
              std::vector<Bins>& chunk_bins) const {
         const std::size_t n = t.end - t.begin;
-        const PrimRef* refs = buffers[t.buffer];
         out.clear(bins);
         if (n < kParallelSplit) {
             if (n < 1024) {
@@ -386,54 +384,20 @@ struct Builder {
         return best;
     }
 
-    // Moves t's range into the other buffer, the left side first (stable), several tasks when
-    // it is large (chunk_bins: bin()'s bins of its chunks); sets the children's buffer and
-    // centre bounds.
+    // Partitions t's range in place and sets the children's centre bounds. One task, also for
+    // the largest nodes: the children's subtrees are tasks of their own, so only the top levels
+    // are partitioned with fewer tasks than threads, a small part of a build.
     template <int A>
-    void partition_axis(const Task& t, const Binner& binner, const Split& s,
-                        const std::vector<Bins>& chunk_bins, Task& l, Task& r) {
+    void partition_axis(const Task& t, const Binner& binner, const Split& s, Task& l, Task& r) {
         const GoesLeft<A> left{binner.base, binner.scale, _mm_set1_epi32(s.bin)};
-        const PrimRef* src = buffers[t.buffer];
-        PrimRef* dst = buffers[1 - t.buffer];
-        l.buffer = r.buffer = 1 - t.buffer;
-        const std::size_t n = t.end - t.begin;
-        if (n < kParallelSplit) {
-            partition_range(src, dst, t.begin, t.end, t.begin, t.begin + s.left_count, left,
-                            l.centres, r.centres);
-            return;
-        }
-        // In chunks: each chunk's left side is the count of its bins below the split, the
-        // primitives GoesLeft sends left, so each chunk knows where its primitives go.
-        const std::size_t chunks = (n + kChunk - 1) / kChunk;
-        std::vector<std::size_t> left_at(chunks), right_at(chunks);
-        std::size_t nl = 0, nr = 0;
-        for (std::size_t c = 0; c < chunks; ++c) {
-            std::size_t left_count = 0;
-            for (int b = 0; b < s.bin; ++b) left_count += chunk_bins[c].count(A, b);
-            left_at[c] = t.begin + nl;
-            right_at[c] = t.begin + s.left_count + nr;
-            nl += left_count;
-            nr += std::min(kChunk, n - c * kChunk) - left_count;
-        }
-        std::vector<Box4> lcs(chunks), rcs(chunks);
-        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, chunks, 1), [&](const auto& range) {
-            for (std::size_t c = range.begin(); c != range.end(); ++c) {
-                const std::size_t b = t.begin + c * kChunk, e = std::min(b + kChunk, t.end);
-                partition_range(src, dst, b, e, left_at[c], right_at[c], left, lcs[c], rcs[c]);
-            }
-        });
-        for (std::size_t c = 0; c < chunks; ++c) {
-            l.centres.extend(lcs[c]);
-            r.centres.extend(rcs[c]);
-        }
+        partition_range(refs, t.begin, t.end, left, l.centres, r.centres);
     }
 
-    void partition(const Task& t, const Binner& binner, const Split& s,
-                   const std::vector<Bins>& chunk_bins, Task& l, Task& r) {
+    void partition(const Task& t, const Binner& binner, const Split& s, Task& l, Task& r) {
         switch (s.axis) {
-            case 0: partition_axis<0>(t, binner, s, chunk_bins, l, r); break;
-            case 1: partition_axis<1>(t, binner, s, chunk_bins, l, r); break;
-            default: partition_axis<2>(t, binner, s, chunk_bins, l, r); break;
+            case 0: partition_axis<0>(t, binner, s, l, r); break;
+            case 1: partition_axis<1>(t, binner, s, l, r); break;
+            default: partition_axis<2>(t, binner, s, l, r); break;
         }
     }
 
@@ -450,7 +414,6 @@ struct Builder {
     }
 
     void make_leaf(const Task& t) {
-        const PrimRef* refs = buffers[t.buffer];
         for (std::size_t i = t.begin; i < t.end; ++i)
             prim_indices[i] =
                 static_cast<std::uint32_t>(_mm_extract_epi32(_mm_castps_si128(refs[i].lo), 3));
@@ -466,7 +429,7 @@ struct Builder {
     void build(Task root) {
         std::vector<Task> todo{root};
         Bins bins_storage;
-        std::vector<Bins> chunk_bins;  // of the large nodes, for their partitions
+        std::vector<Bins> chunk_bins;  // of the large nodes' chunks
         while (!todo.empty()) {
             Task t = todo.back();
             todo.pop_back();
@@ -487,8 +450,8 @@ struct Builder {
             Split s = find_split(bins_storage, node_bins, n);
             const float leaf_cost = config.intersection_cost * blocks(n);
             std::size_t mid;
-            Task left{t.chunk, 0, t.buffer, t.begin, 0, {}, {}};
-            Task right{t.chunk, 0, t.buffer, 0, t.end, {}, {}};
+            Task left{t.chunk, 0, t.begin, 0, {}, {}};
+            Task right{t.chunk, 0, 0, t.end, {}, {}};
             if (s.axis >= 0) {
                 float split_cost = config.traversal_cost +
                                    config.intersection_cost * s.cost / t.bounds.half_area();
@@ -496,7 +459,7 @@ struct Builder {
                     make_leaf(t);
                     continue;
                 }
-                partition(t, binner, s, chunk_bins, left, right);
+                partition(t, binner, s, left, right);
                 mid = t.begin + s.left_count;
                 left.bounds = s.left;
                 right.bounds = s.right;
@@ -506,8 +469,8 @@ struct Builder {
                     continue;
                 }
                 mid = t.begin + n / 2;  // identical centres: split the list in two
-                range_bounds(buffers[t.buffer], t.begin, mid, left.bounds, left.centres);
-                range_bounds(buffers[t.buffer], mid, t.end, right.bounds, right.centres);
+                range_bounds(refs, t.begin, mid, left.bounds, left.centres);
+                range_bounds(refs, mid, t.end, right.bounds, right.centres);
             }
             left.end = mid;
             right.begin = mid;
@@ -575,18 +538,17 @@ Bvh build_over(std::size_t n, BoxOf box_of, const Bvh::Config& config,
         }
     }
 
-    auto scratch = accel::make_huge_array<PrimRef>(n);
     accel::reserve_huge(bvh.prim_indices, n);
     bvh.prim_indices.resize(n);
     if (leaf_areas) {
         accel::reserve_huge(*leaf_areas, n);
         leaf_areas->resize(n);
     }
-    Builder builder(config, refs.get(), scratch.get(), bvh.prim_indices.data(),
+    Builder builder(config, refs.get(), bvh.prim_indices.data(),
                     leaf_areas ? leaf_areas->data() : nullptr);
     NodeChunk* root = builder.new_chunk(0, n).chunk;
     root->nodes.emplace_back();
-    builder.build(Task{root, 0, 0, 0, n, bounds, centres});
+    builder.build(Task{root, 0, 0, n, bounds, centres});
     builder.tasks.wait();
 
     // Join the chunks: the root's first, then the others by their first primitive (a parent's

@@ -41,7 +41,7 @@ struct Bvh {
     std::vector<std::uint32_t> prim_indices;  ///< primitive ids in leaf order
 
     /// Builds with binned SAH on the boxes' centres: all three axes binned in one pass over the
-    /// primitives, the large top levels binned and partitioned in parallel (TBB) and subtrees
+    /// primitives, the large top levels binned in parallel (TBB), partitions in place, and subtrees
     /// built as parallel tasks. Deterministic: the same input gives the same tree for any thread
     /// count (work is cut at fixed sizes, merges are exact min/max and sums, and each subtree
     /// task numbers its nodes in a chunk of its own; the chunks are joined in the order of their
