@@ -42,6 +42,36 @@ TEST(InkLines, TeapotHasLinesOfEveryStageAndIsThreadIndependent) {
     EXPECT_GT(covered, 1000);
 }
 
+TEST(InkLines, MeshEdgesAreKeptForTheNextFrameWhileTheWeldsStay) {
+    // The cache keeps the last frame's mesh edges with the welded triangles they were found
+    // for, which the next frame's drawing moves into it: the same triangles reuse them, and
+    // welds that change find them again.
+    Teapot t(640, 360);
+    ink::InkLines lines;
+    ink::draw_ink_lines(t.scene, t.accel, t.camera, 640, 360, {}, 1, lines);
+    const auto first = lines.intersections.topology;
+    ASSERT_NE(first, nullptr);
+    const std::vector<ink::FeatureSegment> segments = lines.segments;
+    ink::draw_ink_lines(t.scene, t.accel, t.camera, 640, 360, {}, 1, lines);
+    EXPECT_EQ(lines.intersections.topology, first);
+    EXPECT_EQ(lines.intersections.welded, lines.mesh.tri_vertices);
+    ASSERT_EQ(lines.segments.size(), segments.size());
+    // Two corners of the first triangle at one place: its welds change.
+    t.scene.positions[t.scene.tri_positions[0][1]] = t.scene.positions[t.scene.tri_positions[0][0]];
+    t.accel.build(t.scene.positions, t.scene.tri_positions);
+    ink::draw_ink_lines(t.scene, t.accel, t.camera, 640, 360, {}, 1, lines);
+    EXPECT_NE(lines.intersections.topology, first);
+    // A fresh drawing of the changed teapot gives the same segments.
+    ink::InkLines fresh;
+    ink::draw_ink_lines(t.scene, t.accel, t.camera, 640, 360, {}, 1, fresh);
+    ASSERT_EQ(lines.segments.size(), fresh.segments.size());
+    for (std::size_t i = 0; i < fresh.segments.size(); ++i) {
+        EXPECT_EQ(lines.segments[i].p0, fresh.segments[i].p0) << i;
+        EXPECT_EQ(lines.segments[i].p1, fresh.segments[i].p1) << i;
+        EXPECT_EQ(lines.segments[i].type, fresh.segments[i].type) << i;
+    }
+}
+
 TEST(InkSvg, ParsesAsXmlWithTheLayersAndGroups) {
     const Teapot t(640, 360);
     ink::InkSettings settings;

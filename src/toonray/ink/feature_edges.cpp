@@ -567,7 +567,7 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
     // The mesh edges, as the last frame's when the triangles' welded corners, objects and
     // usability did not change.
     std::shared_ptr<const MeshTopology> kept = cache ? cache->topology : nullptr;
-    if (!kept || !kept->same(scene, mesh, usable_triangle, objects))
+    if (!kept || cache->welded != mesh.tri_vertices || !kept->same(scene, usable_triangle, objects))
         kept =
             std::make_shared<const MeshTopology>(scene.tri_object, mesh, usable_triangle, objects);
     if (cache) cache->topology = kept;

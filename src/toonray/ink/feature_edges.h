@@ -141,6 +141,11 @@ struct IntersectionCache {
     /// The last frame's mesh edges, the same while the welded triangles, their objects and
     /// which of them are usable (not degenerate) stay the same.
     std::shared_ptr<const MeshTopology> topology;
+    /// The welded triangles (WeldedMesh::tri_vertices) `topology` was found for, which
+    /// draw_ink_lines moves here from the last frame's mesh before it welds the next (rather
+    /// than the topology keeping a copy: 12 bytes a triangle at the frame's peak). Left empty,
+    /// the topology is found again each frame.
+    std::vector<std::array<std::uint32_t, 3>> welded;
 };
 
 /// Per object, whether the mesh edges of the cache's last frame make it closed (every edge has

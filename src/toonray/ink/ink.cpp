@@ -183,6 +183,8 @@ void draw_ink_lines(const Scene& scene, const TriangleAccel& accel, const Camera
     visibility.min_piece = chain.min_piece;
 
     auto start = std::chrono::steady_clock::now();
+    // The last frame's welded triangles go to the cache, whose mesh edges were found for them.
+    out.intersections.welded = std::move(out.mesh.tri_vertices);
     out.mesh = weld_vertices(scene);
     FeatureEdgeSettings edges = settings.edges;
     if (!settings.chain.hidden) edges.certainly_hidden = false;  // chaining would drop them

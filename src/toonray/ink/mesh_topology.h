@@ -32,8 +32,7 @@ struct Side {
 static_assert(sizeof(Side) == 12);
 
 struct MeshTopology {
-    // What it was made from.
-    std::vector<std::array<std::uint32_t, 3>> tri_vertices;
+    // What it was made from, besides the welded triangles (IntersectionCache::welded).
     std::vector<std::uint32_t> tri_object;
     std::vector<std::uint8_t> usable;
     std::size_t objects = 0;
@@ -48,11 +47,11 @@ struct MeshTopology {
     /// `object_of` has each triangle's object (< objects_).
     MeshTopology(std::span<const std::uint32_t> object_of, const WeldedMesh& mesh,
                  std::span<const std::uint8_t> usable_, std::size_t objects_)
-        : tri_vertices(mesh.tri_vertices),
-          tri_object(object_of.begin(), object_of.begin() + usable_.size()),
+        : tri_object(object_of.begin(), object_of.begin() + usable_.size()),
           usable(usable_.begin(), usable_.end()),
           objects(objects_),
           open(objects_, 0) {
+        const auto& tri_vertices = mesh.tri_vertices;
         const std::size_t n = usable.size(), vertices = mesh.vertex_count();
         // A counting sort by lo over the triangles in order puts each vertex's sides in
         // (triangle, corner) order; a stable sort by hi within each vertex then gives the
@@ -108,11 +107,11 @@ struct MeshTopology {
         edge_first.push_back(static_cast<std::uint32_t>(side_count));
     }
 
-    [[nodiscard]] bool same(const TriangleMesh& scene, const WeldedMesh& mesh,
-                            std::span<const std::uint8_t> usable_, std::size_t objects_) const {
+    /// Whether the triangles' objects and usability are those it was made from.
+    [[nodiscard]] bool same(const TriangleMesh& scene, std::span<const std::uint8_t> usable_,
+                            std::size_t objects_) const {
         return objects_ == objects && usable_.size() == usable.size() &&
                std::equal(usable.begin(), usable.end(), usable_.begin()) &&
-               mesh.tri_vertices == tri_vertices &&
                std::equal(tri_object.begin(), tri_object.end(), scene.tri_object.begin());
     }
 };
