@@ -401,8 +401,7 @@ struct Builder {
         }
     }
 
-    void range_bounds(const PrimRef* refs, std::size_t begin, std::size_t end, Box4& bounds,
-                      Box4& centres) const {
+    void range_bounds(std::size_t begin, std::size_t end, Box4& bounds, Box4& centres) const {
         for (std::size_t i = begin; i < end; ++i) {
             bounds.extend(refs[i].lo, refs[i].hi);
             centres.extend_point(_mm_add_ps(refs[i].lo, refs[i].hi));
@@ -469,8 +468,8 @@ struct Builder {
                     continue;
                 }
                 mid = t.begin + n / 2;  // identical centres: split the list in two
-                range_bounds(refs, t.begin, mid, left.bounds, left.centres);
-                range_bounds(refs, mid, t.end, right.bounds, right.centres);
+                range_bounds(t.begin, mid, left.bounds, left.centres);
+                range_bounds(mid, t.end, right.bounds, right.centres);
             }
             left.end = mid;
             right.begin = mid;

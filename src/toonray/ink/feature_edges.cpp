@@ -58,11 +58,6 @@ bool has_corner_normals(const Scene& scene, std::size_t t) {
     return true;
 }
 
-std::array<Vec3f, 3> corners(const Scene& scene, std::size_t t) {
-    const auto& v = scene.tri_positions[t];
-    return {scene.positions[v[0]], scene.positions[v[1]], scene.positions[v[2]]};
-}
-
 }  // namespace
 
 WeldedMesh weld_vertices(const TriangleMesh& scene) { return weld_vertices(scene, false); }
@@ -220,14 +215,14 @@ struct Slots {
     std::unique_ptr<std::uint32_t[]> corner[3];
     std::unique_ptr<std::uint32_t[]> stale;  // null when every triangle is
 
-    Slots(std::size_t count, bool some_fresh) {  // values left for the caller to write
+    Slots(std::size_t count, bool with_stale) {  // values left for the caller to write
         tri = std::make_unique_for_overwrite<std::uint32_t[]>(count);
         for (int a = 0; a < 3; ++a) {
             lo[a] = std::make_unique_for_overwrite<float[]>(count);
             hi[a] = std::make_unique_for_overwrite<float[]>(count);
             corner[a] = std::make_unique_for_overwrite<std::uint32_t[]>(count);
         }
-        if (some_fresh) stale = std::make_unique_for_overwrite<std::uint32_t[]>(count);
+        if (with_stale) stale = std::make_unique_for_overwrite<std::uint32_t[]>(count);
     }
 };
 
@@ -511,10 +506,11 @@ std::vector<std::int8_t> outward_objects(const Scene& scene, std::span<const std
                                          const Vec3f& eye) {
     std::vector<double> volume(closed.size(), 0.0);
     std::vector<BBox> box(closed.size());
+    const IndexedCorners corners_of{scene.positions, scene.tri_positions};
     for (std::size_t t = 0; t < scene.triangle_count(); ++t) {
         const std::uint32_t o = scene.tri_object[t];
         if (o >= closed.size() || !closed[o]) continue;
-        const auto p = corners(scene, t);
+        const auto p = corners_of(t);
         volume[o] += static_cast<double>(dot(p[0], cross(p[1], p[2])));
         for (const Vec3f& q : p) box[o].extend(q);
     }
@@ -549,13 +545,14 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
     // usable), whether it has a normal at every corner, and its object's box and volume. The
     // corners are read from the scene where needed, not stored: at a million triangles a copy
     // is 40 MB more at the frame's peak, whose first touch costs more than the reads.
+    const IndexedCorners corners_of{scene.positions, scene.tri_positions};
     std::vector<Vec3f> normal;
     std::vector<std::uint8_t> corner_normals, usable_triangle;
     normal.reserve(n);
     corner_normals.reserve(n);
     usable_triangle.reserve(n);
     for (std::size_t t = 0; t < n; ++t) {
-        const auto p = corners(scene, t);
+        const auto p = corners_of(t);
         usable_triangle.push_back(normal.emplace_back(face_normal(p)) != Vec3f(0.0f));
         corner_normals.push_back(has_corner_normals(scene, t));
         const std::uint32_t o = scene.tri_object[t];
@@ -591,7 +588,7 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
     std::vector<std::uint8_t> turned_away(n, 0);
     for (std::size_t t = 0; t < n; ++t) {
         const int out = outward[scene.tri_object[t]];
-        const float facing = dot(normal[t], eye - scene.positions[scene.tri_positions[t][0]]);
+        const float facing = dot(normal[t], eye - corners_of(t)[0]);
         turned_away[t] = out != 0 && usable(t) && (out > 0 ? facing < 0 : facing > 0);
     }
 
@@ -671,7 +668,7 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
         std::vector<float> g_value(scene.positions.size());
         for (std::size_t t = 0; t < n; ++t) {
             if (!usable(t) || !corner_normals[t]) continue;
-            const auto p = corners(scene, t);
+            const auto p = corners_of(t);
             float g[3];
             for (int k = 0; k < 3; ++k) {
                 const std::uint32_t position = scene.tri_positions[t][k],
@@ -726,14 +723,13 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
             };
             stale.resize(n);
             for (std::size_t t = 0; t < n; ++t) {
-                const auto now = corners(scene, t);
+                const auto now = corners_of(t);
                 stale[t] = !cache->tested[t] ||
                            !std::equal(now.begin(), now.end(), cache->corners[t].begin(), same);
             }
         }
-        std::vector<PairCrossing> found =
-            find_crossings(bvh, IndexedCorners{scene.positions, scene.tri_positions}, mesh,
-                           live_triangle, some_fresh ? &stale : nullptr, threads);
+        std::vector<PairCrossing> found = find_crossings(bvh, corners_of, mesh, live_triangle,
+                                                         some_fresh ? &stale : nullptr, threads);
         if (cache) {
             // The cache's crossings of triangles that are not stale and take part now; then
             // the cache is this frame's.
@@ -742,8 +738,9 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
                     if (!stale[c.t] && !stale[c.u] && live_triangle[c.t] && live_triangle[c.u])
                         found.push_back(c);
             // Written after the search, into memory it has freed.
-            cache->corners.resize(n);
-            for (std::size_t t = 0; t < n; ++t) cache->corners[t] = corners(scene, t);
+            cache->corners.clear();
+            cache->corners.reserve(n);
+            for (std::size_t t = 0; t < n; ++t) cache->corners.push_back(corners_of(t));
             cache->tested = live_triangle;
         }
         // In the order of the triangle pairs, whatever the tree.
