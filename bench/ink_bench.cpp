@@ -253,8 +253,11 @@ void run_lines_only(const Options& options) {
                    fresh.row());
         if (!options.previous) continue;
         for (int i = 0; i <= options.repeats; ++i) {
+            // The previous frame twice: the cache keeps corners from its second frame on.
             fresh_frame_lines(before.scene, before.accel, before.camera, options.width,
                               options.height, lines);
+            ink::draw_ink_lines(before.scene, before.accel, before.camera, options.width,
+                                options.height, {}, 1, lines);
             next_frame_lines(scene, accel, camera, options.width, options.height, lines);
             if (i > 0 || options.repeats == 0) next.add(lines.timings);
         }

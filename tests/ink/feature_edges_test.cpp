@@ -278,7 +278,12 @@ TEST(FeatureEdges, WhatIsKeptFromTheLastFrameGivesTheSegmentsFoundAnew) {
         EXPECT_TRUE(same_segments(kept, find(nullptr)));
         EXPECT_EQ(intersection_lines(kept), brute_force_crossings(s));
     };
+    // The first frame keeps no corners (a single frame would not read them); the second does.
     check_frame();
+    EXPECT_TRUE(cache.corners.empty() && cache.tested.empty());
+    check_frame();
+    EXPECT_EQ(cache.corners.size(), s.triangle_count());
+    EXPECT_EQ(cache.tested.size(), s.triangle_count());
     // The sphere moves through the soup and the boxes; the rest stays (the mesh edges are
     // the same, the intersection lines of the sphere are found again).
     for (std::size_t t = 0; t < s.triangle_count(); ++t)

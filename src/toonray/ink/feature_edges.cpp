@@ -563,6 +563,9 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
 
     // The mesh edges, as the last frame's when the triangles' welded corners, objects and
     // usability did not change.
+    // A cache that holds mesh edges has seen a frame before: frames follow each other, and
+    // this one's corners are worth keeping for the next.
+    const bool frames_follow = cache && cache->topology;
     std::shared_ptr<const MeshTopology> kept = cache ? cache->topology : nullptr;
     if (!kept || cache->welded != mesh.tri_vertices || !kept->same(scene, usable_triangle, objects))
         kept =
@@ -739,9 +742,12 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
                         found.push_back(c);
             // Written after the search, into memory it has freed.
             cache->corners.clear();
-            cache->corners.reserve(n);
-            for (std::size_t t = 0; t < n; ++t) cache->corners.push_back(corners_of(t));
-            cache->tested = live_triangle;
+            cache->tested.clear();
+            if (frames_follow) {
+                cache->corners.reserve(n);
+                for (std::size_t t = 0; t < n; ++t) cache->corners.push_back(corners_of(t));
+                cache->tested = live_triangle;
+            }
         }
         // In the order of the triangle pairs, whatever the tree.
         std::sort(found.begin(), found.end(), [](const PairCrossing& x, const PairCrossing& y) {

@@ -132,7 +132,8 @@ struct MeshTopology;
 /// and did not move (corners equal bit for bit) gives the same crossing; only pairs with another
 /// triangle are tested again. Between two frames of the piano most triangles do not move.
 struct IntersectionCache {
-    std::vector<std::array<Vec3f, 3>> corners;  ///< each triangle's corners in the last frame
+    /// Each triangle's corners in the last frame; empty after the cache's first frame.
+    std::vector<std::array<Vec3f, 3>> corners;
     /// Per triangle: it took part in the last frame (without hidden lines, triangles turned
     /// away from the eye on closed solids do not), so its pairs with others that did are in
     /// `crossings`.
@@ -166,7 +167,9 @@ struct IntersectionCache {
 /// whatever the thread count. `bvh` is a BVH over the scene's triangles (TriangleAccel::bvh())
 /// for the intersection lines. With a cache, the intersection lines of triangles that did not
 /// move since the cache's last frame are taken from it (the same segments), and the cache is
-/// updated.
+/// updated. The cache keeps the triangles' corners only from its second frame on (when it
+/// already holds mesh edges): a single frame does not pay for a copy it will not read (36
+/// bytes a triangle), and an animation's second frame searches in full.
 [[nodiscard]] std::vector<FeatureSegment> find_feature_edges(
     const Scene& scene, const WeldedMesh& mesh, const Bvh& bvh, const Vec3f& eye,
     const FeatureEdgeSettings& settings, int threads, IntersectionCache* cache = nullptr);
