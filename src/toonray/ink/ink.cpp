@@ -185,6 +185,9 @@ void draw_ink_lines(const Scene& scene, const TriangleAccel& accel, const Camera
     auto start = std::chrono::steady_clock::now();
     // The last frame's welded triangles go to the cache, whose mesh edges were found for them.
     out.intersections.welded = std::move(out.mesh.tri_vertices);
+    // The rest of the last frame's mesh (its vertex rings: 12 bytes a triangle) is freed
+    // before the next is welded, not after: one mesh at the frame's peak, not two.
+    out.mesh = {};
     out.mesh = weld_vertices(scene);
     FeatureEdgeSettings edges = settings.edges;
     if (!settings.chain.hidden) edges.certainly_hidden = false;  // chaining would drop them
