@@ -28,4 +28,13 @@ void parallel_for(int count, int grain, int threads, const std::function<void(in
     }
 }
 
+void with_threads(int threads, const std::function<void()>& work) {
+    if (threads <= 0) {
+        work();
+        return;
+    }
+    tbb::task_arena arena(threads);
+    arena.execute(work);
+}
+
 }  // namespace toonray

@@ -12,6 +12,11 @@ namespace toonray {
 /// (0 = all hardware threads). Blocks until done.
 void parallel_for(int count, int grain, int threads, const std::function<void(int, int)>& body);
 
+/// Runs work() with the TBB algorithms it calls (a BVH build's tasks and loops) on at most
+/// `threads` threads (0 = all hardware threads), so that a thread count asked for holds for
+/// every stage of a frame, not only those that take one. Blocks until done.
+void with_threads(int threads, const std::function<void()>& work);
+
 /// Hardware threads available to this process.
 int hardware_threads();
 

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "toonray/core/error.h"
+#include "toonray/core/parallel.h"
 #include "toonray/frame/feature_images.h"
 #include "toonray/ink/svg.h"
 #include "toonray/io/exr.h"
@@ -162,9 +163,15 @@ const FrameLayers& FrameRenderer::render_layers(const Scene& scene, const Camera
         drawn_ = &flattened_;
     }
     const Scene& drawn = *drawn_;
-    const TriangleAccel& accel = accel_.update(drawn, options.bvh);
-    const TextureSet* textures =
-        settings.shading.textures ? &textures_.load(drawn, warnings) : nullptr;
+    // The acceleration structure's build and the textures' decoding keep to the frame's
+    // threads too (they take no thread count of their own).
+    const TriangleAccel* built = nullptr;
+    const TextureSet* textures = nullptr;
+    with_threads(settings.threads, [&] {
+        built = &accel_.update(drawn, options.bvh);
+        if (settings.shading.textures) textures = &textures_.load(drawn, warnings);
+    });
+    const TriangleAccel& accel = *built;
     RenderSettings with_brushes = settings;
     if (read_brushes(settings.lines.ink.styles, brushes_)) with_brushes.brushes = &brushes_;
     renderer_.render(drawn, accel, camera, lights, with_brushes, textures, progress);
