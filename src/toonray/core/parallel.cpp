@@ -20,12 +20,7 @@ void parallel_for(int count, int grain, int threads, const std::function<void(in
         tbb::parallel_for(tbb::blocked_range<int>(0, count, grain),
                           [&](const tbb::blocked_range<int>& r) { body(r.begin(), r.end()); });
     };
-    if (threads <= 0) {
-        run();
-    } else {
-        tbb::task_arena arena(threads);
-        arena.execute(run);
-    }
+    with_threads(threads, run);
 }
 
 void with_threads(int threads, const std::function<void()>& work) {

@@ -561,11 +561,11 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
     }
     auto usable = [&](std::size_t t) { return usable_triangle[t] != 0; };
 
-    // The mesh edges, as the last frame's when the triangles' welded corners, objects and
-    // usability did not change.
     // A cache that holds mesh edges has seen a frame before: frames follow each other, and
     // this one's corners are worth keeping for the next.
     const bool frames_follow = cache && cache->topology;
+    // The mesh edges, as the last frame's when the triangles' welded corners, objects and
+    // usability did not change.
     std::shared_ptr<const MeshTopology> kept = cache ? cache->topology : nullptr;
     if (!kept || cache->welded != mesh.tri_vertices || !kept->same(scene, usable_triangle, objects))
         kept =
