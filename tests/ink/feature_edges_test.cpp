@@ -7,9 +7,11 @@
 #include <bit>
 #include <cmath>
 #include <map>
+#include <numbers>
 #include <tuple>
 
 #include "ink/ink_scenes.h"
+#include "toonray/ink/mesh_topology.h"
 
 namespace toonray {
 namespace {
@@ -303,6 +305,103 @@ TEST(FeatureEdges, WhatIsKeptFromTheLastFrameGivesTheSegmentsFoundAnew) {
     // And back.
     s = crossing_scene();
     check_frame();
+}
+
+// A grid over [0, 1]^2 placed by at(u, v), wound so that its normals follow du x dv.
+template <class At>
+void add_grid(Scene& s, int nu, int nv, At at, std::uint32_t object) {
+    const auto base = static_cast<std::uint32_t>(s.positions.size());
+    for (int j = 0; j <= nv; ++j)
+        for (int i = 0; i <= nu; ++i)
+            s.positions.push_back(at(static_cast<float>(i) / static_cast<float>(nu),
+                                     static_cast<float>(j) / static_cast<float>(nv)));
+    auto id = [&](int i, int j) { return base + static_cast<std::uint32_t>(j * (nu + 1) + i); };
+    for (int j = 0; j < nv; ++j)
+        for (int i = 0; i < nu; ++i) {
+            s.add_triangle({id(i, j), id(i + 1, j), id(i + 1, j + 1)}, 0, object);
+            s.add_triangle({id(i, j), id(i + 1, j + 1), id(i, j + 1)}, 0, object);
+        }
+}
+
+// Open surfaces whose normals all point up (+z), at `n` cells across: a ramp winding a little
+// more than once around the z axis, whose start passes through its end; two sheets of one
+// object, one passing through the other, twice; and a bumpy sheet that crosses nothing. Seen along z,
+// each is made of triangles wound the same way: only their borders tell the ones that cross
+// themselves from the one that cannot.
+Scene upward_surfaces(int n) {
+    Scene s;
+    const float pi = std::numbers::pi_v<float>;
+    add_grid(
+        s, n, 5 * n,
+        [&](float u, float v) {
+            const float r = 1.0f + u, theta = 2.3f * pi * v;
+            return Vec3f(r * std::cos(theta), r * std::sin(theta),
+                         0.5f * (r - 1.513f) * (theta - 1.15f * pi));
+        },
+        0);
+    s.objects.push_back("sheets");
+    add_grid(
+        s, 2 * n, 2 * n, [](float u, float v) { return Vec3f(3 + 2 * u, -1 + 2 * v, 0); }, 1);
+    add_grid(
+        s, 2 * n, 2 * n,
+        [](float u, float v) {
+            return Vec3f(3 + 2 * u, -1 + 2 * v, 0.2f * (u - 0.47f) + 0.01f * std::sin(7 * v));
+        },
+        1);
+    // A small sheet through the middle of a larger one: their borders are apart, one inside
+    // the other.
+    s.objects.push_back("nested");
+    add_grid(
+        s, 2 * n, 2 * n, [](float u, float v) { return Vec3f(-1 + 2 * u, 3 + 2 * v, 0); }, 2);
+    add_grid(
+        s, n, n,
+        [](float u, float v) {
+            return Vec3f(-0.4f + 0.8f * u, 3.6f + 0.8f * v, 0.3f * (u - 0.53f));
+        },
+        2);
+    s.objects.push_back("bumps");
+    add_grid(
+        s, 2 * n, 2 * n,
+        [](float u, float v) {
+            return Vec3f(-5 + 2 * u, -1 + 2 * v, 0.1f * std::sin(5 * u) * std::cos(4 * v));
+        },
+        3);
+    return s;
+}
+
+TEST(FeatureEdges, SurfacesFacingOneWayThatCrossThemselvesKeepTheirIntersectionLines) {
+    const Scene s = upward_surfaces(8);
+    const auto expected = brute_force_crossings(s);
+    ASSERT_GT(expected.size(), 40u);
+    EXPECT_EQ(intersection_lines(edges_of(s, Vec3f(0.3f, -0.2f, 9.0f))), expected);
+}
+
+TEST(FindCrossings, SkippingPatchesThatCannotCrossThemselvesFindsTheSamePairs) {
+    const Scene s = upward_surfaces(24);
+    const auto n = static_cast<std::uint32_t>(s.triangle_count());
+    const ink::WeldedMesh mesh = ink::weld_vertices(s);
+    const TriangleAccel accel = build_accel(s);
+    const ink::IndexedCorners corners_of{s.positions, s.tri_positions};
+    std::vector<Vec3f> normals(n);
+    std::vector<std::uint8_t> usable(n);
+    for (std::uint32_t t = 0; t < n; ++t) {
+        const auto p = corners_of(t);
+        const Vec3f c = cross(p[1] - p[0], p[2] - p[0]);
+        usable[t] = length(c) > 0.0f;
+        normals[t] = usable[t] ? normalize(c) : Vec3f(0.0f);
+    }
+    const ink::MeshTopology topology(s.tri_object, mesh, usable, s.objects.size());
+    const ink::SurfacePatches patches{normals, topology};
+    auto found = [&](const ink::SurfacePatches* with) {
+        std::map<std::pair<std::uint32_t, std::uint32_t>, std::array<Vec3f, 2>> out;
+        for (const ink::PairCrossing& c :
+             ink::find_crossings(accel.bvh(), corners_of, mesh, usable, nullptr, 2, with))
+            out[{c.t, c.u}] = {c.crossing.p[0], c.crossing.p[1]};
+        return out;
+    };
+    const auto all = found(nullptr);
+    ASSERT_GT(all.size(), 150u);
+    EXPECT_EQ(found(&patches), all);
 }
 
 TEST(FeatureEdges, SameForAnyThreadCount) {

@@ -214,15 +214,148 @@ struct Slots {
     std::unique_ptr<float[]> lo[3], hi[3];
     std::unique_ptr<std::uint32_t[]> corner[3];
     std::unique_ptr<std::uint32_t[]> stale;  // null when every triangle is
+    // With SurfacePatches only: the unit normal, and per side k (corner k to k + 1) the slot
+    // across it when the neighbour there takes part and is wound consistently (else kNoIndex).
+    std::unique_ptr<float[]> normal[3];
+    std::unique_ptr<std::uint32_t[]> across[3];
 
-    Slots(std::size_t count, bool with_stale) {  // values left for the caller to write
+    // Values left for the caller to write.
+    Slots(std::size_t count, bool with_stale, bool with_patches) {
         tri = std::make_unique_for_overwrite<std::uint32_t[]>(count);
         for (int a = 0; a < 3; ++a) {
             lo[a] = std::make_unique_for_overwrite<float[]>(count);
             hi[a] = std::make_unique_for_overwrite<float[]>(count);
             corner[a] = std::make_unique_for_overwrite<std::uint32_t[]>(count);
+            if (with_patches) {
+                normal[a] = std::make_unique_for_overwrite<float[]>(count);
+                across[a] = std::make_unique_for_overwrite<std::uint32_t[]>(count);
+            }
         }
         if (with_stale) stale = std::make_unique_for_overwrite<std::uint32_t[]>(count);
+    }
+};
+
+// Patches tested for crossing themselves: at least this many slots (smaller subtrees cost less
+// to search than to test), normals at least this far into the half-space about the patch's axis
+// (a cosine), and each border side turning about the centre by at least this sine.
+constexpr std::uint32_t kPatchMin = 64;
+constexpr float kPatchCone = 0.05f;
+
+// The border of a patch projected to a plane, as sides from one welded vertex to the next (in
+// the triangles' winding), and whether they make one simple closed polygon.
+struct PatchBorder {
+    struct Point {
+        float x, y;
+    };
+    struct Side {
+        Point from, to;
+        std::uint32_t from_vertex, to_vertex;
+    };
+    std::vector<Side> sides;
+    std::vector<std::uint32_t> order, next;
+    std::vector<std::pair<std::uint64_t, std::uint32_t>> cells;
+
+    static float cross(Point o, Point a, Point b) {
+        return (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x);
+    }
+    static float dist(Point a, Point b) { return std::hypot(b.x - a.x, b.y - a.y); }
+
+    // Whether the sides make one closed loop (each vertex starts one side, and following them
+    // from the first comes back after all of them) that comes within `margin` of itself
+    // nowhere but where consecutive sides meet.
+    bool simple_loop() {
+        const std::size_t m = sides.size();
+        if (m < 3) return false;
+        order.resize(m);
+        for (std::uint32_t i = 0; i < m; ++i) order[i] = i;
+        std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
+            return sides[a].from_vertex < sides[b].from_vertex;
+        });
+        for (std::size_t i = 1; i < m; ++i)
+            if (sides[order[i]].from_vertex == sides[order[i - 1]].from_vertex) return false;
+        next.resize(m);
+        for (std::uint32_t i = 0; i < m; ++i) {
+            const auto at = std::lower_bound(
+                order.begin(), order.end(), sides[i].to_vertex,
+                [&](std::uint32_t a, std::uint32_t v) { return sides[a].from_vertex < v; });
+            if (at == order.end() || sides[*at].from_vertex != sides[i].to_vertex) return false;
+            next[i] = *at;
+        }
+        std::size_t steps = 0;
+        std::uint32_t e = 0;
+        do {
+            e = next[e];
+            ++steps;
+        } while (e != 0 && steps <= m);
+        if (steps != m) return false;
+        // Sides no longer than `longest` can only come near each other when their middles lie
+        // in neighbouring cells of that size. The margin is far above the rounding of the
+        // projected corners, which grows with their distance from the centre.
+        float longest = 0.0f, reach = 0.0f;
+        for (const Side& s : sides) {
+            longest = std::max(longest, dist(s.from, s.to));
+            reach = std::max({reach, std::abs(s.from.x), std::abs(s.from.y)});
+        }
+        const float margin = std::max(1e-3f * longest, 1e-5f * reach);
+        const float cell = 1.01f * longest + 2.0f * margin;
+        if (!(longest > 0.0f) || !(reach < 1e30f)) return false;
+        cells.resize(m);
+        auto cell_of = [&](float v) { return static_cast<std::int64_t>(std::floor(v / cell)); };
+        auto key = [](std::int64_t x, std::int64_t y) {
+            return (static_cast<std::uint64_t>(x) << 32) ^ static_cast<std::uint32_t>(y);
+        };
+        for (std::uint32_t i = 0; i < m; ++i) {
+            const Side& s = sides[i];
+            cells[i] = {
+                key(cell_of((s.from.x + s.to.x) * 0.5f), cell_of((s.from.y + s.to.y) * 0.5f)), i};
+        }
+        std::sort(cells.begin(), cells.end());
+        for (std::uint32_t i = 0; i < m; ++i) {
+            const Side& a = sides[i];
+            const float ax = (a.from.x + a.to.x) * 0.5f, ay = (a.from.y + a.to.y) * 0.5f;
+            const std::int64_t cx = cell_of(ax), cy = cell_of(ay);
+            for (std::int64_t dx = -1; dx <= 1; ++dx)
+                for (std::int64_t dy = -1; dy <= 1; ++dy) {
+                    const std::uint64_t k = key(cx + dx, cy + dy);
+                    auto at = std::lower_bound(cells.begin(), cells.end(),
+                                               std::pair<std::uint64_t, std::uint32_t>{k, 0});
+                    for (; at != cells.end() && at->first == k; ++at) {
+                        const std::uint32_t j = at->second;
+                        if (j <= i) continue;
+                        if (!apart(i, j, margin)) return false;
+                    }
+                }
+        }
+        return true;
+    }
+
+    // Whether sides i and j keep at least `margin` apart, or (when consecutive) meet only at
+    // their shared corner without folding back along each other.
+    [[nodiscard]] bool apart(std::uint32_t i, std::uint32_t j, float margin) const {
+        const Side& a = sides[i];
+        const Side& b = sides[j];
+        const float la = dist(a.from, a.to), lb = dist(b.from, b.to);
+        if (!(la > margin) || !(lb > margin)) return false;
+        if (next[i] == j || next[j] == i) {
+            if (next[i] == j && next[j] == i) return false;
+            const Side& first = next[i] == j ? a : b;
+            const Side& second = next[i] == j ? b : a;
+            const Point u{first.to.x - first.from.x, first.to.y - first.from.y};
+            const Point v{second.to.x - second.from.x, second.to.y - second.from.y};
+            const float turn = u.x * v.y - u.y * v.x, along = u.x * v.x + u.y * v.y;
+            return along >= 0.0f || std::abs(turn) > margin * std::max(la, lb);
+        }
+        if (std::max(a.from.x, a.to.x) + margin < std::min(b.from.x, b.to.x) ||
+            std::max(b.from.x, b.to.x) + margin < std::min(a.from.x, a.to.x) ||
+            std::max(a.from.y, a.to.y) + margin < std::min(b.from.y, b.to.y) ||
+            std::max(b.from.y, b.to.y) + margin < std::min(a.from.y, a.to.y))
+            return true;
+        // One side wholly beyond the other's line, by more than the margin.
+        const float b0 = cross(a.from, a.to, b.from), b1 = cross(a.from, a.to, b.to);
+        if ((b0 > margin * la && b1 > margin * la) || (b0 < -margin * la && b1 < -margin * la))
+            return true;
+        const float a0 = cross(b.from, b.to, a.from), a1 = cross(b.from, b.to, a.to);
+        return (a0 > margin * lb && a1 > margin * lb) || (a0 < -margin * lb && a1 < -margin * lb);
     }
 };
 
@@ -264,7 +397,8 @@ template <class CornersOf>
 std::vector<PairCrossing> find_crossings(const Bvh& bvh, const CornersOf& corners_of,
                                          const WeldedMesh& mesh,
                                          const std::vector<std::uint8_t>& live,
-                                         const std::vector<std::uint8_t>* stale, int threads) {
+                                         const std::vector<std::uint8_t>* stale, int threads,
+                                         const SurfacePatches* patches) {
     const std::uint32_t prims = static_cast<std::uint32_t>(bvh.prim_indices.size());
     constexpr float inf = std::numeric_limits<float>::infinity();
     // Only the triangles that take part have slots (about half of them, without hidden lines:
@@ -278,7 +412,7 @@ std::vector<PairCrossing> find_crossings(const Bvh& bvh, const CornersOf& corner
         taking_part += t != kNoIndex && live[t] ? 1 : 0;
     }
     slot_of[prims] = taking_part;
-    Slots slots(taking_part + kLanes, stale != nullptr);
+    Slots slots(taking_part + kLanes, stale != nullptr, patches != nullptr);
     // The triangles come in the tree's order, which scatters them over the per-triangle
     // arrays: what a slot reads is fetched ahead (the fill is bound by those misses).
     constexpr std::uint32_t kAhead = 16;
@@ -304,6 +438,8 @@ std::vector<PairCrossing> find_crossings(const Bvh& bvh, const CornersOf& corner
             slots.lo[a][at] = box.lo[a];
             slots.hi[a][at] = box.hi[a];
         }
+        if (patches)
+            for (int a = 0; a < 3; ++a) slots.normal[a][at] = patches->normals[t][a];
     }
     for (std::uint32_t at = taking_part; at < taking_part + kLanes; ++at) {
         slots.tri[at] = kNoIndex;
@@ -353,6 +489,95 @@ std::vector<PairCrossing> find_crossings(const Bvh& bvh, const CornersOf& corner
         range_first[i] = range_first[l];
         range_count[i] = joined ? range_count[l] + range_count[r] : kNoIndex;
     }
+    if (patches) {
+        // The slots across the slots' sides, from the mesh edges: an edge of two sides in
+        // opposite directions joins the slots of its triangles, when both take part.
+        for (int k = 0; k < 3; ++k)
+            std::fill(slots.across[k].get(), slots.across[k].get() + taking_part + kLanes,
+                      kNoIndex);
+        std::vector<std::uint32_t> slot_of_tri(live.size(), kNoIndex);
+        for (std::uint32_t at = 0; at < taking_part; ++at) slot_of_tri[slots.tri[at]] = at;
+        const MeshTopology& topology = patches->topology;
+        const Side* const sides = topology.sides.get();
+        for (std::size_t e = 0; e + 1 < topology.edge_first.size(); ++e) {
+            const std::uint32_t i = topology.edge_first[e];
+            if (topology.edge_first[e + 1] - i != 2) continue;
+            const Side& s0 = sides[i];
+            const Side& s1 = sides[i + 1];
+            if (s0.forward() == s1.forward()) continue;
+            const std::uint32_t a = slot_of_tri[s0.tri()], b = slot_of_tri[s1.tri()];
+            if (a == kNoIndex || b == kNoIndex) continue;
+            slots.across[s0.corner()][a] = b;
+            slots.across[s1.corner()][b] = a;
+        }
+    }
+    // Whether the live triangles of a subtree (its slots [a0, a0 + an)) cannot cross one another.
+    // Seen along an axis d with every normal in the half-space about d, each triangle projects
+    // to the plane across d wound the same way; the number of triangles over a point of the
+    // plane is then the winding number there of the patch's projected border (the sides without
+    // a live, consistently wound neighbour in the subtree: inner sides cancel in pairs). When the
+    // border is one simple closed polygon, that number is at most one: no point is covered
+    // twice, and two triangles that crossed would cover the points near their crossing twice.
+    // The margins keep every decision far from rounding; a patch that fails is searched as
+    // before.
+    auto cannot_cross_itself = [&](std::uint32_t node) {
+        const std::uint32_t a0 = range_first[node], an = range_count[node];
+        float nlo[3], nhi[3];
+        for (int a = 0; a < 3; ++a) {
+            const float* n = slots.normal[a].get();
+            __m128 lo = _mm_set1_ps(inf), hi = _mm_set1_ps(-inf);
+            std::uint32_t i = a0;
+            for (; i + kLanes <= a0 + an; i += kLanes) {
+                lo = _mm_min_ps(lo, _mm_loadu_ps(n + i));
+                hi = _mm_max_ps(hi, _mm_loadu_ps(n + i));
+            }
+            alignas(16) float l[4], h[4];
+            _mm_store_ps(l, lo);
+            _mm_store_ps(h, hi);
+            nlo[a] = std::min({l[0], l[1], l[2], l[3]});
+            nhi[a] = std::max({h[0], h[1], h[2], h[3]});
+            for (; i < a0 + an; ++i) {
+                nlo[a] = std::min(nlo[a], n[i]);
+                nhi[a] = std::max(nhi[a], n[i]);
+            }
+        }
+        Vec3f d((nlo[0] + nhi[0]) * 0.5f, (nlo[1] + nhi[1]) * 0.5f, (nlo[2] + nhi[2]) * 0.5f);
+        const float len = length(d);
+        if (!(len > 0.0f)) return false;
+        d = d / len;
+        // The least n . d over the box of the normals.
+        float least = 0.0f;
+        for (int a = 0; a < 3; ++a) least += std::min(nlo[a] * d[a], nhi[a] * d[a]);
+        if (!(least > kPatchCone)) return false;
+        const Vec3f e1 =
+            normalize(cross(d, std::abs(d.x) < 0.6f ? Vec3f(1, 0, 0) : Vec3f(0, 1, 0)));
+        const Vec3f e2 = cross(d, e1);
+        const Vec3f c = live_box[node].center();
+        thread_local PatchBorder border;
+        border.sides.clear();
+        for (std::uint32_t i = a0; i < a0 + an; ++i) {
+            // Sides across which the slot's neighbour is in the subtree are inner sides.
+            if (slots.across[0][i] - a0 < an && slots.across[1][i] - a0 < an &&
+                slots.across[2][i] - a0 < an)
+                continue;
+            const std::uint32_t t = slots.tri[i];
+            std::array<Vec3f, 3> p{};
+            bool read = false;
+            for (std::size_t k = 0; k < 3; ++k) {
+                if (slots.across[k][i] - a0 < an) continue;
+                if (!read) {
+                    p = corners_of(t);
+                    read = true;
+                }
+                const Vec3f from = p[k] - c, to = p[(k + 1) % 3] - c;
+                border.sides.push_back({{dot(from, e1), dot(from, e2)},
+                                        {dot(to, e1), dot(to, e2)},
+                                        mesh.tri_vertices[t][k],
+                                        mesh.tri_vertices[t][(k + 1) % 3]});
+            }
+        }
+        return border.simple_loop();
+    };
     auto overlap = [](const BBox& a, const BBox& b) {
         return !(a.lo.x > b.hi.x || a.hi.x < b.lo.x || a.lo.y > b.hi.y || a.hi.y < b.lo.y ||
                  a.lo.z > b.hi.z || a.hi.z < b.lo.z);
@@ -389,6 +614,9 @@ std::vector<PairCrossing> find_crossings(const Bvh& bvh, const CornersOf& corner
         if (pair.first == pair.second) {
             if (a.is_leaf() || an <= kSmallSubtree) {
                 for (std::uint32_t i = a0; i + 1 < a0 + an; ++i) test_slots(i, i + 1, a0 + an, out);
+            } else if (patches && an != kNoIndex && an >= kPatchMin &&
+                       cannot_cross_itself(pair.first)) {
+                return;
             } else {
                 next.push_back({a.first, a.first});
                 next.push_back({a.first + 1, a.first + 1});
@@ -442,11 +670,13 @@ std::vector<PairCrossing> find_crossings(const Bvh& bvh, const CornersOf& corner
 template std::vector<PairCrossing> find_crossings(const Bvh&, const StoredCorners&,
                                                   const WeldedMesh&,
                                                   const std::vector<std::uint8_t>&,
-                                                  const std::vector<std::uint8_t>*, int);
+                                                  const std::vector<std::uint8_t>*, int,
+                                                  const SurfacePatches*);
 template std::vector<PairCrossing> find_crossings(const Bvh&, const IndexedCorners&,
                                                   const WeldedMesh&,
                                                   const std::vector<std::uint8_t>&,
-                                                  const std::vector<std::uint8_t>*, int);
+                                                  const std::vector<std::uint8_t>*, int,
+                                                  const SurfacePatches*);
 
 namespace {
 
@@ -731,8 +961,9 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
                            !std::equal(now.begin(), now.end(), cache->corners[t].begin(), same);
             }
         }
-        std::vector<PairCrossing> found = find_crossings(bvh, corners_of, mesh, live_triangle,
-                                                         some_fresh ? &stale : nullptr, threads);
+        const SurfacePatches patches{normal, topology};
+        std::vector<PairCrossing> found = find_crossings(
+            bvh, corners_of, mesh, live_triangle, some_fresh ? &stale : nullptr, threads, &patches);
         if (cache) {
             // The cache's crossings of triangles that are not stale and take part now; then
             // the cache is this frame's.

@@ -10,24 +10,36 @@
 #include <span>
 #include <vector>
 
+#include <fmt/format.h>
+
 #include "toonray/accel/bvh.h"
+#include "toonray/core/error.h"
 #include "toonray/ink/feature_edges.h"
 #include "toonray/scene/scene.h"
 
 namespace toonray::ink {
 
 // A side of a usable triangle: from welded vertex lo to hi (lo < hi). 12 bytes: whether it runs
-// forward shares a word with the triangle (a million triangles have three million sides).
+// forward and which corner of the triangle starts it share a word with the triangle (a million
+// triangles have three million sides).
 struct Side {
     std::uint32_t lo, hi;
-    std::uint32_t tri_forward;  // the triangle, and kForward when lo -> hi is its winding
+    // The triangle (the low kCornerShift bits), the corner k whose side (k -> k + 1 in the
+    // triangle's winding) this is, and kForward when lo -> hi is its winding.
+    std::uint32_t tri_corner_forward;
 
     static constexpr std::uint32_t kForward = 0x80000000u;
+    static constexpr int kCornerShift = 29;
+    static constexpr std::uint32_t kTriangles = 1u << kCornerShift;  // triangle ids are below
     Side() = default;
-    Side(std::uint32_t lo_, std::uint32_t hi_, std::uint32_t tri_, bool forward_)
-        : lo(lo_), hi(hi_), tri_forward(tri_ | (forward_ ? kForward : 0u)) {}
-    [[nodiscard]] std::uint32_t tri() const { return tri_forward & ~kForward; }
-    [[nodiscard]] bool forward() const { return (tri_forward & kForward) != 0; }
+    Side(std::uint32_t lo_, std::uint32_t hi_, std::uint32_t tri_, std::uint32_t corner_,
+         bool forward_)
+        : lo(lo_),
+          hi(hi_),
+          tri_corner_forward(tri_ | (corner_ << kCornerShift) | (forward_ ? kForward : 0u)) {}
+    [[nodiscard]] std::uint32_t tri() const { return tri_corner_forward & (kTriangles - 1); }
+    [[nodiscard]] std::uint32_t corner() const { return (tri_corner_forward >> kCornerShift) & 3; }
+    [[nodiscard]] bool forward() const { return (tri_corner_forward & kForward) != 0; }
 };
 static_assert(sizeof(Side) == 12);
 
@@ -53,6 +65,9 @@ struct MeshTopology {
           open(objects_, 0) {
         const auto& tri_vertices = mesh.tri_vertices;
         const std::size_t n = usable.size(), vertices = mesh.vertex_count();
+        if (n > Side::kTriangles)
+            throw Error(
+                fmt::format("ink lines: a mesh of {} triangles (at most {})", n, Side::kTriangles));
         // A counting sort by lo over the triangles in order puts each vertex's sides in
         // (triangle, corner) order; a stable sort by hi within each vertex then gives the
         // whole order.
@@ -76,7 +91,8 @@ struct MeshTopology {
                     const std::uint32_t u = w[k], v = w[(k + 1) % 3];
                     if (u == v) continue;
                     const std::uint32_t lo = std::min(u, v);
-                    sides[fill[lo]++] = {lo, std::max(u, v), static_cast<std::uint32_t>(t), u < v};
+                    sides[fill[lo]++] = {lo, std::max(u, v), static_cast<std::uint32_t>(t),
+                                         static_cast<std::uint32_t>(k), u < v};
                 }
             }
         }
@@ -138,14 +154,24 @@ struct IndexedCorners {
     void prefetch(std::uint32_t t) const { __builtin_prefetch(&triangles[t]); }
 };
 
+/// What lets the intersection search skip whole subtrees whose triangles cannot cross one
+/// another: per triangle, its unit normal (face_normal), and the mesh edges.
+struct SurfacePatches {
+    std::span<const Vec3f> normals;
+    const MeshTopology& topology;
+};
+
 /// Every pair of triangles that take part (`live`) and cross, as intersect_triangles finds them,
 /// with (when `stale` is given) at least one stale triangle; in no particular order. `bvh` is
 /// built over the triangles whose corners `corners_of` gives (StoredCorners or IndexedCorners);
-/// triangles sharing a corner position (mesh.vertex_position) are not tested.
+/// triangles sharing a corner position (mesh.vertex_position) are not tested. With `patches`,
+/// subtrees whose live triangles make a patch that provably does not cross itself are not
+/// searched (the pairs found are the same).
 template <class CornersOf>
 std::vector<PairCrossing> find_crossings(const Bvh& bvh, const CornersOf& corners_of,
                                          const WeldedMesh& mesh,
                                          const std::vector<std::uint8_t>& live,
-                                         const std::vector<std::uint8_t>* stale, int threads);
+                                         const std::vector<std::uint8_t>* stale, int threads,
+                                         const SurfacePatches* patches = nullptr);
 
 }  // namespace toonray::ink
