@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
@@ -70,6 +72,30 @@ TEST(InkLines, MeshEdgesAreKeptForTheNextFrameWhileTheWeldsStay) {
         EXPECT_EQ(lines.segments[i].p1, fresh.segments[i].p1) << i;
         EXPECT_EQ(lines.segments[i].type, fresh.segments[i].type) << i;
     }
+}
+
+TEST(InkLines, VertexRingsAreBuiltOnlyForTheLinesThatReadThem) {
+    // A sphere's corner normals give smooth contours, whose visibility reads the rings.
+    Scene scene;
+    test_support::add_sphere(scene, Vec3f(0.0f), 1.0f, 16, 32, 0);
+    TriangleAccel accel;
+    accel.build(scene.positions, scene.tri_positions);
+    const CameraSpec camera = auto_camera(scene.positions, 320, 240);
+    auto draw = [&](const ink::InkSettings& settings) {
+        ink::InkLines lines;
+        ink::draw_ink_lines(scene, accel, camera, 320, 240, settings, 1, lines);
+        const bool smooth = std::any_of(lines.segments.begin(), lines.segments.end(),
+                                        [](const ink::FeatureSegment& s) { return s.smooth; });
+        return std::pair{smooth, lines.mesh.has_rings()};
+    };
+    EXPECT_EQ(draw({}), std::pair(true, true));
+    // Without them no line is smooth, and the rings (12 bytes a triangle) are not built...
+    scene.tri_normals.clear();
+    EXPECT_EQ(draw({}), std::pair(false, false));
+    // ...unless band lines, which read them too, are drawn.
+    ink::InkSettings bands;
+    bands.bands = true;
+    EXPECT_EQ(draw(bands).second, true);
 }
 
 TEST(InkSvg, ParsesAsXmlWithTheLayersAndGroups) {

@@ -63,10 +63,16 @@ bool has_corner_normals(const Scene& scene, std::size_t t) {
 WeldedMesh weld_vertices(const TriangleMesh& scene) { return weld_vertices(scene, false); }
 
 WeldedMesh weld_vertices(const TriangleMesh& scene, bool one_object) {
+    WeldedMesh mesh = weld_vertices_without_rings(scene, one_object);
+    add_vertex_rings(mesh);
+    return mesh;
+}
+
+WeldedMesh weld_vertices_without_rings(const TriangleMesh& scene, bool one_object) {
     const std::size_t n = scene.triangle_count();
     // Positions with the same bits share a canonical index, the lowest among them: each
     // position, in index order, looks its bits up in an open-addressing table (linear probing,
-    // at most half full) and takes the index found there, or enters its own.
+    // at most two thirds full) and takes the index found there, or enters its own.
     const std::size_t positions = scene.positions.size();
     std::vector<std::uint32_t> canonical(positions);
     using Bits = std::array<std::uint32_t, 3>;
@@ -75,7 +81,7 @@ WeldedMesh weld_vertices(const TriangleMesh& scene, bool one_object) {
         return Bits{float_bits(p.x), float_bits(p.y), float_bits(p.z)};
     };
     std::size_t table_size = 16;
-    while (table_size < 2 * positions) table_size *= 2;
+    while (table_size < positions + positions / 2) table_size *= 2;
     const std::size_t mask = table_size - 1;
     std::vector<std::uint32_t> table(table_size, kNoIndex);
     for (std::uint32_t i = 0; i < positions; ++i) {
@@ -119,6 +125,12 @@ WeldedMesh weld_vertices(const TriangleMesh& scene, bool one_object) {
                 id = it->second;
             }
         }
+    return mesh;
+}
+
+void add_vertex_rings(WeldedMesh& mesh) {
+    if (mesh.has_rings()) return;
+    const std::size_t n = mesh.tri_vertices.size();
     // Triangles around each vertex, by counting sort (in triangle order; a triangle with a
     // repeated corner counts once at that vertex).
     auto distinct = [&](std::size_t t, int k) {
@@ -140,7 +152,6 @@ WeldedMesh weld_vertices(const TriangleMesh& scene, bool one_object) {
             if (distinct(t, k))
                 mesh.ring_triangles[fill[mesh.tri_vertices[t][k]]++] =
                     static_cast<std::uint32_t>(t);
-    return mesh;
 }
 
 bool intersect_triangles(const std::array<Vec3f, 3>& a, const std::array<Vec3f, 3>& b,

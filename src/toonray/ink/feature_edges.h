@@ -99,12 +99,17 @@ struct WeldedMesh {
     std::vector<std::uint32_t> ring_offsets, ring_triangles;
 
     [[nodiscard]] std::size_t vertex_count() const { return vertex_position.size(); }
+    [[nodiscard]] bool has_rings() const { return ring_offsets.size() == vertex_count() + 1; }
 };
 
 [[nodiscard]] WeldedMesh weld_vertices(const TriangleMesh& scene);
 /// The same with every triangle taken as one object (an instanced mesh, whose instance is
 /// the object) when `one_object`.
 [[nodiscard]] WeldedMesh weld_vertices(const TriangleMesh& scene, bool one_object);
+/// The same without the vertex rings (12 bytes a triangle), which only the visibility of smooth
+/// lines and the band and shadow lines read: add_vertex_rings adds them when needed.
+[[nodiscard]] WeldedMesh weld_vertices_without_rings(const TriangleMesh& scene, bool one_object);
+void add_vertex_rings(WeldedMesh& mesh);
 
 /// The segment where triangles (a0, a1, a2) and (b0, b1, b2) cross, if they do properly (each
 /// has corners strictly on both sides of the other's plane; coplanar or touching pairs give

@@ -188,7 +188,7 @@ void draw_ink_lines(const Scene& scene, const TriangleAccel& accel, const Camera
     // The rest of the last frame's mesh (its vertex rings: 12 bytes a triangle) is freed
     // before the next is welded, not after: one mesh at the frame's peak, not two.
     out.mesh = {};
-    out.mesh = weld_vertices(scene);
+    out.mesh = weld_vertices_without_rings(scene, false);
     FeatureEdgeSettings edges = settings.edges;
     if (!settings.chain.hidden) edges.certainly_hidden = false;  // chaining would drop them
     edges.bands = settings.bands;
@@ -206,6 +206,7 @@ void draw_ink_lines(const Scene& scene, const TriangleAccel& accel, const Camera
     add_polyline_segments(scene, out.segments);
     const LightingModel lighting{settings.lights, settings.band_thresholds};
     const std::vector<std::uint8_t> closed = closed_objects(out.intersections);
+    if (settings.bands || settings.shadows) add_vertex_rings(out.mesh);
     for (bool shadow : {false, true}) {
         if (!(shadow ? settings.shadows : settings.bands)) continue;
         std::vector<FeatureSegment> more =
@@ -242,6 +243,10 @@ void draw_ink_lines(const Scene& scene, const TriangleAccel& accel, const Camera
     out.timings.tone = seconds_since(start);
 
     start = std::chrono::steady_clock::now();
+    // The visibility of a smooth line ignores the triangles around its face's corners.
+    if (std::any_of(out.segments.begin(), out.segments.end(),
+                    [](const FeatureSegment& s) { return s.smooth; }))
+        add_vertex_rings(out.mesh);
     const VisibilityContext context{scene, out.mesh, accel, view, &out.instances};
     const std::span<const FeatureSegment> all(out.segments);
     out.pieces =
