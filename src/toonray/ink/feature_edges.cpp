@@ -269,7 +269,10 @@ struct PatchBorder {
     static float cross(Point o, Point a, Point b) {
         return (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x);
     }
-    static float dist(Point a, Point b) { return std::hypot(b.x - a.x, b.y - a.y); }
+    static float dist(Point a, Point b) {
+        const float x = b.x - a.x, y = b.y - a.y;
+        return std::sqrt(x * x + y * y);
+    }
 
     // Whether the sides make one closed loop (each vertex starts one side, and following them
     // from the first comes back after all of them) that comes within `margin` of itself
@@ -803,14 +806,15 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
     auto usable = [&](std::size_t t) { return usable_triangle[t] != 0; };
 
     // A cache that holds mesh edges has seen a frame before: frames follow each other, and
-    // this one's corners are worth keeping for the next.
+    // this one's corners, and what its mesh edges are made from, are worth keeping for the
+    // next (a single frame keeps neither: an animation's second frame finds them anew).
     const bool frames_follow = cache && cache->topology;
     // The mesh edges, as the last frame's when the triangles' welded corners, objects and
     // usability did not change.
     std::shared_ptr<const MeshTopology> kept = cache ? cache->topology : nullptr;
     if (!kept || cache->welded != mesh.tri_vertices || !kept->same(scene, usable_triangle, objects))
-        kept =
-            std::make_shared<const MeshTopology>(scene.tri_object, mesh, usable_triangle, objects);
+        kept = std::make_shared<const MeshTopology>(scene.tri_object, mesh, usable_triangle,
+                                                    objects, frames_follow);
     if (cache) cache->topology = kept;
     const MeshTopology& topology = *kept;
     const Side* const sides = topology.sides.get();

@@ -44,7 +44,8 @@ struct Side {
 static_assert(sizeof(Side) == 12);
 
 struct MeshTopology {
-    // What it was made from, besides the welded triangles (IntersectionCache::welded).
+    // What it was made from, besides the welded triangles (IntersectionCache::welded), when
+    // asked to keep it (for frames that follow: `same`).
     std::vector<std::uint32_t> tri_object;
     std::vector<std::uint8_t> usable;
     std::size_t objects = 0;
@@ -56,13 +57,18 @@ struct MeshTopology {
     /// or a triangle that is not usable or has two corners welded together.
     std::vector<std::uint8_t> open;
 
-    /// `object_of` has each triangle's object (< objects_).
+    /// `object_of` has each triangle's object (< objects_). With `keep_sources`, the objects
+    /// and usability are kept for `same`.
     MeshTopology(std::span<const std::uint32_t> object_of, const WeldedMesh& mesh,
-                 std::span<const std::uint8_t> usable_, std::size_t objects_)
-        : tri_object(object_of.begin(), object_of.begin() + usable_.size()),
-          usable(usable_.begin(), usable_.end()),
-          objects(objects_),
-          open(objects_, 0) {
+                 std::span<const std::uint8_t> usable_, std::size_t objects_,
+                 bool keep_sources = false)
+        : objects(objects_), open(objects_, 0) {
+        if (keep_sources) {
+            tri_object.assign(object_of.begin(), object_of.begin() + usable_.size());
+            usable.assign(usable_.begin(), usable_.end());
+        }
+        const std::span<const std::uint32_t> tri_object = object_of;
+        const std::span<const std::uint8_t> usable = usable_;
         const auto& tri_vertices = mesh.tri_vertices;
         const std::size_t n = usable.size(), vertices = mesh.vertex_count();
         if (n > Side::kTriangles)
@@ -123,7 +129,8 @@ struct MeshTopology {
         edge_first.push_back(static_cast<std::uint32_t>(side_count));
     }
 
-    /// Whether the triangles' objects and usability are those it was made from.
+    /// Whether the triangles' objects and usability are those it was made from (false when
+    /// they were not kept).
     [[nodiscard]] bool same(const TriangleMesh& scene, std::span<const std::uint8_t> usable_,
                             std::size_t objects_) const {
         return objects_ == objects && usable_.size() == usable.size() &&
