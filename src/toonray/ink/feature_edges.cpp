@@ -849,9 +849,9 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
             if (mesh.tri_vertices[t][k] == welded) return scene.normals[scene.tri_normals[t][k]];
         return Vec3f(0.0f);
     };
-    auto smooth_across = [&](const Side& s0, const Side& s1) {
+    auto smooth_across = [&](std::uint32_t lo, const Side& s0, const Side& s1) {
         if (!corner_normals[s0.tri()] || !corner_normals[s1.tri()]) return false;
-        return corner_normal(s0.tri(), s0.lo) == corner_normal(s1.tri(), s1.lo) &&
+        return corner_normal(s0.tri(), lo) == corner_normal(s1.tri(), lo) &&
                corner_normal(s0.tri(), s0.hi) == corner_normal(s1.tri(), s1.hi);
     };
     const EdgeBands edge_bands{scene, mesh, settings, eye, corner_normals};
@@ -860,7 +860,7 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
     // edge a few ahead are fetched while this one is classified.
     constexpr std::size_t kAhead = 8;
     const std::size_t side_count = edge_first.back();
-    for (std::size_t e = 0; e < edge_count; ++e) {
+    topology.for_each_edge([&](std::uint32_t e, std::uint32_t lo) {
         if (e + kAhead < edge_count) {
             const std::uint32_t first = edge_first[e + kAhead];
             for (std::uint32_t k = first; k < std::min<std::size_t>(first + 2, side_count); ++k) {
@@ -870,11 +870,11 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
         }
         const std::uint32_t i = edge_first[e], j = edge_first[e + 1];
         const Side& s0 = sides[i];
-        const Vec3f p0 = scene.positions[mesh.vertex_position[s0.lo]];
+        const Vec3f p0 = scene.positions[mesh.vertex_position[lo]];
         EdgeType type = EdgeType::Border;
         bool certainly_hidden = false;
         if (j - i != 2) {
-            if (!settings.borders) continue;
+            if (!settings.borders) return;
         } else {
             const Side& s1 = sides[i + 1];
             const Vec3f n0 = normal[s0.tri()];
@@ -883,30 +883,30 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
             const float d0 = dot(n0, eye - p0), d1 = dot(n1, eye - p0);
             const bool front0 = d0 > 0, front1 = d1 > 0;
             if (settings.silhouettes && front0 != front1 &&
-                !(settings.smooth_contours && smooth_across(s0, s1)))
+                !(settings.smooth_contours && smooth_across(lo, s0, s1)))
                 type = EdgeType::Silhouette;
             else if (settings.creases && dot(n0, n1) < cos_crease) type = EdgeType::Crease;
             else if (settings.materials &&
                      scene.tri_material[s0.tri()] != scene.tri_material[s1.tri()])
                 type = EdgeType::Material;
-            else if (settings.bands && !smooth_across(s0, s1) &&
-                     bands_differ(edge_bands, s0.lo, s0.hi, s0.tri(), s1.tri(), n0, n1))
+            else if (settings.bands && !smooth_across(lo, s0, s1) &&
+                     bands_differ(edge_bands, lo, s0.hi, s0.tri(), s1.tri(), n0, n1))
                 type = EdgeType::Band;
-            else continue;
+            else return;
             const int out = outward[scene.tri_object[s0.tri()]];
             certainly_hidden =
                 out != 0 && front0 == (out < 0) && front1 == (out < 0) && d0 != 0 && d1 != 0;
-            if (certainly_hidden && !settings.certainly_hidden) continue;
+            if (certainly_hidden && !settings.certainly_hidden) return;
         }
         FeatureSegment& seg = segments.emplace_back();
         seg.p0 = p0;
         seg.p1 = scene.positions[mesh.vertex_position[s0.hi]];
-        seg.key0 = {s0.lo, kNoIndex, kNoIndex};
+        seg.key0 = {lo, kNoIndex, kNoIndex};
         seg.key1 = {s0.hi, kNoIndex, kNoIndex};
         seg.faces = {s0.tri(), j - i > 1 ? sides[i + 1].tri() : kNoIndex};
         seg.type = type;
         seg.certainly_hidden = certainly_hidden;
-    }
+    });
 
     // Smooth contours: where n . (p - eye), interpolated linearly from the corners, is zero.
     if (settings.silhouettes && settings.smooth_contours) {

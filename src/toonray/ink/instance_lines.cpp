@@ -263,38 +263,37 @@ std::shared_ptr<const MeshLines> make_mesh_lines(std::shared_ptr<const TriangleM
             if (ml.welded.tri_vertices[t][k] == welded) return mesh.normals[mesh.tri_normals[t][k]];
         return Vec3f(0.0f);
     };
-    auto smooth_across = [&](const Side& s0, const Side& s1) {
+    auto smooth_across = [&](std::uint32_t lo, const Side& s0, const Side& s1) {
         if (!ml.corner_normals[s0.tri()] || !ml.corner_normals[s1.tri()]) return false;
-        return corner_normal(s0.tri(), s0.lo) == corner_normal(s1.tri(), s1.lo) &&
+        return corner_normal(s0.tri(), lo) == corner_normal(s1.tri(), lo) &&
                corner_normal(s0.tri(), s0.hi) == corner_normal(s1.tri(), s1.hi);
     };
     std::vector<std::uint32_t> owner;
-    const std::size_t edge_count = topology.edge_first.size() - 1;
-    for (std::size_t e = 0; e < edge_count; ++e) {
+    topology.for_each_edge([&](std::uint32_t e, std::uint32_t lo) {
         const std::uint32_t i = topology.edge_first[e], j = topology.edge_first[e + 1];
         const Side& s0 = topology.sides[i];
         MeshLines::Edge edge{
-            s0.lo,       s0.hi,       s0.tri(), j - i > 1 ? topology.sides[i + 1].tri() : kNoIndex,
+            lo,          s0.hi,       s0.tri(), j - i > 1 ? topology.sides[i + 1].tri() : kNoIndex,
             Vec3f(0.0f), Vec3f(0.0f), 0,        static_cast<std::uint32_t>(ml.edges.size())};
         if (j - i != 2) {
-            if (!settings.borders) continue;
+            if (!settings.borders) return;
             edge.flags = MeshLines::kBorder;
         } else {
             const Side& s1 = topology.sides[i + 1];
             edge.n0 = ml.normal[s0.tri()];
             edge.n1 = s0.forward() != s1.forward() ? ml.normal[s1.tri()] : -ml.normal[s1.tri()];
-            if (settings.silhouettes && !(settings.smooth_contours && smooth_across(s0, s1)))
+            if (settings.silhouettes && !(settings.smooth_contours && smooth_across(lo, s0, s1)))
                 edge.flags |= MeshLines::kCandidate;
             if (settings.creases && dot(edge.n0, edge.n1) < cos_crease)
                 edge.flags |= MeshLines::kCrease;
             else if (settings.materials &&
                      mesh.tri_material[s0.tri()] != mesh.tri_material[s1.tri()])
                 edge.flags |= MeshLines::kMaterial;
-            if (!edge.flags) continue;
+            if (!edge.flags) return;
         }
         ml.edges.push_back(edge);
         owner.push_back(s0.tri());
-    }
+    });
     // Edges by owning triangle (a stable counting sort keeps edge order within a triangle).
     ml.owned_first.assign(n + 1, 0);
     for (std::uint32_t t : owner) ++ml.owned_first[t + 1];

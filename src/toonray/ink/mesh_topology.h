@@ -19,11 +19,12 @@
 
 namespace toonray::ink {
 
-// A side of a usable triangle: from welded vertex lo to hi (lo < hi). 12 bytes: whether it runs
-// forward and which corner of the triangle starts it share a word with the triangle (a million
-// triangles have three million sides).
+// A side of a usable triangle, from welded vertex lo to hi (lo < hi), kept in lo's range of
+// the sides (MeshTopology::vertex_edges): 8 bytes, as a million triangles have three million
+// sides. Whether it runs forward and which corner of the triangle starts it share a word with
+// the triangle.
 struct Side {
-    std::uint32_t lo, hi;
+    std::uint32_t hi;
     // The triangle (the low kCornerShift bits), the corner k whose side (k -> k + 1 in the
     // triangle's winding) this is, and kForward when lo -> hi is its winding.
     std::uint32_t tri_corner_forward;
@@ -32,16 +33,14 @@ struct Side {
     static constexpr int kCornerShift = 29;
     static constexpr std::uint32_t kTriangles = 1u << kCornerShift;  // triangle ids are below
     Side() = default;
-    Side(std::uint32_t lo_, std::uint32_t hi_, std::uint32_t tri_, std::uint32_t corner_,
-         bool forward_)
-        : lo(lo_),
-          hi(hi_),
+    Side(std::uint32_t hi_, std::uint32_t tri_, std::uint32_t corner_, bool forward_)
+        : hi(hi_),
           tri_corner_forward(tri_ | (corner_ << kCornerShift) | (forward_ ? kForward : 0u)) {}
     [[nodiscard]] std::uint32_t tri() const { return tri_corner_forward & (kTriangles - 1); }
     [[nodiscard]] std::uint32_t corner() const { return (tri_corner_forward >> kCornerShift) & 3; }
     [[nodiscard]] bool forward() const { return (tri_corner_forward & kForward) != 0; }
 };
-static_assert(sizeof(Side) == 12);
+static_assert(sizeof(Side) == 8);
 
 struct MeshTopology {
     // What it was made from, besides the welded triangles (IntersectionCache::welded), when
@@ -50,9 +49,10 @@ struct MeshTopology {
     std::vector<std::uint8_t> usable;
     std::size_t objects = 0;
     /// Every side of a usable triangle, in order of (lo, hi, triangle, corner), so that the
-    /// sides of one edge are adjacent: edge e is sides [edge_first[e], edge_first[e + 1]).
+    /// sides of one edge are adjacent: edge e is sides [edge_first[e], edge_first[e + 1]), and
+    /// the edges from welded vertex lo are [vertex_edges[lo], vertex_edges[lo + 1]).
     std::unique_ptr<Side[]> sides;  // every one written: not cleared first
-    std::vector<std::uint32_t> edge_first;
+    std::vector<std::uint32_t> edge_first, vertex_edges;
     /// Per object: not closed, for an edge without exactly two sides in opposite directions,
     /// or a triangle that is not usable or has two corners welded together.
     std::vector<std::uint8_t> open;
@@ -97,13 +97,15 @@ struct MeshTopology {
                     const std::uint32_t u = w[k], v = w[(k + 1) % 3];
                     if (u == v) continue;
                     const std::uint32_t lo = std::min(u, v);
-                    sides[fill[lo]++] = {lo, std::max(u, v), static_cast<std::uint32_t>(t),
+                    sides[fill[lo]++] = {std::max(u, v), static_cast<std::uint32_t>(t),
                                          static_cast<std::uint32_t>(k), u < v};
                 }
             }
         }
         edge_first.reserve(side_count / 2 + 1);
+        vertex_edges.resize(vertices + 1);
         for (std::size_t v = 0; v < vertices; ++v) {
+            vertex_edges[v] = static_cast<std::uint32_t>(edge_first.size());
             Side* const first = sides.get() + offsets[v];
             Side* const last = sides.get() + offsets[v + 1];
             // By insertion, as a vertex has few sides (but not at the centre of a large fan).
@@ -126,7 +128,15 @@ struct MeshTopology {
                 i = j;
             }
         }
+        vertex_edges[vertices] = static_cast<std::uint32_t>(edge_first.size());
         edge_first.push_back(static_cast<std::uint32_t>(side_count));
+    }
+
+    /// Calls f(e, lo) for every edge e in order, with its lower welded vertex lo.
+    template <class F>
+    void for_each_edge(F&& f) const {
+        for (std::uint32_t lo = 0; lo + 1 < vertex_edges.size(); ++lo)
+            for (std::uint32_t e = vertex_edges[lo]; e < vertex_edges[lo + 1]; ++e) f(e, lo);
     }
 
     /// Whether the triangles' objects and usability are those it was made from (false when
