@@ -376,6 +376,36 @@ TEST(FeatureEdges, SurfacesFacingOneWayThatCrossThemselvesKeepTheirIntersectionL
     EXPECT_EQ(intersection_lines(edges_of(s, Vec3f(0.3f, -0.2f, 9.0f))), expected);
 }
 
+TEST(FeatureEdges, APatchFoldedUnderItsOwnBorderKeepsItsIntersectionLines) {
+    // A disc whose profile folds back under itself and out again, one fold passing through the
+    // other: its border is one circle, simple, but its normals turn over, so its triangles are
+    // not all wound one way seen along any axis.
+    Scene s;
+    const float pi = std::numbers::pi_v<float>;
+    add_grid(
+        s, 24, 48,
+        [&](float u, float v) {
+            float rho = 0, z = 0;
+            if (u <= 1.0f / 3) {
+                rho = 2.4f * u;
+            } else if (u <= 2.0f / 3) {
+                const float t = 3 * u - 1;
+                rho = 0.8f - 0.4f * t;
+                z = 0.2f * t;
+            } else {
+                const float w = 0.6f * (3 * u - 2);
+                rho = 0.4f + w;
+                z = 0.2f - w + 2 * w * w;
+            }
+            const float theta = v < 1.0f ? 2 * pi * v : 0.0f;  // the seam's corners weld
+            return Vec3f(rho * std::cos(theta), rho * std::sin(theta), z);
+        },
+        0);
+    const auto expected = brute_force_crossings(s);
+    ASSERT_GT(expected.size(), 40u);
+    EXPECT_EQ(intersection_lines(edges_of(s, Vec3f(0.3f, -0.2f, 9.0f))), expected);
+}
+
 TEST(FindCrossings, SkippingPatchesThatCannotCrossThemselvesFindsTheSamePairs) {
     const Scene s = upward_surfaces(24);
     const auto n = static_cast<std::uint32_t>(s.triangle_count());

@@ -227,7 +227,7 @@ struct Slots {
     std::unique_ptr<std::uint32_t[]> stale;  // null when every triangle is
     // With SurfacePatches only: the unit normal, and per side k (corner k to k + 1) the slot
     // across it when the neighbour there takes part and is wound consistently (else kNoIndex).
-    std::unique_ptr<float[]> normal[3];
+    std::unique_ptr<std::int8_t[]> normal[3];  // rounded to whole 127ths
     std::unique_ptr<std::uint32_t[]> across[3];
 
     // Values left for the caller to write.
@@ -238,7 +238,7 @@ struct Slots {
             hi[a] = std::make_unique_for_overwrite<float[]>(count);
             corner[a] = std::make_unique_for_overwrite<std::uint32_t[]>(count);
             if (with_patches) {
-                normal[a] = std::make_unique_for_overwrite<float[]>(count);
+                normal[a] = std::make_unique_for_overwrite<std::int8_t[]>(count);
                 across[a] = std::make_unique_for_overwrite<std::uint32_t[]>(count);
             }
         }
@@ -453,7 +453,10 @@ std::vector<PairCrossing> find_crossings(const Bvh& bvh, const CornersOf& corner
             slots.hi[a][at] = box.hi[a];
         }
         if (patches)
-            for (int a = 0; a < 3; ++a) slots.normal[a][at] = patches->normals[t][a];
+            for (int a = 0; a < 3; ++a) {
+                const float n = patches->normals[t][a] * 127.0f;  // a unit normal's: within 127
+                slots.normal[a][at] = static_cast<std::int8_t>(n + (n < 0.0f ? -0.5f : 0.5f));
+            }
     }
     for (std::uint32_t at = taking_part; at < taking_part + kLanes; ++at) {
         slots.tri[at] = kNoIndex;
@@ -536,32 +539,37 @@ std::vector<PairCrossing> find_crossings(const Bvh& bvh, const CornersOf& corner
     // before.
     auto cannot_cross_itself = [&](std::uint32_t node) {
         const std::uint32_t a0 = range_first[node], an = range_count[node];
+        // The box of the slots' rounded normals, in 127ths.
         float nlo[3], nhi[3];
         for (int a = 0; a < 3; ++a) {
-            const float* n = slots.normal[a].get();
-            __m128 lo = _mm_set1_ps(inf), hi = _mm_set1_ps(-inf);
+            const std::int8_t* n = slots.normal[a].get();
+            __m128i lo = _mm_set1_epi8(127), hi = _mm_set1_epi8(-128);
             std::uint32_t i = a0;
-            for (; i + kLanes <= a0 + an; i += kLanes) {
-                lo = _mm_min_ps(lo, _mm_loadu_ps(n + i));
-                hi = _mm_max_ps(hi, _mm_loadu_ps(n + i));
+            for (; i + 16 <= a0 + an; i += 16) {
+                const __m128i v = _mm_loadu_si128(reinterpret_cast<const __m128i*>(n + i));
+                lo = _mm_min_epi8(lo, v);
+                hi = _mm_max_epi8(hi, v);
             }
-            alignas(16) float l[4], h[4];
-            _mm_store_ps(l, lo);
-            _mm_store_ps(h, hi);
-            nlo[a] = std::min({l[0], l[1], l[2], l[3]});
-            nhi[a] = std::max({h[0], h[1], h[2], h[3]});
+            alignas(16) std::int8_t l[16], h[16];
+            _mm_store_si128(reinterpret_cast<__m128i*>(l), lo);
+            _mm_store_si128(reinterpret_cast<__m128i*>(h), hi);
+            int least_q = *std::min_element(l, l + 16), most_q = *std::max_element(h, h + 16);
             for (; i < a0 + an; ++i) {
-                nlo[a] = std::min(nlo[a], n[i]);
-                nhi[a] = std::max(nhi[a], n[i]);
+                least_q = std::min<int>(least_q, n[i]);
+                most_q = std::max<int>(most_q, n[i]);
             }
+            nlo[a] = static_cast<float>(least_q);
+            nhi[a] = static_cast<float>(most_q);
         }
         Vec3f d((nlo[0] + nhi[0]) * 0.5f, (nlo[1] + nhi[1]) * 0.5f, (nlo[2] + nhi[2]) * 0.5f);
         const float len = length(d);
         if (!(len > 0.0f)) return false;
         d = d / len;
-        // The least n . d over the box of the normals.
+        // The least n . d over the box of the normals, less what the rounding can take off
+        // (half a 127th along each axis).
         float least = 0.0f;
         for (int a = 0; a < 3; ++a) least += std::min(nlo[a] * d[a], nhi[a] * d[a]);
+        least = (least - 0.5f * (std::abs(d.x) + std::abs(d.y) + std::abs(d.z))) / 127.0f;
         if (!(least > kPatchCone)) return false;
         const Vec3f e1 =
             normalize(cross(d, std::abs(d.x) < 0.6f ? Vec3f(1, 0, 0) : Vec3f(0, 1, 0)));
