@@ -471,23 +471,16 @@ std::vector<PairCrossing> find_crossings(const Bvh& bvh, const CornersOf& corner
         return BBox{Vec3f(slots.lo[0][i], slots.lo[1][i], slots.lo[2][i]),
                     Vec3f(slots.hi[0][i], slots.hi[1][i], slots.hi[2][i])};
     };
-    // Per node: the box of its live triangles (empty without), and whether one is stale (with
-    // `stale` only). Boxes of live triangles only: nodes of faces turned away from the eye
-    // shrink or vanish, and fewer pairs of nodes overlap.
-    std::vector<BBox> live_box(bvh.nodes.size());
+    // Per node, with `stale` only: whether one of its live triangles is stale.
     std::vector<std::uint8_t> node_stale(stale ? bvh.nodes.size() : 0, 0);
-    for (std::size_t i = bvh.nodes.size(); i-- > 0;) {  // children come after parents
+    for (std::size_t i = node_stale.size(); i-- > 0;) {  // children come after parents
         const BvhNode& node = bvh.nodes[i];
         if (node.is_leaf()) {
-            for (std::uint32_t k = slot_of[node.first]; k < slot_of[node.first + node.count]; ++k) {
-                live_box[i].extend(slot_box(k));
-                if (stale) node_stale[i] |= slots.stale[k] != 0;
-            }
+            for (std::uint32_t k = slot_of[node.first]; k < slot_of[node.first + node.count]; ++k)
+                node_stale[i] |= slots.stale[k] != 0;
             continue;
         }
-        live_box[i] = live_box[node.first];
-        live_box[i].extend(live_box[node.first + 1]);
-        if (stale) node_stale[i] = node_stale[node.first] | node_stale[node.first + 1];
+        node_stale[i] = node_stale[node.first] | node_stale[node.first + 1];
     }
     // Per node: its slots, when they are a contiguous range (a subtree's leaves follow each
     // other in the BVHs built here; kNoIndex otherwise). Pairs of small subtrees are tested
@@ -574,7 +567,7 @@ std::vector<PairCrossing> find_crossings(const Bvh& bvh, const CornersOf& corner
         const Vec3f e1 =
             normalize(cross(d, std::abs(d.x) < 0.6f ? Vec3f(1, 0, 0) : Vec3f(0, 1, 0)));
         const Vec3f e2 = cross(d, e1);
-        const Vec3f c = live_box[node].center();
+        const Vec3f c = bvh.nodes[node].bounds.center();
         thread_local PatchBorder border;
         border.sides.clear();
         for (std::uint32_t i = a0; i < a0 + an; ++i) {
@@ -626,13 +619,14 @@ std::vector<PairCrossing> find_crossings(const Bvh& bvh, const CornersOf& corner
     // pushes the child pairs whose boxes may overlap.
     auto expand = [&](NodePair pair, std::vector<NodePair>& next, std::vector<PairCrossing>& out) {
         if (stale && !node_stale[pair.first] && !node_stale[pair.second]) return;
-        const BBox& box_a = live_box[pair.first];
-        const BBox& box_b = live_box[pair.second];
-        if (!overlap(box_a, box_b)) return;  // also when either has no live triangle
-        const BvhNode& a = bvh.nodes[pair.first];
-        const BvhNode& b = bvh.nodes[pair.second];
         const std::uint32_t a0 = range_first[pair.first], an = range_count[pair.first];
         const std::uint32_t b0 = range_first[pair.second], bn = range_count[pair.second];
+        if (an == 0 || bn == 0) return;  // a subtree without a live triangle
+        const BvhNode& a = bvh.nodes[pair.first];
+        const BvhNode& b = bvh.nodes[pair.second];
+        const BBox& box_a = a.bounds;
+        const BBox& box_b = b.bounds;
+        if (!overlap(box_a, box_b)) return;
         if (pair.first == pair.second) {
             if (a.is_leaf() || an <= kSmallSubtree) {
                 for (std::uint32_t i = a0; i + 1 < a0 + an; ++i) test_slots(i, i + 1, a0 + an, out);
@@ -984,9 +978,13 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
                            !std::equal(now.begin(), now.end(), cache->corners[t].begin(), same);
             }
         }
+        // Patches that cannot cross themselves are skipped in a full search; one limited to
+        // stale triangles is mostly skipped already, and the patches would cost more than
+        // they save.
         const SurfacePatches patches{normal, topology};
-        std::vector<PairCrossing> found = find_crossings(
-            bvh, corners_of, mesh, live_triangle, some_fresh ? &stale : nullptr, threads, &patches);
+        std::vector<PairCrossing> found =
+            find_crossings(bvh, corners_of, mesh, live_triangle, some_fresh ? &stale : nullptr,
+                           threads, some_fresh ? nullptr : &patches);
         if (cache) {
             // The cache's crossings of triangles that are not stale and take part now; then
             // the cache is this frame's.
