@@ -312,7 +312,9 @@ struct PatchBorder {
         }
         const float margin = std::max(1e-3f * longest, 1e-5f * reach);
         const float cell = 1.01f * longest + 2.0f * margin;
-        if (!(longest > 0.0f) || !(reach < 1e30f)) return false;
+        // (A patch a million of its longest sides across is not tested: its cells' numbers
+        // must fit the keys.)
+        if (!(longest > 0.0f) || !(reach < 1e6f * cell)) return false;
         cells.resize(m);
         auto cell_of = [&](float v) { return static_cast<std::int64_t>(std::floor(v / cell)); };
         auto key = [](std::int64_t x, std::int64_t y) {
