@@ -225,8 +225,9 @@ struct Slots {
     std::unique_ptr<float[]> lo[3], hi[3];
     std::unique_ptr<std::uint32_t[]> corner[3];
     std::unique_ptr<std::uint32_t[]> stale;  // null when every triangle is
-    // With SurfacePatches only: the unit normal, and per side k (corner k to k + 1) the slot
-    // across it when the neighbour there takes part and is wound consistently (else kNoIndex).
+    // With SurfacePatches only: the unit normal (rounded), and per side k (corner k to k + 1)
+    // the slot across it when the neighbour there takes part and is wound consistently (else
+    // kNoIndex).
     std::unique_ptr<std::int8_t[]> normal[3];  // rounded to whole 127ths
     std::unique_ptr<std::uint32_t[]> across[3];
 
@@ -247,8 +248,8 @@ struct Slots {
 };
 
 // Patches tested for crossing themselves: at least this many slots (smaller subtrees cost less
-// to search than to test), normals at least this far into the half-space about the patch's axis
-// (a cosine), and each border side turning about the centre by at least this sine.
+// to search than to test), and normals at least this far into the half-space about the patch's
+// axis (a cosine).
 constexpr std::uint32_t kPatchMin = 64;
 constexpr float kPatchCone = 0.05f;
 
