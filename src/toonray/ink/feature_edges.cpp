@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <bit>
+#include <functional>
 #include <limits>
 #include <map>
 #include <memory>
@@ -99,11 +100,15 @@ WeldedMesh weld_vertices_without_rings(const TriangleMesh& scene, bool one_objec
         }
     }
     // Welded ids in order of first use by the triangles: one per (object, canonical position).
-    // Most positions belong to one object; the few shared by several look the rest up.
+    // Most positions belong to one object; the few shared by several look the rest up. When
+    // every triangle has the same object, no position's object is kept.
+    const bool single =
+        one_object || std::adjacent_find(scene.tri_object.begin(), scene.tri_object.begin() + n,
+                                         std::not_equal_to<>()) == scene.tri_object.begin() + n;
     WeldedMesh mesh;
     mesh.tri_vertices.resize(n);
     std::vector<std::uint32_t> id_of(scene.positions.size(), kNoIndex),
-        object_of(scene.positions.size());
+        object_of(single ? 0 : scene.positions.size());
     std::map<std::pair<std::uint32_t, std::uint32_t>, std::uint32_t> shared;
     auto new_id = [&](std::uint32_t c) {
         mesh.vertex_position.push_back(c);
@@ -112,12 +117,12 @@ WeldedMesh weld_vertices_without_rings(const TriangleMesh& scene, bool one_objec
     for (std::size_t t = 0; t < n; ++t)
         for (int k = 0; k < 3; ++k) {
             const std::uint32_t c = canonical[scene.tri_positions[t][k]],
-                                object = one_object ? 0u : scene.tri_object[t];
+                                object = single ? 0u : scene.tri_object[t];
             std::uint32_t& id = mesh.tri_vertices[t][k];
             if (id_of[c] == kNoIndex) {
                 id = id_of[c] = new_id(c);
-                object_of[c] = object;
-            } else if (object_of[c] == object) {
+                if (!single) object_of[c] = object;
+            } else if (single || object_of[c] == object) {
                 id = id_of[c];
             } else {
                 auto [it, inserted] = shared.try_emplace({object, c}, 0u);
@@ -865,12 +870,17 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
     // edge a few ahead are fetched while this one is classified.
     constexpr std::size_t kAhead = 8;
     const std::size_t side_count = edge_first.back();
+    // With one material for every triangle there is no material edge to look for.
+    const bool materials =
+        settings.materials &&
+        std::adjacent_find(scene.tri_material.begin(), scene.tri_material.begin() + n,
+                           std::not_equal_to<>()) != scene.tri_material.begin() + n;
     topology.for_each_edge([&](std::uint32_t e, std::uint32_t lo) {
         if (e + kAhead < edge_count) {
             const std::uint32_t first = edge_first[e + kAhead];
             for (std::uint32_t k = first; k < std::min<std::size_t>(first + 2, side_count); ++k) {
                 __builtin_prefetch(&normal[sides[k].tri()]);
-                __builtin_prefetch(&scene.tri_material[sides[k].tri()]);
+                if (materials) __builtin_prefetch(&scene.tri_material[sides[k].tri()]);
             }
         }
         const std::uint32_t i = edge_first[e], j = edge_first[e + 1];
@@ -891,8 +901,7 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
                 !(settings.smooth_contours && smooth_across(lo, s0, s1)))
                 type = EdgeType::Silhouette;
             else if (settings.creases && dot(n0, n1) < cos_crease) type = EdgeType::Crease;
-            else if (settings.materials &&
-                     scene.tri_material[s0.tri()] != scene.tri_material[s1.tri()])
+            else if (materials && scene.tri_material[s0.tri()] != scene.tri_material[s1.tri()])
                 type = EdgeType::Material;
             else if (settings.bands && !smooth_across(lo, s0, s1) &&
                      bands_differ(edge_bands, lo, s0.hi, s0.tri(), s1.tri(), n0, n1))

@@ -76,30 +76,29 @@ struct MeshTopology {
                 fmt::format("ink lines: a mesh of {} triangles (at most {})", n, Side::kTriangles));
         // A counting sort by lo over the triangles in order puts each vertex's sides in
         // (triangle, corner) order; a stable sort by hi within each vertex then gives the
-        // whole order.
-        std::vector<std::uint32_t> offsets(vertices + 1, 0);
+        // whole order. Vertex v's count goes to offsets[v + 2], so that after the sums
+        // offsets[v + 1] is where its sides start: the cursor its sides are written at, which
+        // then ends where the next vertex's start (offsets[v] is v's start after the fill).
+        std::vector<std::uint32_t> offsets(vertices + 2, 0);
         for (std::size_t t = 0; t < n; ++t) {
             const auto& w = tri_vertices[t];
             if (!usable[t] || w[0] == w[1] || w[1] == w[2] || w[2] == w[0]) open[tri_object[t]] = 1;
             if (!usable[t]) continue;
             for (int k = 0; k < 3; ++k)
-                if (w[k] != w[(k + 1) % 3]) ++offsets[std::min(w[k], w[(k + 1) % 3]) + 1];
+                if (w[k] != w[(k + 1) % 3]) ++offsets[std::min(w[k], w[(k + 1) % 3]) + 2];
         }
-        for (std::size_t v = 0; v < vertices; ++v) offsets[v + 1] += offsets[v];
-        const std::size_t side_count = offsets[vertices];
+        for (std::size_t v = 2; v < vertices + 2; ++v) offsets[v] += offsets[v - 1];
+        const std::size_t side_count = offsets[vertices + 1];
         sides = std::make_unique_for_overwrite<Side[]>(side_count);
-        {
-            std::vector<std::uint32_t> fill(offsets.begin(), offsets.end() - 1);
-            for (std::size_t t = 0; t < n; ++t) {
-                if (!usable[t]) continue;
-                const auto& w = tri_vertices[t];
-                for (int k = 0; k < 3; ++k) {
-                    const std::uint32_t u = w[k], v = w[(k + 1) % 3];
-                    if (u == v) continue;
-                    const std::uint32_t lo = std::min(u, v);
-                    sides[fill[lo]++] = {std::max(u, v), static_cast<std::uint32_t>(t),
-                                         static_cast<std::uint32_t>(k), u < v};
-                }
+        for (std::size_t t = 0; t < n; ++t) {
+            if (!usable[t]) continue;
+            const auto& w = tri_vertices[t];
+            for (int k = 0; k < 3; ++k) {
+                const std::uint32_t u = w[k], v = w[(k + 1) % 3];
+                if (u == v) continue;
+                const std::uint32_t lo = std::min(u, v);
+                sides[offsets[lo + 1]++] = {std::max(u, v), static_cast<std::uint32_t>(t),
+                                            static_cast<std::uint32_t>(k), u < v};
             }
         }
         edge_first.reserve(side_count / 2 + 1);
