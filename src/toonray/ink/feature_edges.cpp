@@ -513,21 +513,22 @@ std::vector<PairCrossing> find_crossings(const Bvh& bvh, const CornersOf& corner
         for (int k = 0; k < 3; ++k)
             std::fill(slots.across[k].get(), slots.across[k].get() + taking_part + kLanes,
                       kNoIndex);
-        std::vector<std::uint32_t> slot_of_tri(live.size(), kNoIndex);
+        // Each triangle's slot, in the memory of the tree ranges' (no longer read).
+        std::vector<std::uint32_t> slot_of_tri = std::move(slot_of);
+        slot_of_tri.assign(live.size(), kNoIndex);
         for (std::uint32_t at = 0; at < taking_part; ++at) slot_of_tri[slots.tri[at]] = at;
         const MeshTopology& topology = patches->topology;
         const Side* const sides = topology.sides.get();
-        for (std::size_t e = 0; e + 1 < topology.edge_first.size(); ++e) {
-            const std::uint32_t i = topology.edge_first[e];
-            if (topology.edge_first[e + 1] - i != 2) continue;
+        topology.for_each_edge([&](std::uint32_t i, std::uint32_t j, std::uint32_t) {
+            if (j - i != 2) return;
             const Side& s0 = sides[i];
             const Side& s1 = sides[i + 1];
-            if (s0.forward() == s1.forward()) continue;
+            if (s0.forward() == s1.forward()) return;
             const std::uint32_t a = slot_of_tri[s0.tri()], b = slot_of_tri[s1.tri()];
-            if (a == kNoIndex || b == kNoIndex) continue;
+            if (a == kNoIndex || b == kNoIndex) return;
             slots.across[s0.corner()][a] = b;
             slots.across[s1.corner()][b] = a;
-        }
+        });
     }
     // Whether the live triangles of a subtree (its slots [a0, a0 + an)) cannot cross one another.
     // Seen along an axis d with every normal in the half-space about d, each triangle projects
@@ -796,18 +797,24 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
     std::vector<BBox> object_box(objects);
 
     // Per triangle, in one pass: its unit normal (zero when degenerate: the triangle is not
-    // usable), whether it has a normal at every corner, and its object's box and volume. The
-    // corners are read from the scene where needed, not stored: at a million triangles a copy
-    // is 40 MB more at the frame's peak, whose first touch costs more than the reads.
+    // usable), whether it has a normal at every corner, which side of it the eye is on, and
+    // its object's box and volume. The corners are read from the scene where needed, not
+    // stored: at a million triangles a copy is 40 MB more at the frame's peak, whose first
+    // touch costs more than the reads.
     const IndexedCorners corners_of{scene.positions, scene.tri_positions};
     std::vector<Vec3f> normal;
-    std::vector<std::uint8_t> corner_normals, usable_triangle;
+    std::vector<std::uint8_t> corner_normals, usable_triangle, eye_side;
     normal.reserve(n);
     corner_normals.reserve(n);
     usable_triangle.reserve(n);
+    eye_side.reserve(n);
+    constexpr std::uint8_t kEyeInFront = 1, kEyeBehind = 2;
     for (std::size_t t = 0; t < n; ++t) {
         const auto p = corners_of(t);
-        usable_triangle.push_back(normal.emplace_back(face_normal(p)) != Vec3f(0.0f));
+        const Vec3f& nt = normal.emplace_back(face_normal(p));
+        usable_triangle.push_back(nt != Vec3f(0.0f));
+        const float facing = dot(nt, eye - p[0]);
+        eye_side.push_back(facing > 0 ? kEyeInFront : facing < 0 ? kEyeBehind : 0);
         corner_normals.push_back(has_corner_normals(scene, t));
         const std::uint32_t o = scene.tri_object[t];
         for (const Vec3f& q : p) object_box[o].extend(q);
@@ -828,9 +835,7 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
     if (cache) cache->topology = kept;
     const MeshTopology& topology = *kept;
     const Side* const sides = topology.sides.get();
-    const std::vector<std::uint32_t>& edge_first = topology.edge_first;
     for (std::size_t o = 0; o < objects; ++o) closed[o] = !topology.open[o];
-    const std::size_t edge_count = edge_first.size() - 1;
 
     auto eye_outside = [&](const BBox& b) {
         return eye.x < b.lo.x || eye.y < b.lo.y || eye.z < b.lo.z || eye.x > b.hi.x ||
@@ -843,11 +848,11 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
             outward[o] = volume[o] > 0.0 ? 1 : -1;
     // Triangles turned away from the eye on those objects: every point inside them is hidden
     // by the solid, so an intersection line on one is certainly hidden.
-    std::vector<std::uint8_t> turned_away(n, 0);
+    std::vector<std::uint8_t>& turned_away = eye_side;  // in its place
     for (std::size_t t = 0; t < n; ++t) {
         const int out = outward[scene.tri_object[t]];
-        const float facing = dot(normal[t], eye - corners_of(t)[0]);
-        turned_away[t] = out != 0 && usable(t) && (out > 0 ? facing < 0 : facing > 0);
+        turned_away[t] =
+            out != 0 && usable(t) && eye_side[t] == (out > 0 ? kEyeBehind : kEyeInFront);
     }
 
     const float cos_crease =
@@ -866,24 +871,22 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
     };
     const EdgeBands edge_bands{scene, mesh, settings, eye, corner_normals};
     // One segment per edge that is a line: each is classified first, and made only if drawn.
-    // The edges come by vertex, their faces from all over the per-triangle arrays: those of an
-    // edge a few ahead are fetched while this one is classified.
-    constexpr std::size_t kAhead = 8;
-    const std::size_t side_count = edge_first.back();
+    // The edges come by vertex, their faces from all over the per-triangle arrays: those of the
+    // sides a few edges ahead are fetched while this one is classified.
+    constexpr std::size_t kAhead = 16;
+    const std::size_t side_count = topology.side_count();
     // With one material for every triangle there is no material edge to look for.
     const bool materials =
         settings.materials &&
         std::adjacent_find(scene.tri_material.begin(), scene.tri_material.begin() + n,
                            std::not_equal_to<>()) != scene.tri_material.begin() + n;
-    topology.for_each_edge([&](std::uint32_t e, std::uint32_t lo) {
-        if (e + kAhead < edge_count) {
-            const std::uint32_t first = edge_first[e + kAhead];
-            for (std::uint32_t k = first; k < std::min<std::size_t>(first + 2, side_count); ++k) {
+    topology.for_each_edge([&](std::uint32_t i, std::uint32_t j, std::uint32_t lo) {
+        if (i + kAhead + 2 <= side_count) {
+            for (std::size_t k = i + kAhead; k < i + kAhead + 2; ++k) {
                 __builtin_prefetch(&normal[sides[k].tri()]);
                 if (materials) __builtin_prefetch(&scene.tri_material[sides[k].tri()]);
             }
         }
-        const std::uint32_t i = edge_first[e], j = edge_first[e + 1];
         const Side& s0 = sides[i];
         const Vec3f p0 = scene.positions[mesh.vertex_position[lo]];
         EdgeType type = EdgeType::Border;

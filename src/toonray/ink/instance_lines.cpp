@@ -269,8 +269,7 @@ std::shared_ptr<const MeshLines> make_mesh_lines(std::shared_ptr<const TriangleM
                corner_normal(s0.tri(), s0.hi) == corner_normal(s1.tri(), s1.hi);
     };
     std::vector<std::uint32_t> owner;
-    topology.for_each_edge([&](std::uint32_t e, std::uint32_t lo) {
-        const std::uint32_t i = topology.edge_first[e], j = topology.edge_first[e + 1];
+    topology.for_each_edge([&](std::uint32_t i, std::uint32_t j, std::uint32_t lo) {
         const Side& s0 = topology.sides[i];
         MeshLines::Edge edge{
             lo,          s0.hi,       s0.tri(), j - i > 1 ? topology.sides[i + 1].tri() : kNoIndex,

@@ -20,7 +20,7 @@
 namespace toonray::ink {
 
 // A side of a usable triangle, from welded vertex lo to hi (lo < hi), kept in lo's range of
-// the sides (MeshTopology::vertex_edges): 8 bytes, as a million triangles have three million
+// the sides (MeshTopology::vertex_sides): 8 bytes, as a million triangles have three million
 // sides. Whether it runs forward and which corner of the triangle starts it share a word with
 // the triangle.
 struct Side {
@@ -48,11 +48,11 @@ struct MeshTopology {
     std::vector<std::uint32_t> tri_object;
     std::vector<std::uint8_t> usable;
     std::size_t objects = 0;
-    /// Every side of a usable triangle, in order of (lo, hi, triangle, corner), so that the
-    /// sides of one edge are adjacent: edge e is sides [edge_first[e], edge_first[e + 1]), and
-    /// the edges from welded vertex lo are [vertex_edges[lo], vertex_edges[lo + 1]).
+    /// Every side of a usable triangle, in order of (lo, hi, triangle, corner): the sides from
+    /// welded vertex lo are [vertex_sides[lo], vertex_sides[lo + 1]), and an edge is a run of
+    /// them with the same hi (found as they are read, rather than listed: 4 bytes an edge).
     std::unique_ptr<Side[]> sides;  // every one written: not cleared first
-    std::vector<std::uint32_t> edge_first, vertex_edges;
+    std::vector<std::uint32_t> vertex_sides;
     /// Per object: not closed, for an edge without exactly two sides in opposite directions,
     /// or a triangle that is not usable or has two corners welded together.
     std::vector<std::uint8_t> open;
@@ -78,8 +78,10 @@ struct MeshTopology {
         // (triangle, corner) order; a stable sort by hi within each vertex then gives the
         // whole order. Vertex v's count goes to offsets[v + 2], so that after the sums
         // offsets[v + 1] is where its sides start: the cursor its sides are written at, which
-        // then ends where the next vertex's start (offsets[v] is v's start after the fill).
-        std::vector<std::uint32_t> offsets(vertices + 2, 0);
+        // then ends where the next vertex's start (offsets[v] is v's start after the fill, and
+        // the offsets, less the last, are vertex_sides).
+        std::vector<std::uint32_t>& offsets = vertex_sides;
+        offsets.assign(vertices + 2, 0);
         for (std::size_t t = 0; t < n; ++t) {
             const auto& w = tri_vertices[t];
             if (!usable[t] || w[0] == w[1] || w[1] == w[2] || w[2] == w[0]) open[tri_object[t]] = 1;
@@ -101,10 +103,8 @@ struct MeshTopology {
                                             static_cast<std::uint32_t>(k), u < v};
             }
         }
-        edge_first.reserve(side_count / 2 + 1);
-        vertex_edges.resize(vertices + 1);
+        offsets.pop_back();
         for (std::size_t v = 0; v < vertices; ++v) {
-            vertex_edges[v] = static_cast<std::uint32_t>(edge_first.size());
             Side* const first = sides.get() + offsets[v];
             Side* const last = sides.get() + offsets[v + 1];
             // By insertion, as a vertex has few sides (but not at the centre of a large fan).
@@ -122,20 +122,31 @@ struct MeshTopology {
             for (const Side* i = first; i < last;) {
                 const Side* j = i + 1;
                 while (j < last && j->hi == i->hi) ++j;
-                edge_first.push_back(static_cast<std::uint32_t>(i - sides.get()));
                 if (j - i != 2 || i[0].forward() == i[1].forward()) open[tri_object[i->tri()]] = 1;
                 i = j;
             }
         }
-        vertex_edges[vertices] = static_cast<std::uint32_t>(edge_first.size());
-        edge_first.push_back(static_cast<std::uint32_t>(side_count));
     }
 
-    /// Calls f(e, lo) for every edge e in order, with its lower welded vertex lo.
+    [[nodiscard]] std::size_t side_count() const { return vertex_sides.back(); }
+
+    /// Calls f(i, j, lo) for every edge in order: its sides [i, j) and its lower welded vertex.
     template <class F>
     void for_each_edge(F&& f) const {
-        for (std::uint32_t lo = 0; lo + 1 < vertex_edges.size(); ++lo)
-            for (std::uint32_t e = vertex_edges[lo]; e < vertex_edges[lo + 1]; ++e) f(e, lo);
+        // Locals, which f cannot be taken to change.
+        const Side* const s = sides.get();
+        const std::uint32_t* const first = vertex_sides.data();
+        const std::size_t vertices = vertex_sides.size() - 1;
+        for (std::uint32_t lo = 0; lo < vertices; ++lo) {
+            const std::uint32_t last = first[lo + 1];
+            for (std::uint32_t i = first[lo]; i < last;) {
+                const std::uint32_t hi = s[i].hi;
+                std::uint32_t j = i + 1;
+                while (j < last && s[j].hi == hi) ++j;
+                f(i, j, lo);
+                i = j;
+            }
+        }
     }
 
     /// Whether the triangles' objects and usability are those it was made from (false when
