@@ -412,16 +412,17 @@ TEST(FindCrossings, SkippingPatchesThatCannotCrossThemselvesFindsTheSamePairs) {
     const ink::WeldedMesh mesh = ink::weld_vertices(s);
     const TriangleAccel accel = build_accel(s);
     const ink::IndexedCorners corners_of{s.positions, s.tri_positions};
-    std::vector<Vec3f> normals(n);
+    std::vector<ink::RoundedNormal> normals(n);
     std::vector<std::uint8_t> usable(n);
     for (std::uint32_t t = 0; t < n; ++t) {
         const auto p = corners_of(t);
         const Vec3f c = cross(p[1] - p[0], p[2] - p[0]);
         usable[t] = length(c) > 0.0f;
-        normals[t] = usable[t] ? normalize(c) : Vec3f(0.0f);
+        normals[t] = ink::round_normal(usable[t] ? normalize(c) : Vec3f(0.0f));
     }
     const ink::MeshTopology topology(s.tri_object, mesh, usable, s.objects.size());
-    const ink::SurfacePatches patches{normals, topology};
+    const auto across = topology.triangles_across(n);
+    const ink::SurfacePatches patches{normals, across};
     auto found = [&](const ink::SurfacePatches* with) {
         std::map<std::pair<std::uint32_t, std::uint32_t>, std::array<Vec3f, 2>> out;
         for (const ink::PairCrossing& c :

@@ -48,15 +48,19 @@ TEST(InkLines, TeapotHasLinesOfEveryStageAndIsThreadIndependent) {
 TEST(InkLines, MeshEdgesAreKeptForTheNextFrameWhileTheWeldsStay) {
     // The cache keeps the last frame's mesh edges with the welded triangles they were found
     // for, which the next frame's drawing moves into it: the same triangles reuse them, and
-    // welds that change find them again. A first frame does not keep the objects and
-    // usability its mesh edges are checked against (a still would not read them): the second
-    // finds them again, and keeps them.
+    // welds that change find them again. A first frame keeps no mesh edges (a still would not
+    // read them: they are freed before the frame's peak), only which objects they close; the
+    // second finds them again, and keeps them with the objects and usability they are checked
+    // against.
     Teapot t(640, 360);
     ink::InkLines lines;
     ink::draw_ink_lines(t.scene, t.accel, t.camera, 640, 360, {}, 1, lines);
-    ASSERT_NE(lines.intersections.topology, nullptr);
-    EXPECT_TRUE(lines.intersections.topology->usable.empty());
+    EXPECT_EQ(lines.intersections.topology, nullptr);
+    ASSERT_EQ(lines.intersections.open.size(), t.scene.objects.size());
+    const std::vector<std::uint8_t> closed_after_one = ink::closed_objects(lines.intersections);
     ink::draw_ink_lines(t.scene, t.accel, t.camera, 640, 360, {}, 1, lines);
+    ASSERT_NE(lines.intersections.topology, nullptr);
+    EXPECT_EQ(ink::closed_objects(lines.intersections), closed_after_one);
     const auto first = lines.intersections.topology;
     EXPECT_EQ(first->usable.size(), t.scene.triangle_count());
     const std::vector<ink::FeatureSegment> segments = lines.segments;

@@ -461,10 +461,7 @@ std::vector<PairCrossing> find_crossings(const Bvh& bvh, const CornersOf& corner
             slots.hi[a][at] = box.hi[a];
         }
         if (patches)
-            for (int a = 0; a < 3; ++a) {
-                const float n = patches->normals[t][a] * 127.0f;  // a unit normal's: within 127
-                slots.normal[a][at] = static_cast<std::int8_t>(n + (n < 0.0f ? -0.5f : 0.5f));
-            }
+            for (int a = 0; a < 3; ++a) slots.normal[a][at] = patches->normals[t][a];
     }
     for (std::uint32_t at = taking_part; at < taking_part + kLanes; ++at) {
         slots.tri[at] = kNoIndex;
@@ -508,27 +505,18 @@ std::vector<PairCrossing> find_crossings(const Bvh& bvh, const CornersOf& corner
         range_count[i] = joined ? range_count[l] + range_count[r] : kNoIndex;
     }
     if (patches) {
-        // The slots across the slots' sides, from the mesh edges: an edge of two sides in
-        // opposite directions joins the slots of its triangles, when both take part.
-        for (int k = 0; k < 3; ++k)
-            std::fill(slots.across[k].get(), slots.across[k].get() + taking_part + kLanes,
-                      kNoIndex);
-        // Each triangle's slot, in the memory of the tree ranges' (no longer read).
+        // The slots across the slots' sides: those of the triangles across them, when they
+        // take part. Each triangle's slot is kept in the memory of the tree ranges' (no longer
+        // read).
         std::vector<std::uint32_t> slot_of_tri = std::move(slot_of);
         slot_of_tri.assign(live.size(), kNoIndex);
         for (std::uint32_t at = 0; at < taking_part; ++at) slot_of_tri[slots.tri[at]] = at;
-        const MeshTopology& topology = patches->topology;
-        const Side* const sides = topology.sides.get();
-        topology.for_each_edge([&](std::uint32_t i, std::uint32_t j, std::uint32_t) {
-            if (j - i != 2) return;
-            const Side& s0 = sides[i];
-            const Side& s1 = sides[i + 1];
-            if (s0.forward() == s1.forward()) return;
-            const std::uint32_t a = slot_of_tri[s0.tri()], b = slot_of_tri[s1.tri()];
-            if (a == kNoIndex || b == kNoIndex) return;
-            slots.across[s0.corner()][a] = b;
-            slots.across[s1.corner()][b] = a;
-        });
+        for (std::uint32_t at = 0; at < taking_part + kLanes; ++at)
+            for (int k = 0; k < 3; ++k) {
+                const std::uint32_t u =
+                    at < taking_part ? patches->across[slots.tri[at]][k] : kNoIndex;
+                slots.across[k][at] = u == kNoIndex ? kNoIndex : slot_of_tri[u];
+            }
     }
     // Whether the live triangles of a subtree (its slots [a0, a0 + an)) cannot cross one another.
     // Seen along an axis d with every normal in the half-space about d, each triangle projects
@@ -752,8 +740,7 @@ struct EdgeBands {
 
 std::vector<std::uint8_t> closed_objects(const IntersectionCache& cache) {
     std::vector<std::uint8_t> closed;
-    if (!cache.topology) return closed;
-    for (std::uint8_t open : cache.topology->open) closed.push_back(open ? 0 : 1);
+    for (std::uint8_t open : cache.open) closed.push_back(open ? 0 : 1);
     return closed;
 }
 
@@ -808,10 +795,20 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
     corner_normals.reserve(n);
     usable_triangle.reserve(n);
     eye_side.reserve(n);
+    // A full intersection search (without a cache of the same triangles' crossings) skips
+    // patches that cannot cross themselves, which read the normals rounded (3 bytes a
+    // triangle: the float normals are freed before the search) and the triangles across each
+    // side (MeshTopology::triangles_across, found with the edges below).
+    const bool intersections = settings.intersections && !bvh.nodes.empty();
+    const bool some_fresh = cache && cache->corners.size() == n && cache->tested.size() == n;
+    const bool patches_searched = intersections && !some_fresh;
+    std::vector<RoundedNormal> rounded;
+    if (patches_searched) rounded.reserve(n);
     constexpr std::uint8_t kEyeInFront = 1, kEyeBehind = 2;
     for (std::size_t t = 0; t < n; ++t) {
         const auto p = corners_of(t);
         const Vec3f& nt = normal.emplace_back(face_normal(p));
+        if (patches_searched) rounded.push_back(round_normal(nt));
         usable_triangle.push_back(nt != Vec3f(0.0f));
         const float facing = dot(nt, eye - p[0]);
         eye_side.push_back(facing > 0 ? kEyeInFront : facing < 0 ? kEyeBehind : 0);
@@ -822,17 +819,21 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
     }
     auto usable = [&](std::size_t t) { return usable_triangle[t] != 0; };
 
-    // A cache that holds mesh edges has seen a frame before: frames follow each other, and
-    // this one's corners, and what its mesh edges are made from, are worth keeping for the
-    // next (a single frame keeps neither: an animation's second frame finds them anew).
-    const bool frames_follow = cache && cache->topology;
+    // A cache that has seen a frame before: frames follow each other, and this one's mesh
+    // edges, corners, and what the mesh edges are made from, are worth keeping for the next (a
+    // single frame keeps none of them: an animation's second frame finds them anew).
+    const bool frames_follow = cache && cache->frames > 0;
+    if (cache) ++cache->frames;
     // The mesh edges, as the last frame's when the triangles' welded corners, objects and
     // usability did not change.
     std::shared_ptr<const MeshTopology> kept = cache ? cache->topology : nullptr;
     if (!kept || cache->welded != mesh.tri_vertices || !kept->same(scene, usable_triangle, objects))
         kept = std::make_shared<const MeshTopology>(scene.tri_object, mesh, usable_triangle,
                                                     objects, frames_follow);
-    if (cache) cache->topology = kept;
+    if (cache) {
+        cache->topology = frames_follow ? kept : nullptr;
+        cache->open = kept->open;
+    }
     const MeshTopology& topology = *kept;
     const Side* const sides = topology.sides.get();
     for (std::size_t o = 0; o < objects; ++o) closed[o] = !topology.open[o];
@@ -870,6 +871,9 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
                corner_normal(s0.tri(), s0.hi) == corner_normal(s1.tri(), s1.hi);
     };
     const EdgeBands edge_bands{scene, mesh, settings, eye, corner_normals};
+    // The triangles across the sides, for a full intersection search (kNoIndex: none).
+    std::vector<std::array<std::uint32_t, 3>> across;
+    if (patches_searched) across.assign(n, {kNoIndex, kNoIndex, kNoIndex});
     // One segment per edge that is a line: each is classified first, and made only if drawn.
     // The edges come by vertex, their faces from all over the per-triangle arrays: those of the
     // sides a few edges ahead are fetched while this one is classified.
@@ -895,9 +899,14 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
             if (!settings.borders) return;
         } else {
             const Side& s1 = sides[i + 1];
-            const Vec3f n0 = normal[s0.tri()];
             // Consistently wound neighbours run the shared side in opposite directions.
-            const Vec3f n1 = s0.forward() != s1.forward() ? normal[s1.tri()] : -normal[s1.tri()];
+            const bool consistent = s0.forward() != s1.forward();
+            if (patches_searched && consistent) {
+                across[s0.tri()][s0.corner()] = s1.tri();
+                across[s1.tri()][s1.corner()] = s0.tri();
+            }
+            const Vec3f n0 = normal[s0.tri()];
+            const Vec3f n1 = consistent ? normal[s1.tri()] : -normal[s1.tri()];
             const float d0 = dot(n0, eye - p0), d1 = dot(n1, eye - p0);
             const bool front0 = d0 > 0, front1 = d1 > 0;
             if (settings.silhouettes && front0 != front1 &&
@@ -970,7 +979,7 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
     }
 
     // Intersection lines: each triangle against the triangles whose boxes overlap its own.
-    if (settings.intersections && !bvh.nodes.empty()) {
+    if (intersections) {
         // Triangles that take part: usable ones, and without hidden lines only those not turned
         // away from the eye on a closed solid.
         std::vector<std::uint8_t> live_triangle(n);
@@ -980,7 +989,6 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
         // is stale: its corners changed since the cache's frame, or it did not take part then.
         // Without one, every triangle is.
         std::vector<std::uint8_t> stale;
-        const bool some_fresh = cache && cache->corners.size() == n && cache->tested.size() == n;
         if (some_fresh) {
             auto same = [](const Vec3f& a, const Vec3f& b) {
                 return std::bit_cast<std::array<std::uint32_t, 3>>(a) ==
@@ -995,8 +1003,12 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
         }
         // Patches that cannot cross themselves are skipped in a full search; one limited to
         // stale triangles is mostly skipped already, and the patches would cost more than
-        // they save.
-        const SurfacePatches patches{normal, topology};
+        // they save. The normals, and the mesh edges when no frame follows, are freed before
+        // the search makes its slots: the frame's peak.
+        std::vector<Vec3f>().swap(normal);
+        std::vector<std::uint8_t>().swap(corner_normals);
+        kept.reset();  // `topology` is not read from here on
+        const SurfacePatches patches{rounded, across};
         std::vector<PairCrossing> found =
             find_crossings(bvh, corners_of, mesh, live_triangle, some_fresh ? &stale : nullptr,
                            threads, some_fresh ? nullptr : &patches);

@@ -144,9 +144,14 @@ struct IntersectionCache {
     /// `crossings`.
     std::vector<std::uint8_t> tested;
     std::vector<PairCrossing> crossings;  ///< of those pairs, by (t, u)
-    /// The last frame's mesh edges, the same while the welded triangles, their objects and
-    /// which of them are usable (not degenerate) stay the same.
+    /// The frames drawn with the cache: from the second on, the mesh edges are kept.
+    std::uint64_t frames = 0;
+    /// The last frame's mesh edges (from the cache's second frame on), the same while the
+    /// welded triangles, their objects and which of them are usable (not degenerate) stay the
+    /// same.
     std::shared_ptr<const MeshTopology> topology;
+    /// Per object, whether the last frame's mesh edges leave it open (MeshTopology::open).
+    std::vector<std::uint8_t> open;
     /// The welded triangles (WeldedMesh::tri_vertices) `topology` was found for, which
     /// draw_ink_lines moves here from the last frame's mesh before it welds the next (rather
     /// than the topology keeping a copy: 12 bytes a triangle at the frame's peak). Left empty,

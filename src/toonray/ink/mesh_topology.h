@@ -149,6 +149,20 @@ struct MeshTopology {
         }
     }
 
+    /// Per triangle t < n and corner k, the triangle across its side k (corner k to k + 1)
+    /// when that edge has two sides in opposite directions (consistently wound neighbours);
+    /// else kNoIndex.
+    [[nodiscard]] std::vector<std::array<std::uint32_t, 3>> triangles_across(std::size_t n) const {
+        std::vector<std::array<std::uint32_t, 3>> across(n, {kNoIndex, kNoIndex, kNoIndex});
+        const Side* const s = sides.get();
+        for_each_edge([&](std::uint32_t i, std::uint32_t j, std::uint32_t) {
+            if (j - i != 2 || s[i].forward() == s[i + 1].forward()) return;
+            across[s[i].tri()][s[i].corner()] = s[i + 1].tri();
+            across[s[i + 1].tri()][s[i + 1].corner()] = s[i].tri();
+        });
+        return across;
+    }
+
     /// Whether the triangles' objects and usability are those it was made from (false when
     /// they were not kept).
     [[nodiscard]] bool same(const TriangleMesh& scene, std::span<const std::uint8_t> usable_,
@@ -181,11 +195,23 @@ struct IndexedCorners {
     void prefetch(std::uint32_t t) const { __builtin_prefetch(&triangles[t]); }
 };
 
+/// A unit normal rounded to whole 127ths per axis (zero stays zero): 3 bytes rather than 12.
+using RoundedNormal = std::array<std::int8_t, 3>;
+[[nodiscard]] inline RoundedNormal round_normal(const Vec3f& unit) {
+    RoundedNormal r;
+    for (int a = 0; a < 3; ++a) {
+        const float n = unit[a] * 127.0f;  // a unit normal's: within 127
+        r[static_cast<std::size_t>(a)] = static_cast<std::int8_t>(n + (n < 0.0f ? -0.5f : 0.5f));
+    }
+    return r;
+}
+
 /// What lets the intersection search skip whole subtrees whose triangles cannot cross one
-/// another: per triangle, its unit normal (face_normal), and the mesh edges.
+/// another: per triangle, its unit normal (face_normal) rounded, and the triangles across its
+/// sides (MeshTopology::triangles_across).
 struct SurfacePatches {
-    std::span<const Vec3f> normals;
-    const MeshTopology& topology;
+    std::span<const RoundedNormal> normals;
+    std::span<const std::array<std::uint32_t, 3>> across;
 };
 
 /// Every pair of triangles that take part (`live`) and cross, as intersect_triangles finds them,
