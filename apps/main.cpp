@@ -9,6 +9,7 @@
 #include "commands.h"
 #include "hints.h"
 #include "toonray/core/error.h"
+#include "toonray/core/memory.h"
 #include "toonray/frame/settings.h"
 
 namespace {
@@ -27,6 +28,7 @@ int run(const Subcommand& command) {
 }  // namespace
 
 int main(int argc, char** argv) {
+    toonray::retain_freed_memory();
     CLI::App app{"toonray: a toon ray tracer. OBJ/MTL scenes in, cel-shaded and outlined PNG out."};
     app.require_subcommand(1);
     app.set_version_flag("--version", "toonray " + std::string(toonray::toonray_version()));
