@@ -15,6 +15,7 @@
 #include "toonray/ink/chunks.h"
 #include "toonray/ink/hash.h"
 #include "toonray/ink/mesh_topology.h"
+#include "toonray/ink/patch_border.h"
 #include "toonray/ink/light_lines.h"
 
 namespace toonray::ink {
@@ -85,6 +86,7 @@ WeldedMesh weld_vertices_without_rings(const TriangleMesh& scene, bool one_objec
     while (table_size < positions + positions / 2) table_size *= 2;
     const std::size_t mask = table_size - 1;
     std::vector<std::uint32_t> table(table_size, kNoIndex);
+    bool shared_bits = false;
     for (std::uint32_t i = 0; i < positions; ++i) {
         const Bits b = bits(i);
         for (std::size_t slot = hash_words(b[0], b[1], b[2]) & mask;; slot = (slot + 1) & mask) {
@@ -95,6 +97,7 @@ WeldedMesh weld_vertices_without_rings(const TriangleMesh& scene, bool one_objec
             }
             if (bits(table[slot]) == b) {
                 canonical[i] = table[slot];
+                shared_bits = true;
                 break;
             }
         }
@@ -116,7 +119,9 @@ WeldedMesh weld_vertices_without_rings(const TriangleMesh& scene, bool one_objec
     };
     for (std::size_t t = 0; t < n; ++t)
         for (int k = 0; k < 3; ++k) {
-            const std::uint32_t c = canonical[scene.tri_positions[t][k]],
+            // Every position its own canonical one when none shares its bits with another.
+            const std::uint32_t position = scene.tri_positions[t][k],
+                                c = shared_bits ? canonical[position] : position,
                                 object = single ? 0u : scene.tri_object[t];
             std::uint32_t& id = mesh.tri_vertices[t][k];
             if (id_of[c] == kNoIndex) {
@@ -257,129 +262,6 @@ struct Slots {
 // axis (a cosine).
 constexpr std::uint32_t kPatchMin = 64;
 constexpr float kPatchCone = 0.05f;
-
-// The border of a patch projected to a plane, as sides from one welded vertex to the next (in
-// the triangles' winding), and whether they make one simple closed polygon.
-struct PatchBorder {
-    struct Point {
-        float x, y;
-    };
-    struct Side {
-        Point from, to;
-        std::uint32_t from_vertex, to_vertex;
-    };
-    std::vector<Side> sides;
-    std::vector<std::uint32_t> order, next;
-    std::vector<std::pair<std::uint64_t, std::uint32_t>> cells;
-
-    static float cross(Point o, Point a, Point b) {
-        return (a.x - o.x) * (b.y - o.y) - (a.y - o.y) * (b.x - o.x);
-    }
-    static float dist(Point a, Point b) {
-        const float x = b.x - a.x, y = b.y - a.y;
-        return std::sqrt(x * x + y * y);
-    }
-
-    // Whether the sides make one closed loop (each vertex starts one side, and following them
-    // from the first comes back after all of them) that comes within `margin` of itself
-    // nowhere but where consecutive sides meet.
-    bool simple_loop() {
-        const std::size_t m = sides.size();
-        if (m < 3) return false;
-        order.resize(m);
-        for (std::uint32_t i = 0; i < m; ++i) order[i] = i;
-        std::sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
-            return sides[a].from_vertex < sides[b].from_vertex;
-        });
-        for (std::size_t i = 1; i < m; ++i)
-            if (sides[order[i]].from_vertex == sides[order[i - 1]].from_vertex) return false;
-        next.resize(m);
-        for (std::uint32_t i = 0; i < m; ++i) {
-            const auto at = std::lower_bound(
-                order.begin(), order.end(), sides[i].to_vertex,
-                [&](std::uint32_t a, std::uint32_t v) { return sides[a].from_vertex < v; });
-            if (at == order.end() || sides[*at].from_vertex != sides[i].to_vertex) return false;
-            next[i] = *at;
-        }
-        std::size_t steps = 0;
-        std::uint32_t e = 0;
-        do {
-            e = next[e];
-            ++steps;
-        } while (e != 0 && steps <= m);
-        if (steps != m) return false;
-        // Sides no longer than `longest` can only come near each other when their middles lie
-        // in neighbouring cells of that size. The margin is far above the rounding of the
-        // projected corners, which grows with their distance from the centre.
-        float longest = 0.0f, reach = 0.0f;
-        for (const Side& s : sides) {
-            longest = std::max(longest, dist(s.from, s.to));
-            reach = std::max({reach, std::abs(s.from.x), std::abs(s.from.y)});
-        }
-        const float margin = std::max(1e-3f * longest, 1e-5f * reach);
-        const float cell = 1.01f * longest + 2.0f * margin;
-        // (A patch a million of its longest sides across is not tested: its cells' numbers
-        // must fit the keys.)
-        if (!(longest > 0.0f) || !(reach < 1e6f * cell)) return false;
-        cells.resize(m);
-        auto cell_of = [&](float v) { return static_cast<std::int64_t>(std::floor(v / cell)); };
-        auto key = [](std::int64_t x, std::int64_t y) {
-            return (static_cast<std::uint64_t>(x) << 32) ^ static_cast<std::uint32_t>(y);
-        };
-        for (std::uint32_t i = 0; i < m; ++i) {
-            const Side& s = sides[i];
-            cells[i] = {
-                key(cell_of((s.from.x + s.to.x) * 0.5f), cell_of((s.from.y + s.to.y) * 0.5f)), i};
-        }
-        std::sort(cells.begin(), cells.end());
-        for (std::uint32_t i = 0; i < m; ++i) {
-            const Side& a = sides[i];
-            const float ax = (a.from.x + a.to.x) * 0.5f, ay = (a.from.y + a.to.y) * 0.5f;
-            const std::int64_t cx = cell_of(ax), cy = cell_of(ay);
-            for (std::int64_t dx = -1; dx <= 1; ++dx)
-                for (std::int64_t dy = -1; dy <= 1; ++dy) {
-                    const std::uint64_t k = key(cx + dx, cy + dy);
-                    auto at = std::lower_bound(cells.begin(), cells.end(),
-                                               std::pair<std::uint64_t, std::uint32_t>{k, 0});
-                    for (; at != cells.end() && at->first == k; ++at) {
-                        const std::uint32_t j = at->second;
-                        if (j <= i) continue;
-                        if (!apart(i, j, margin)) return false;
-                    }
-                }
-        }
-        return true;
-    }
-
-    // Whether sides i and j keep at least `margin` apart, or (when consecutive) meet only at
-    // their shared corner without folding back along each other.
-    [[nodiscard]] bool apart(std::uint32_t i, std::uint32_t j, float margin) const {
-        const Side& a = sides[i];
-        const Side& b = sides[j];
-        const float la = dist(a.from, a.to), lb = dist(b.from, b.to);
-        if (!(la > margin) || !(lb > margin)) return false;
-        if (next[i] == j || next[j] == i) {
-            if (next[i] == j && next[j] == i) return false;
-            const Side& first = next[i] == j ? a : b;
-            const Side& second = next[i] == j ? b : a;
-            const Point u{first.to.x - first.from.x, first.to.y - first.from.y};
-            const Point v{second.to.x - second.from.x, second.to.y - second.from.y};
-            const float turn = u.x * v.y - u.y * v.x, along = u.x * v.x + u.y * v.y;
-            return along >= 0.0f || std::abs(turn) > margin * std::max(la, lb);
-        }
-        if (std::max(a.from.x, a.to.x) + margin < std::min(b.from.x, b.to.x) ||
-            std::max(b.from.x, b.to.x) + margin < std::min(a.from.x, a.to.x) ||
-            std::max(a.from.y, a.to.y) + margin < std::min(b.from.y, b.to.y) ||
-            std::max(b.from.y, b.to.y) + margin < std::min(a.from.y, a.to.y))
-            return true;
-        // One side wholly beyond the other's line, by more than the margin.
-        const float b0 = cross(a.from, a.to, b.from), b1 = cross(a.from, a.to, b.to);
-        if ((b0 > margin * la && b1 > margin * la) || (b0 < -margin * la && b1 < -margin * la))
-            return true;
-        const float a0 = cross(b.from, b.to, a.from), a1 = cross(b.from, b.to, a.to);
-        return (a0 > margin * lb && a1 > margin * lb) || (a0 < -margin * lb && a1 < -margin * lb);
-    }
-};
 
 // Bit k is set when slot j + k may cross slot i: their boxes overlap, they share no corner
 // position, and one of them is stale.
@@ -942,7 +824,6 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
         std::vector<float> g_value(scene.positions.size());
         for (std::size_t t = 0; t < n; ++t) {
             if (!usable(t) || !corner_normals[t]) continue;
-            const auto p = corners_of(t);
             float g[3];
             for (int k = 0; k < 3; ++k) {
                 const std::uint32_t position = scene.tri_positions[t][k],
@@ -951,11 +832,16 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
                     // Unit normals: the zero's position depends on their lengths.
                     const Vec3f nk = scene.normals[normal_index];
                     const float len = length(nk);
-                    g_value[position] = dot(nk, p[k] - eye) / (len > 0.0f ? len : 1.0f);
+                    g_value[position] =
+                        dot(nk, scene.positions[position] - eye) / (len > 0.0f ? len : 1.0f);
                     g_normal[position] = normal_index;
                 }
                 g[k] = g_value[position];
             }
+            // Most triangles have no contour: their corners are read only when one does.
+            const bool g0 = g[0] >= 0;
+            if (g0 == (g[1] >= 0) && g0 == (g[2] >= 0)) continue;
+            const auto p = corners_of(t);
             FeatureSegment seg;
             seg.type = EdgeType::Silhouette;
             seg.smooth = true;
