@@ -7,6 +7,18 @@
 #include <cstdlib>
 #include <cstring>
 
+// AddressSanitizer replaces glibc's allocator with its own, which keeps freed blocks out of use
+// for a while: there is no glibc policy to observe in that build.
+#if defined(__SANITIZE_ADDRESS__)
+#define TOONRAY_ADDRESS_SANITIZER 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define TOONRAY_ADDRESS_SANITIZER 1
+#endif
+#endif
+
+#if defined(__GLIBC__) && !defined(TOONRAY_ADDRESS_SANITIZER)
+
 namespace toonray {
 namespace {
 
@@ -27,18 +39,18 @@ long faults_to_fill(std::size_t bytes) {
     return after - before;
 }
 
-#if defined(__GLIBC__)
 TEST(Memory, AFreedBlockIsReusedWithoutFaultingItsPagesAgain) {
     retain_freed_memory();
     constexpr std::size_t kBytes = std::size_t{16} << 20;  // 4,096 pages of 4 KiB
     const long first = faults_to_fill(kBytes);
     const long second = faults_to_fill(kBytes);
     EXPECT_GT(first, 64);  // fresh memory, faulted in
-    // Handed back to the system, the block would be faulted in again, page by page (or by
-    // huge page: still more than a few).
-    EXPECT_LT(second, 8) << "first fill took " << first << " faults";
+    // Handed back to the system, the block would be faulted in again as many times (an
+    // emulator running the test may take a few faults of its own).
+    EXPECT_LT(second, first / 16) << "first fill took " << first << " faults";
 }
-#endif
 
 }  // namespace
 }  // namespace toonray
+
+#endif
