@@ -753,7 +753,8 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
                corner_normal(s0.tri(), s0.hi) == corner_normal(s1.tri(), s1.hi);
     };
     const EdgeBands edge_bands{scene, mesh, settings, eye, corner_normals};
-    // The triangles across the sides, for a full intersection search (kNoIndex: none).
+    // The triangles across the sides (MeshTopology::triangles_across), for a full intersection
+    // search.
     std::vector<std::array<std::uint32_t, 3>> across;
     if (patches_searched) across.assign(n, {kNoIndex, kNoIndex, kNoIndex});
     // One segment per edge that is a line: each is classified first, and made only if drawn.
@@ -783,10 +784,7 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
             const Side& s1 = sides[i + 1];
             // Consistently wound neighbours run the shared side in opposite directions.
             const bool consistent = s0.forward() != s1.forward();
-            if (patches_searched && consistent) {
-                across[s0.tri()][s0.corner()] = s1.tri();
-                across[s1.tri()][s1.corner()] = s0.tri();
-            }
+            if (patches_searched) MeshTopology::link_across(s0, s1, across);
             const Vec3f n0 = normal[s0.tri()];
             const Vec3f n1 = consistent ? normal[s1.tri()] : -normal[s1.tri()];
             const float d0 = dot(n0, eye - p0), d1 = dot(n1, eye - p0);

@@ -156,11 +156,18 @@ struct MeshTopology {
         std::vector<std::array<std::uint32_t, 3>> across(n, {kNoIndex, kNoIndex, kNoIndex});
         const Side* const s = sides.get();
         for_each_edge([&](std::uint32_t i, std::uint32_t j, std::uint32_t) {
-            if (j - i != 2 || s[i].forward() == s[i + 1].forward()) return;
-            across[s[i].tri()][s[i].corner()] = s[i + 1].tri();
-            across[s[i + 1].tri()][s[i + 1].corner()] = s[i].tri();
+            if (j - i == 2) link_across(s[i], s[i + 1], across);
         });
         return across;
+    }
+
+    /// triangles_across's entries for the two sides of one edge, in a pass over the edges that
+    /// already reads them.
+    static void link_across(const Side& s0, const Side& s1,
+                            std::vector<std::array<std::uint32_t, 3>>& across) {
+        if (s0.forward() == s1.forward()) return;
+        across[s0.tri()][s0.corner()] = s1.tri();
+        across[s1.tri()][s1.corner()] = s0.tri();
     }
 
     /// Whether the triangles' objects and usability are those it was made from (false when
