@@ -2,6 +2,7 @@
 // areas it hands the wide collapse, exact partitions on non-finite input, huge-page buffers.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -136,6 +137,65 @@ TEST(Build, NonFiniteCoordinatesStillPartitionExactly) {
         accel.build(s.positions, s.tris);
         Hit hit;
         accel.intersect(Ray{{0.0f, 0.0f, -5.0f}, {0.0f, 0.0f, 1.0f}}, hit);  // must not crash
+    }
+}
+
+TEST(Build, EveryNodeIsTheBoxOfItsPrimitives) {
+    // A node's bounds come from the bins of its parent's split, before the partition moves any
+    // primitive: they are exactly the union of the node's primitives' boxes only when the
+    // partition put exactly the primitives the bins counted on each side. Small (serial),
+    // parallel top levels, and clustered (long runs on one side, misplaced ones in bursts).
+    for (int count : {3000, 70000}) {
+        for (float size : {0.02f, 0.3f}) {
+            Soup s = random_soup(count, 41, size);
+            const std::vector<BBox> boxes = boxes_of(s);
+            const Bvh bvh = Bvh::build(boxes);
+            expect_one_tree(bvh, boxes.size());
+            // Children come after their parents: a reverse sweep sees them first.
+            std::vector<BBox> uni(bvh.nodes.size());
+            for (std::size_t i = bvh.nodes.size(); i-- > 0;) {
+                const BvhNode& node = bvh.nodes[i];
+                if (node.is_leaf()) {
+                    for (std::uint32_t k = node.first; k < node.first + node.count; ++k)
+                        uni[i].extend(boxes[bvh.prim_indices[k]]);
+                } else {
+                    uni[i] = uni[node.first];
+                    uni[i].extend(uni[node.first + 1]);
+                }
+                ASSERT_EQ(std::memcmp(&uni[i], &node.bounds, sizeof(BBox)), 0)
+                    << "node " << i << " of " << count << " primitives";
+            }
+        }
+    }
+}
+
+TEST(Build, TheTreeDoesNotDependOnThePrimitivesOrder) {
+    // Bins and the children's centre bounds are minima, maxima and counts, whatever order the
+    // partitions leave the primitives in: the same boxes in another order give the same nodes,
+    // and each leaf the same primitives.
+    for (int count : {3000, 70000}) {
+        Soup s = random_soup(count, 43, 0.05f);
+        const std::vector<BBox> boxes = boxes_of(s);
+        std::vector<std::uint32_t> order(boxes.size());
+        for (std::size_t i = 0; i < order.size(); ++i)
+            order[i] = static_cast<std::uint32_t>((i * 7919) % order.size());  // 7919 is prime
+        std::vector<BBox> shuffled(boxes.size());
+        for (std::size_t i = 0; i < order.size(); ++i) shuffled[i] = boxes[order[i]];
+        const Bvh a = Bvh::build(boxes), b = Bvh::build(shuffled);
+        ASSERT_EQ(a.nodes.size(), b.nodes.size());
+        ASSERT_EQ(std::memcmp(a.nodes.data(), b.nodes.data(), a.nodes.size() * sizeof(BvhNode)), 0)
+            << count << " primitives";
+        for (const BvhNode& leaf : a.nodes) {
+            if (!leaf.is_leaf()) continue;
+            std::vector<std::uint32_t> in_a, in_b;
+            for (std::uint32_t k = leaf.first; k < leaf.first + leaf.count; ++k) {
+                in_a.push_back(a.prim_indices[k]);
+                in_b.push_back(order[b.prim_indices[k]]);
+            }
+            std::sort(in_a.begin(), in_a.end());
+            std::sort(in_b.begin(), in_b.end());
+            ASSERT_EQ(in_a, in_b);
+        }
     }
 }
 
