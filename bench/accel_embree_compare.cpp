@@ -13,8 +13,8 @@
 //   embree 8      rtcIntersect8, 4x2-pixel packets, RTC_INTERSECT_CONTEXT_FLAG_COHERENT
 // shadow rays from every primary hit towards two point lights, timed with
 // TriangleAccel::intersect (closest hit) and TriangleAccel::occluded (any hit); and build times:
-// ours (TriangleAccel::build) and Embree (rtcCommitScene, default quality), each on 1 thread and
-// on all threads.
+// ours (TriangleAccel::build) and Embree (rtcCommitScene, default quality), each on 1 thread (under
+// a one-thread TBB limit, its CPU time checked) and on all threads.
 //
 // Checks before timing (the exit status is 1 when one fails; --quick runs only them, small):
 // trace_primary's directions are bit-identical to normalize(pixel_point - eye); ours single and
@@ -29,6 +29,7 @@
 // `--quick` (checks only) as accel_bench_quick.
 
 #include <embree3/rtcore.h>
+#include <sys/resource.h>
 #include <tbb/global_control.h>
 
 #include <algorithm>
@@ -54,6 +55,14 @@ using namespace toonray;
 namespace {
 
 using Clock = std::chrono::steady_clock;
+
+// User + system time of the whole process so far (all its threads).
+double process_cpu_seconds() {
+    rusage u{};
+    getrusage(RUSAGE_SELF, &u);
+    return static_cast<double>(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
+           1e-6 * static_cast<double>(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
 
 double seconds_since(Clock::time_point t0) {
     return std::chrono::duration<double>(Clock::now() - t0).count();
@@ -608,17 +617,27 @@ int main(int argc, char** argv) {
 
         double bo1 = 0, be1 = 0, boa = 0, bea = 0;
         if (opt.build) {
-            std::vector<double> o1, e1t, oa, ea;
+            std::vector<double> o1, e1t, oa, ea, o1_cpu, e1t_cpu;
             int reps = std::max(3, opt.repeats);
+            // Both one-thread builds run under a one-thread TBB limit. Embree's own "threads=1" is
+            // not enough: while another device (embree_all) exists, that device's build used both
+            // cores (CPU time twice its wall time), so the one-thread figure was a two-thread one.
+            // The CPU time of each one-thread build is checked below.
+            auto one_thread = [](std::vector<double>& wall, std::vector<double>& cpu,
+                                 auto&& build) {
+                tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
+                const double c0 = process_cpu_seconds();
+                wall.push_back(build());
+                cpu.push_back(process_cpu_seconds() - c0);
+            };
             for (int r = 0; r < reps; ++r) {
-                {
-                    tbb::global_control one(tbb::global_control::max_allowed_parallelism, 1);
+                one_thread(o1, o1_cpu, [&] {
                     TriangleAccel a;
                     auto t0 = Clock::now();
                     a.build(m.positions, m.tris, opt.config);
-                    o1.push_back(seconds_since(t0));
-                }
-                e1t.push_back(embree_1t.build(m));
+                    return seconds_since(t0);
+                });
+                one_thread(e1t, e1t_cpu, [&] { return embree_1t.build(m); });
                 {
                     TriangleAccel a;
                     auto t0 = Clock::now();
@@ -634,6 +653,22 @@ int main(int argc, char** argv) {
             std::printf(
                 "  build ms: ours 1t %.1f, embree 1t %.1f, ours all %.1f, embree all %.1f\n", bo1,
                 be1, boa, bea);
+            // CPU over wall time of the one-thread builds (the Embree build's wall time includes
+            // making the scene, so it may read a little under 1): well over 1 means a build ran
+            // on more than one thread, and its figure is not a one-thread one.
+            double sum_o = 0, sum_e = 0, cpu_o = 0, cpu_e = 0;
+            for (int r = 0; r < reps; ++r) {
+                sum_o += o1[r];
+                sum_e += e1t[r];
+                cpu_o += o1_cpu[r];
+                cpu_e += e1t_cpu[r];
+            }
+            std::printf("  one-thread builds, CPU / wall time: ours %.2f, embree %.2f\n",
+                        cpu_o / sum_o, cpu_e / sum_e);
+            if (cpu_o > 1.25 * sum_o || cpu_e > 1.25 * sum_e) {
+                std::printf("  FAIL: a one-thread build used more than one thread\n");
+                failed = true;
+            }
         }
         char row[512];
         auto ratio = [](double a, double b) { return b > 0 ? a / b : 0.0; };
