@@ -665,7 +665,12 @@ int main(int argc, char** argv) {
             }
             std::printf("  one-thread builds, CPU / wall time: ours %.2f, embree %.2f\n",
                         cpu_o / sum_o, cpu_e / sum_e);
-            if (cpu_o > 1.25 * sum_o || cpu_e > 1.25 * sum_e) {
+            // Judged on 50 ms or more of builds: the all-threads builds' TBB workers may still
+            // spin for a moment after them, which weighs on the teapot's 1 ms builds only.
+            const auto more_than_one_thread = [](double cpu, double wall) {
+                return wall >= 0.05 && cpu > 1.25 * wall;
+            };
+            if (more_than_one_thread(cpu_o, sum_o) || more_than_one_thread(cpu_e, sum_e)) {
                 std::printf("  FAIL: a one-thread build used more than one thread\n");
                 failed = true;
             }
