@@ -151,20 +151,13 @@ TEST(Build, EveryNodeIsTheBoxOfItsPrimitives) {
             const std::vector<BBox> boxes = boxes_of(s);
             const Bvh bvh = Bvh::build(boxes);
             expect_one_tree(bvh, boxes.size());
-            // Children come after their parents: a reverse sweep sees them first.
-            std::vector<BBox> uni(bvh.nodes.size());
-            for (std::size_t i = bvh.nodes.size(); i-- > 0;) {
-                const BvhNode& node = bvh.nodes[i];
-                if (node.is_leaf()) {
-                    for (std::uint32_t k = node.first; k < node.first + node.count; ++k)
-                        uni[i].extend(boxes[bvh.prim_indices[k]]);
-                } else {
-                    uni[i] = uni[node.first];
-                    uni[i].extend(uni[node.first + 1]);
-                }
-                ASSERT_EQ(std::memcmp(&uni[i], &node.bounds, sizeof(BBox)), 0)
+            // Refitting sets every node to the union of its primitives' boxes.
+            Bvh refitted = bvh;
+            refitted.refit(boxes);
+            for (std::size_t i = 0; i < bvh.nodes.size(); ++i)
+                ASSERT_EQ(
+                    std::memcmp(&refitted.nodes[i].bounds, &bvh.nodes[i].bounds, sizeof(BBox)), 0)
                     << "node " << i << " of " << count << " primitives";
-            }
         }
     }
 }
