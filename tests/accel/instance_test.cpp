@@ -198,8 +198,7 @@ TEST(Instances, RaysFindTheClosestHitInObjectSpace) {
 }
 
 TEST(Instances, WithoutOwnTrianglesAndAxisAlignedViews) {
-    // Rays along the axes in object space make groups irregular there (zero components),
-    // which the tiles then trace ray by ray.
+    // Rays along the axes in object space (zero direction components).
     const Soup teapot = from_obj("teapot.obj");
     Soup pot = teapot;
     for (Vec3f& p : pot.positions) p = p * 0.2f;
