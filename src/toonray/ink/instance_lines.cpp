@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <tuple>
 
@@ -65,28 +66,39 @@ Cone merge(const Cone& a, const Cone& b) {
     return c;
 }
 
-// The sign of n . (eye - p) for every normal n of the cone and point p of the box: +1 when
-// positive for all, -1 when negative for all, 0 when it may change (or the cone is not valid).
-// The bound is n . (eye - c) - n . (p - c) with c the box's centre: the second term is at most
-// the box's half diagonal r, the first within D cos(phi -+ alpha) of the eye's direction phi
-// from the axis; a margin of 1e-4 (D + r) covers the rounding of this bound and of the dot
-// products the lines are classified with (a few 2^-24 of D + r).
-int facing_bound(const Cone& cone, const BBox& box, const Vec3f& eye) {
-    if (!cone.valid || box.empty()) return 0;
-    const Vec3f c = box.center();
-    const float r = 0.5f * length(box.extent());
-    const Vec3f d = eye - c;
+// A node's box as the sphere around it, which is what the cone bound reads of it.
+struct BoundingSphere {
+    Vec3f centre;
+    float radius = std::numeric_limits<float>::infinity();  ///< infinite for an empty box
+};
+
+BoundingSphere sphere_of(const BBox& box) {
+    if (box.empty()) return {};
+    return {box.center(), 0.5f * length(box.extent())};
+}
+
+// The sign of n . (eye - p) for every normal n of the cone and point p of the node's box: +1
+// when positive for all, -1 when negative for all, 0 when it may change (or the cone is not
+// valid). The bound is n . (eye - c) - n . (p - c) with c the box's centre: the second term is
+// at most the box's half diagonal r, the first within D cos(phi -+ alpha) of the eye's
+// direction phi from the axis, d = eye - c and D = |d|. D cos(phi -+ alpha) is taken as
+// p cos(alpha) +- q sin(alpha) with p = axis . d and q = |axis x d| (D cos phi and D sin phi
+// without a division, and q without the cancellation of sqrt(D^2 - p^2) near the axis): each
+// term is within a few 2^-24 of D, which a margin of 1e-4 (D + r) covers, with the rounding of
+// the dot products the lines are classified with. (The tree's nodes are tested in the
+// millions for a crowd: this is its hottest function.)
+inline int facing_bound(const Cone& cone, const BoundingSphere& box, const Vec3f& eye) {
+    if (!cone.valid) return 0;
+    const float r = box.radius;
+    const Vec3f d = eye - box.centre;
     const float dist = length(d);
     if (!std::isfinite(dist) || !std::isfinite(r) || dist <= r) return 0;
-    const float cos_phi = std::clamp(dot(cone.axis, d) / dist, -1.0f, 1.0f);
-    const float sin_phi = std::sqrt(std::max(0.0f, 1.0f - cos_phi * cos_phi));
+    const float p = dot(cone.axis, d), q = length(cross(cone.axis, d));
     const float margin = 1e-4f * (dist + r);
-    // phi + alpha < 180 degrees and cos(phi + alpha) D - r > 0: all positive.
-    const float cos_sum = cos_phi * cone.cos_a - sin_phi * cone.sin_a;
-    if (dist * cos_sum - r > margin) return 1;
-    // phi > alpha and cos(phi - alpha) D + r < 0: all negative.
-    const float cos_diff = cos_phi * cone.cos_a + sin_phi * cone.sin_a;
-    if (cos_phi < cone.cos_a && dist * cos_diff + r < -margin) return -1;
+    // phi + alpha < 180 degrees and D cos(phi + alpha) - r > 0: all positive.
+    if (p * cone.cos_a - q * cone.sin_a - r > margin) return 1;
+    // phi > alpha and D cos(phi - alpha) + r < 0: all negative.
+    if (p < dist * cone.cos_a && p * cone.cos_a + q * cone.sin_a + r < -margin) return -1;
     return 0;
 }
 
@@ -187,14 +199,18 @@ struct MeshLines {
     // boundary or border from every eye.
     struct Edge {
         std::uint32_t lo, hi, t0, t1;
+        Vec3f p0;      ///< the position of end lo (read for every edge an eye is tested on)
         Vec3f n0, n1;  ///< the faces' normals, n1 turned for inconsistent winding
         std::uint8_t flags;
         std::uint32_t order;  ///< in the mesh's edge order (by welded ends)
     };
     std::vector<Edge> edges;
-    std::vector<std::uint32_t> owned_first;  ///< per triangle: its edges owned_first[t] ..
-    Bvh tree;                                ///< over the triangles
+    /// Per slot k of the tree's leaves (tree.prim_indices[k]): the edges its triangle owns,
+    /// owned_first[k] .. owned_first[k + 1] - 1.
+    std::vector<std::uint32_t> owned_first;
+    Bvh tree;  ///< over the triangles
     struct Node {
+        BoundingSphere sphere;  ///< around the tree node's box
         Cone poly, smooth;
         bool candidates = false, fixed = false, smooth_triangles = false;
     };
@@ -271,9 +287,15 @@ std::shared_ptr<const MeshLines> make_mesh_lines(std::shared_ptr<const TriangleM
     std::vector<std::uint32_t> owner;
     topology.for_each_edge([&](std::uint32_t i, std::uint32_t j, std::uint32_t lo) {
         const Side& s0 = topology.sides[i];
-        MeshLines::Edge edge{
-            lo,          s0.hi,       s0.tri(), j - i > 1 ? topology.sides[i + 1].tri() : kNoIndex,
-            Vec3f(0.0f), Vec3f(0.0f), 0,        static_cast<std::uint32_t>(ml.edges.size())};
+        MeshLines::Edge edge{lo,
+                             s0.hi,
+                             s0.tri(),
+                             j - i > 1 ? topology.sides[i + 1].tri() : kNoIndex,
+                             mesh.positions[ml.welded.vertex_position[lo]],
+                             Vec3f(0.0f),
+                             Vec3f(0.0f),
+                             0,
+                             static_cast<std::uint32_t>(ml.edges.size())};
         if (j - i != 2) {
             if (!settings.borders) return;
             edge.flags = MeshLines::kBorder;
@@ -293,25 +315,32 @@ std::shared_ptr<const MeshLines> make_mesh_lines(std::shared_ptr<const TriangleM
         ml.edges.push_back(edge);
         owner.push_back(s0.tri());
     });
-    // Edges by owning triangle (a stable counting sort keeps edge order within a triangle).
-    ml.owned_first.assign(n + 1, 0);
-    for (std::uint32_t t : owner) ++ml.owned_first[t + 1];
-    for (std::size_t t = 0; t < n; ++t) ml.owned_first[t + 1] += ml.owned_first[t];
-    {
-        std::vector<MeshLines::Edge> sorted(ml.edges.size());
-        std::vector<std::uint32_t> fill(ml.owned_first.begin(), ml.owned_first.end() - 1);
-        for (std::size_t e = 0; e < ml.edges.size(); ++e) sorted[fill[owner[e]]++] = ml.edges[e];
-        ml.edges.swap(sorted);
-    }
-
     // The hierarchy: the triangles' BVH, each node with cones around the normals its lines are
     // classified by.
     ml.tree = Bvh::build(mesh.positions, mesh.tri_positions, Bvh::Config{}, nullptr);
+    // Edges by the slot of their owning triangle in the tree's leaves (a stable counting sort
+    // keeps edge order within a triangle; a triangle the tree does not hold goes last), so
+    // that a walk of the tree reads them in order: every instance walks it again, and by
+    // triangle the edges were read at random (a crowd's frame stalled on them).
+    std::vector<std::uint32_t> slot_of(n, static_cast<std::uint32_t>(n));
+    for (std::size_t k = 0; k < ml.tree.prim_indices.size(); ++k)
+        slot_of[ml.tree.prim_indices[k]] = static_cast<std::uint32_t>(k);
+    ml.owned_first.assign(n + 2, 0);
+    for (std::uint32_t t : owner) ++ml.owned_first[slot_of[t] + 1];
+    for (std::size_t k = 0; k <= n; ++k) ml.owned_first[k + 1] += ml.owned_first[k];
+    {
+        std::vector<MeshLines::Edge> sorted(ml.edges.size());
+        std::vector<std::uint32_t> fill(ml.owned_first.begin(), ml.owned_first.end() - 1);
+        for (std::size_t e = 0; e < ml.edges.size(); ++e)
+            sorted[fill[slot_of[owner[e]]]++] = ml.edges[e];
+        ml.edges.swap(sorted);
+    }
     ml.nodes.resize(ml.tree.nodes.size());
     std::vector<Vec3f> poly, smooth;
     for (std::size_t i = ml.tree.nodes.size(); i-- > 0;) {  // children after parents
         const BvhNode& b = ml.tree.nodes[i];
         MeshLines::Node& node = ml.nodes[i];
+        node.sphere = sphere_of(b.bounds);
         if (!b.is_leaf()) {
             const MeshLines::Node& l = ml.nodes[b.first];
             const MeshLines::Node& r = ml.nodes[b.first + 1];
@@ -329,7 +358,7 @@ std::shared_ptr<const MeshLines> make_mesh_lines(std::shared_ptr<const TriangleM
         bool zero_normal = false;
         for (std::uint32_t k = b.first; k < b.first + b.count; ++k) {
             const std::uint32_t t = ml.tree.prim_indices[k];
-            for (std::uint32_t e = ml.owned_first[t]; e < ml.owned_first[t + 1]; ++e) {
+            for (std::uint32_t e = ml.owned_first[k]; e < ml.owned_first[k + 1]; ++e) {
                 const MeshLines::Edge& edge = ml.edges[e];
                 if (edge.flags & MeshLines::kCandidate) {
                     node.candidates = true;
@@ -430,7 +459,7 @@ void instance_segments(const Placement& pl, const ViewVolume* volume,
     smooth.clear();
     edges_found.clear();
     auto edge_segment = [&](const MeshLines::Edge& e) {
-        const Vec3f p0 = mesh.positions[ml.welded.vertex_position[e.lo]];
+        const Vec3f& p0 = e.p0;
         EdgeType type = EdgeType::Border;
         bool certainly_hidden = false;
         if (!(e.flags & MeshLines::kBorder)) {
@@ -501,9 +530,10 @@ void instance_segments(const Placement& pl, const ViewVolume* volume,
                 all_inside = volume->sees_all(world);
             }
             const bool cones = options.cone_culling;
-            const int poly = cones && node.candidates ? facing_bound(node.poly, b.bounds, eye) : 0;
+            const int poly =
+                cones && node.candidates ? facing_bound(node.poly, node.sphere, eye) : 0;
             const int around =
-                cones && node.smooth_triangles ? facing_bound(node.smooth, b.bounds, eye) : 0;
+                cones && node.smooth_triangles ? facing_bound(node.smooth, node.sphere, eye) : 0;
             const bool edges = node.fixed || (node.candidates && poly == 0);
             const bool contours = node.smooth_triangles && around == 0;
             if (!edges && !contours) continue;
@@ -515,7 +545,7 @@ void instance_segments(const Placement& pl, const ViewVolume* volume,
             for (std::uint32_t k = b.first; k < b.first + b.count; ++k) {
                 const std::uint32_t t = ml.tree.prim_indices[k];
                 if (edges)
-                    for (std::uint32_t e = ml.owned_first[t]; e < ml.owned_first[t + 1]; ++e) {
+                    for (std::uint32_t e = ml.owned_first[k]; e < ml.owned_first[k + 1]; ++e) {
                         const MeshLines::Edge& edge = ml.edges[e];
                         // No silhouette in the node: an edge that is only a candidate is not
                         // a line.
