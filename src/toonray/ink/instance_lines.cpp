@@ -209,12 +209,22 @@ struct MeshLines {
     /// owned_first[k] .. owned_first[k + 1] - 1.
     std::vector<std::uint32_t> owned_first;
     Bvh tree;  ///< over the triangles
-    struct Node {
-        BoundingSphere sphere;  ///< around the tree node's box
-        Cone poly, smooth;
-        bool candidates = false, fixed = false, smooth_triangles = false;
+    // The tree as each instance's walk reads it: in depth-first order, a node's subtree being
+    // the nodes from it up to `skip`, so that a walk only moves forward through memory, one
+    // node per 52 bytes. (Every instance walks it again; a walk that jumped between the
+    // tree's nodes and a second array of cones stalled on both.)
+    enum : std::uint8_t { kHasCandidates = 1, kHasFixed = 2, kHasSmooth = 4 };
+    struct WalkNode {
+        BoundingSphere sphere;  ///< around the node's box
+        Cone poly;              ///< around the normals of its candidate edges' faces
+        std::uint32_t skip;     ///< the first node after its subtree
+        std::uint32_t first;    ///< a leaf's first slot of tree.prim_indices
+        std::uint16_t count;    ///< a leaf's slots; 0 for an inner node
+        std::uint8_t flags;     ///< what lines its triangles can give
     };
-    std::vector<Node> nodes;
+    std::vector<WalkNode> walk;
+    std::vector<BBox> walk_box;           ///< per walk node: its box (for the view volume)
+    std::vector<Cone> walk_smooth;        ///< per walk node: the cone of its smooth normals
     std::vector<PairCrossing> crossings;  ///< within the mesh (usable triangles), by (t, u)
 
     [[nodiscard]] bool usable(std::uint32_t t) const { return normal[t] != Vec3f(0.0f); }
@@ -335,15 +345,18 @@ std::shared_ptr<const MeshLines> make_mesh_lines(std::shared_ptr<const TriangleM
             sorted[fill[slot_of[owner[e]]]++] = ml.edges[e];
         ml.edges.swap(sorted);
     }
-    ml.nodes.resize(ml.tree.nodes.size());
+    struct Node {
+        Cone poly, smooth;
+        bool candidates = false, fixed = false, smooth_triangles = false;
+    };
+    std::vector<Node> nodes(ml.tree.nodes.size());
     std::vector<Vec3f> poly, smooth;
     for (std::size_t i = ml.tree.nodes.size(); i-- > 0;) {  // children after parents
         const BvhNode& b = ml.tree.nodes[i];
-        MeshLines::Node& node = ml.nodes[i];
-        node.sphere = sphere_of(b.bounds);
+        Node& node = nodes[i];
         if (!b.is_leaf()) {
-            const MeshLines::Node& l = ml.nodes[b.first];
-            const MeshLines::Node& r = ml.nodes[b.first + 1];
+            const Node& l = nodes[b.first];
+            const Node& r = nodes[b.first + 1];
             node.candidates = l.candidates || r.candidates;
             node.fixed = l.fixed || r.fixed;
             node.smooth_triangles = l.smooth_triangles || r.smooth_triangles;
@@ -380,6 +393,31 @@ std::shared_ptr<const MeshLines> make_mesh_lines(std::shared_ptr<const TriangleM
         }
         node.poly = cone_of(poly);
         node.smooth = zero_normal ? Cone{} : cone_of(smooth);
+    }
+    // Flattened depth first, left to right: (tree node, or walk node to close, and which).
+    std::vector<std::pair<std::uint32_t, bool>> todo;
+    if (!ml.tree.nodes.empty()) todo.push_back({0u, false});
+    while (!todo.empty()) {
+        const auto [i, close] = todo.back();
+        todo.pop_back();
+        if (close) {
+            ml.walk[i].skip = static_cast<std::uint32_t>(ml.walk.size());
+            continue;
+        }
+        const BvhNode& b = ml.tree.nodes[i];
+        const Node& node = nodes[i];
+        const auto at = static_cast<std::uint32_t>(ml.walk.size());
+        ml.walk.push_back(
+            {sphere_of(b.bounds), node.poly, at + 1, b.first, static_cast<std::uint16_t>(b.count),
+             static_cast<std::uint8_t>((node.candidates ? MeshLines::kHasCandidates : 0) |
+                                       (node.fixed ? MeshLines::kHasFixed : 0) |
+                                       (node.smooth_triangles ? MeshLines::kHasSmooth : 0))});
+        ml.walk_box.push_back(b.bounds);
+        ml.walk_smooth.push_back(node.smooth);
+        if (b.is_leaf()) continue;
+        todo.push_back({at, true});
+        todo.push_back({b.first + 1, false});
+        todo.push_back({b.first, false});
     }
 
     // The crossings within the mesh, among its usable triangles.
@@ -515,46 +553,49 @@ void instance_segments(const Placement& pl, const ViewVolume* volume,
         seg.p1 = m.point(q[1]);
         if (seg.p0 != seg.p1) smooth.push_back(seg);
     };
-    if (!ml.tree.nodes.empty()) {
-        // Depth first, left to right: the order of the leaves, whatever is skipped.
-        std::vector<std::pair<std::uint32_t, bool>> stack{{0u, volume == nullptr}};
-        while (!stack.empty()) {
-            const auto [i, inside] = stack.back();
-            stack.pop_back();
-            const BvhNode& b = ml.tree.nodes[i];
-            const MeshLines::Node& node = ml.nodes[i];
-            bool all_inside = inside;
-            if (!inside) {
-                const BBox world = grown(m.box(b.bounds));
-                if (!volume->may_see(world)) continue;
-                all_inside = volume->sees_all(world);
-            }
-            const bool cones = options.cone_culling;
-            const int poly =
-                cones && node.candidates ? facing_bound(node.poly, node.sphere, eye) : 0;
-            const int around =
-                cones && node.smooth_triangles ? facing_bound(node.smooth, node.sphere, eye) : 0;
-            const bool edges = node.fixed || (node.candidates && poly == 0);
-            const bool contours = node.smooth_triangles && around == 0;
-            if (!edges && !contours) continue;
-            if (!b.is_leaf()) {
-                stack.push_back({b.first + 1, all_inside});
-                stack.push_back({b.first, all_inside});
+    // Depth first, left to right: the order of the leaves, whatever is skipped. Nodes before
+    // `inside_end` lie inside the view volume (below a node that does).
+    const auto nodes = static_cast<std::uint32_t>(ml.walk.size());
+    std::uint32_t inside_end = volume == nullptr ? nodes : 0;
+    for (std::uint32_t i = 0; i < nodes;) {
+        const MeshLines::WalkNode& node = ml.walk[i];
+        if (i >= inside_end) {
+            const BBox world = grown(m.box(ml.walk_box[i]));
+            if (!volume->may_see(world)) {
+                i = node.skip;
                 continue;
             }
-            for (std::uint32_t k = b.first; k < b.first + b.count; ++k) {
-                const std::uint32_t t = ml.tree.prim_indices[k];
-                if (edges)
-                    for (std::uint32_t e = ml.owned_first[k]; e < ml.owned_first[k + 1]; ++e) {
-                        const MeshLines::Edge& edge = ml.edges[e];
-                        // No silhouette in the node: an edge that is only a candidate is not
-                        // a line.
-                        if (poly != 0 && edge.flags == MeshLines::kCandidate) continue;
-                        edge_segment(edge);
-                    }
-                if (contours && ml.usable(t) && ml.corner_normals[t]) contour(t);
-            }
+            if (volume->sees_all(world)) inside_end = node.skip;
         }
+        const bool cones = options.cone_culling;
+        const bool candidates = node.flags & MeshLines::kHasCandidates;
+        const bool smooth_triangles = node.flags & MeshLines::kHasSmooth;
+        const int poly = cones && candidates ? facing_bound(node.poly, node.sphere, eye) : 0;
+        const int around =
+            cones && smooth_triangles ? facing_bound(ml.walk_smooth[i], node.sphere, eye) : 0;
+        const bool edges = (node.flags & MeshLines::kHasFixed) || (candidates && poly == 0);
+        const bool contours = smooth_triangles && around == 0;
+        if (!edges && !contours) {
+            i = node.skip;
+            continue;
+        }
+        if (node.count == 0) {
+            ++i;
+            continue;
+        }
+        for (std::uint32_t k = node.first; k < node.first + node.count; ++k) {
+            const std::uint32_t t = ml.tree.prim_indices[k];
+            if (edges)
+                for (std::uint32_t e = ml.owned_first[k]; e < ml.owned_first[k + 1]; ++e) {
+                    const MeshLines::Edge& edge = ml.edges[e];
+                    // No silhouette in the node: an edge that is only a candidate is not a
+                    // line.
+                    if (poly != 0 && edge.flags == MeshLines::kCandidate) continue;
+                    edge_segment(edge);
+                }
+            if (contours && ml.usable(t) && ml.corner_normals[t]) contour(t);
+        }
+        i = node.skip;
     }
     // Mesh edges in the mesh's edge order (as the flattened scene lists them: chaining starts
     // strokes in segment order), whichever parts of the hierarchy were skipped; then the smooth
