@@ -197,8 +197,33 @@ TEST(Instances, RaysFindTheClosestHitInObjectSpace) {
     EXPECT_GT(hits, 500);
 }
 
+TEST(Instances, FarInstancesUnderFewRaysAreTracedRayByRayWithTheSameHits) {
+    // Seen from far away each teapot (6,320 triangles) covers fewer rays than it has blocks of
+    // four triangles, so a tile's rays go through it one by one; near, as groups. Both must
+    // find what single rays and brute force find, ties included (coinciding instances).
+    const Soup teapot = from_obj("teapot.obj");
+    Soup pot = teapot;
+    for (Vec3f& p : pot.positions) p = p * 0.2f;
+    const auto a = accel_of(pot);
+    std::vector<Placed> placed = crowd(pot, pot, 40, 5);
+    placed.push_back(placed[7]);  // a twin: ties go to the lower instance
+    TriangleAccel accel;
+    accel.set_instances(accel_instances(placed, a, pot, a));
+    const float inf = std::numeric_limits<float>::infinity();
+    int hits = 0;
+    check_view(accel, nullptr, placed,
+               CameraSpec{Vec3f(40, 25, 45), Vec3f(0, 0, 0), Vec3f(0, 1, 0)}, 96, 64, 29, inf,
+               hits);
+    EXPECT_GT(hits, 300);
+    check_view(accel, nullptr, placed,
+               CameraSpec{Vec3f(2, 1.5f, 2.5f), Vec3f(0, 0, 0), Vec3f(0, 1, 0)}, 64, 48, 31, inf,
+               hits);
+    EXPECT_GT(hits, 800);
+}
+
 TEST(Instances, WithoutOwnTrianglesAndAxisAlignedViews) {
-    // Rays along the axes in object space (zero direction components).
+    // Rays along the axes in object space make groups irregular there (zero components),
+    // which the tiles then trace ray by ray.
     const Soup teapot = from_obj("teapot.obj");
     Soup pot = teapot;
     for (Vec3f& p : pot.positions) p = p * 0.2f;

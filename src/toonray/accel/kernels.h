@@ -28,13 +28,18 @@ struct KernelTable {
     void (*intersect_tile)(const WideBvh& w, const Vec3f& origin, const Vec3f* dirs, int width,
                            int height, float tmax, Hit* hits, bool* found, TileEntry* stack,
                            std::uint64_t* stack1);
-    /// The first two through an instance level: `stack` has lv.tree.max_stack entries and
-    /// `bottom` lv.bottom_stack. (An instance level has no tile kernel: its rays are traced one
-    /// by one, see TriangleAccel::intersect_tile.)
+    /// The same three through an instance level: `stack` has lv.tree.max_stack entries and
+    /// `bottom` lv.bottom_stack (tiles: `stack` and `stack1` lv.tree.max_stack, `bottom` and
+    /// `bottom1` lv.bottom_stack).
     bool (*intersect1_instances)(const InstanceLevel& lv, const Ray& ray, Hit& hit,
                                  std::uint64_t* stack, std::uint64_t* bottom);
     bool (*occluded1_instances)(const InstanceLevel& lv, const Ray& ray, std::uint64_t* stack,
                                 std::uint64_t* bottom);
+    void (*intersect_tile_instances)(const InstanceLevel& lv, const Vec3f& origin,
+                                     const Vec3f* dirs, int width, int height, float tmax,
+                                     Hit* hits, bool* found, TileEntry* stack,
+                                     std::uint64_t* stack1, TileEntry* bottom,
+                                     std::uint64_t* bottom1);
 };
 
 const KernelTable& kernels_sse();

@@ -46,7 +46,8 @@ const KernelTable* kernels_avx2() {
                                    &avx2::occluded1,
                                    &avx2::intersect_tile,
                                    &avx2::intersect1_instances,
-                                   &avx2::occluded1_instances};
+                                   &avx2::occluded1_instances,
+                                   &avx2::intersect_tile_instances};
     return &table;
 #else
     return nullptr;

@@ -47,7 +47,8 @@ const KernelTable* kernels_avx512() {
                                    &avx512::occluded1,
                                    &avx512::intersect_tile,
                                    &avx512::intersect1_instances,
-                                   &avx512::occluded1_instances};
+                                   &avx512::occluded1_instances,
+                                   &avx512::intersect_tile_instances};
     return &table;
 #else
     return nullptr;

@@ -23,7 +23,8 @@ const KernelTable& kernels_sse() {
                                    &sse::occluded1,
                                    &sse::intersect_tile,
                                    &sse::intersect1_instances,
-                                   &sse::occluded1_instances};
+                                   &sse::occluded1_instances,
+                                   &sse::intersect_tile_instances};
     return table;
 }
 

@@ -321,20 +321,6 @@ bool TriangleAccel::occluded(const Ray& ray) const {
 void TriangleAccel::intersect_tile(const Vec3f& origin, const Vec3f* dirs, int width, int height,
                                    Hit* hits, bool* found, float tmax) const {
     if (width <= 0 || height <= 0) return;
-    if (level_) {
-        // Through instances, ray by ray. A tile's rays are coherent over the top level but
-        // not inside a far instance, where many triangles lie under one pixel: a tile of
-        // groups there tested most of an instance's leaves to find a few hits, and took each
-        // record's groups into its object space as well (a 10,000-instance crowd at one sample
-        // a pixel: 49M leaf visits against 1M for single rays, and ten times the time).
-        Stack<std::uint64_t> top(level_->tree.max_stack), bottom(level_->bottom_stack);
-        for (int i = 0; i < width * height; ++i) {
-            hits[i] = Hit{};
-            found[i] = kernels().intersect1_instances(*level_, Ray{origin, dirs[i], tmax}, hits[i],
-                                                      top.data(), bottom.data());
-        }
-        return;
-    }
     if (width <= kTileSize && height > kTileSize) {
         // A narrow grid (a list of rays a few wide): its tiles are runs of whole rows, which
         // lie next to each other in memory already.
@@ -362,6 +348,15 @@ void TriangleAccel::intersect_tile(const Vec3f& origin, const Vec3f* dirs, int w
                         found[(y0 + y) * width + x0 + x] = ff[y * w + x];
                     }
             }
+        return;
+    }
+    if (level_) {
+        const std::size_t top = level_->tree.max_stack, bottom = level_->bottom_stack;
+        Stack<accel::TileEntry> stack(top), stack_b(bottom);
+        Stack<std::uint64_t> stack1(top), stack1_b(bottom);
+        kernels().intersect_tile_instances(*level_, origin, dirs, width, height, tmax, hits, found,
+                                           stack.data(), stack1.data(), stack_b.data(),
+                                           stack1_b.data());
         return;
     }
     const accel::WideBvh& wide = *wide_;

@@ -219,7 +219,11 @@ void WideBvh::build(const Bvh& bvh, std::span<const float> leaf_areas,
     root = kEmptyChild;
     depth = 0;
     max_stack = 8;
+    centre = Vec3f(0.0f);
+    radius = 0.0f;
     if (bvh.nodes.empty()) return;
+    centre = bvh.nodes[0].bounds.center();
+    radius = 0.5f * length(bvh.nodes[0].bounds.extent());
 
     std::size_t leaves = 0;
     for (const BvhNode& n : bvh.nodes) leaves += n.is_leaf();

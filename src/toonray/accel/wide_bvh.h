@@ -58,6 +58,10 @@ struct WideBvh {
     std::uint32_t root = kEmptyChild;  ///< inner node 0, or a single leaf, or empty
     int depth = 0;                     ///< wide levels (a leaf root counts 0)
     std::size_t max_stack = 0;         ///< stack entries traversal can need
+    /// The sphere around the triangles' box (build()), which tells the instance tiles how
+    /// many rays an instance of this tree covers.
+    Vec3f centre{0.0f};
+    float radius = 0.0f;
 
     /// SAH weights of the collapse: a wide node visit, and a leaf's test per block of 4.
     struct CollapseCosts {
