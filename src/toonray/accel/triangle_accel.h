@@ -85,7 +85,7 @@ public:
     /// rays should be coherent (a pinhole camera's): each kTileSize x kTileSize tile is
     /// traversed once, as a frustum of 4 x 2 ray packets (larger grids are cut into tiles).
     /// With instances, the groups that reach an instance go through its tree as packets only
-    /// when they are dense for it (see kTileTrianglesPerRay in kernels.inl).
+    /// when they are dense for it (dense_for in kernels.inl).
     void intersect_tile(const Vec3f& origin, const Vec3f* dirs, int width, int height, Hit* hits,
                         bool* found, float tmax = std::numeric_limits<float>::infinity()) const;
 
