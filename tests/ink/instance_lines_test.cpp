@@ -7,7 +7,9 @@
 #include <algorithm>
 #include <bit>
 #include <cstring>
+#include <cmath>
 #include <map>
+#include <memory>
 #include <set>
 #include <tuple>
 #include <vector>
@@ -92,6 +94,47 @@ TEST(InstanceLines, CullingChangesNoSegment) {
         }
     }
     EXPECT_GT(culled_views, 5);  // the test saw culling at work
+}
+
+TEST(InstanceLines, ConesChangeNoSegmentCloseToASurface) {
+    // A wavy sheet seen from just above it, at grazing angles: silhouettes on the crests near
+    // the eye and far away, from nodes at every distance. (The box's term of the bound, r, is
+    // not what this checks: on a sheet a node's points lie near its tangent plane, so n . (p - c)
+    // stays far below r, and the bound without r drops no line here either.)
+    Scene scene;
+    scene.materials.emplace_back("sheet");
+    auto sheet = std::make_shared<TriangleMesh>();
+    constexpr int kCells = 96;
+    auto id = [](int i, int k) { return static_cast<std::uint32_t>(i * (kCells + 1) + k); };
+    for (int i = 0; i <= kCells; ++i)
+        for (int k = 0; k <= kCells; ++k) {
+            const float x = 12.0f * static_cast<float>(i) / kCells - 6.0f;
+            const float z = 12.0f * static_cast<float>(k) / kCells - 6.0f;
+            sheet->positions.emplace_back(x, 0.25f * std::sin(1.7f * x) * std::cos(1.3f * z), z);
+        }
+    for (int i = 0; i < kCells; ++i)
+        for (int k = 0; k < kCells; ++k) {
+            sheet->add_triangle({id(i, k), id(i, k + 1), id(i + 1, k + 1)}, 0, 0);
+            sheet->add_triangle({id(i, k), id(i + 1, k + 1), id(i + 1, k)}, 0, 0);
+        }
+    scene.add_instance(scene.add_mesh(sheet),
+                       test_support::placed(0, 1, 0, 0.3, Vec3f(1.0f), Vec3f(0.5f, 0.0f, -0.2f)),
+                       "sheet");
+    const TriangleAccel accel = build_scene_accel(scene);
+    InstanceLineCache a, b;
+    int views = 0;
+    for (const Vec3f& eye : {Vec3f(-5.5f, 0.3f, -5.0f), Vec3f(0.2f, 0.28f, 0.1f),
+                             Vec3f(2.9f, 0.33f, -1.7f), Vec3f(-1.3f, 0.6f, 2.2f)})
+        for (const Vec3f& target : {Vec3f(6, 0, 6), Vec3f(-6, -0.5f, 4), Vec3f(0, -1, 0)}) {
+            const CameraSpec camera = test_support::looking_at(eye, target);
+            const auto with_cones = instance_lines(scene, accel, camera, a);
+            const auto without = instance_lines(scene, accel, camera, b, {false, true});
+            ASSERT_EQ(with_cones.size(), without.size());
+            for (std::size_t i = 0; i < with_cones.size(); ++i)
+                ASSERT_TRUE(same_segment(with_cones[i], without[i])) << i;
+            views += !with_cones.empty();
+        }
+    EXPECT_GE(views, 10);  // the views have lines to keep
 }
 
 // The flattened scene's segments of the instances' mesh edges (its own triangles are the
