@@ -688,20 +688,50 @@ void own_triangles_in(const Scene& scene, const Bvh& bvh, const BBox& region,
 }
 
 // Every crossing between a triangle of `a` and one of `b` (by their world corners; pairs that
-// share a corner position touch there and are not tested), t from a and u from b.
-std::vector<PairCrossing> cross(const std::vector<WorldTriangle>& a,
-                                const std::vector<WorldTriangle>& b) {
+// share a corner position touch there and are not tested), t from a and u from b, by (t, u).
+// Both lists are sorted by their boxes' low x and swept: each pair whose boxes overlap along x
+// is met once, from the one that starts first, rather than every pair of the two lists (two
+// crowd instances that overlap share thousands of triangles in their boxes' common part).
+// (Boxes with a NaN x, which no order holds, are tested against the whole other list.)
+std::vector<PairCrossing> cross(std::vector<WorldTriangle>& a, std::vector<WorldTriangle>& b) {
+    auto ordered = [](const WorldTriangle& x) {
+        return !std::isnan(x.box.lo.x) && !std::isnan(x.box.hi.x);
+    };
+    auto by_low_x = [](const WorldTriangle& x, const WorldTriangle& y) {
+        return x.box.lo.x < y.box.lo.x;
+    };
+    const auto a_end =
+        static_cast<std::size_t>(std::partition(a.begin(), a.end(), ordered) - a.begin());
+    const auto b_end =
+        static_cast<std::size_t>(std::partition(b.begin(), b.end(), ordered) - b.begin());
+    std::sort(a.begin(), a.begin() + static_cast<std::ptrdiff_t>(a_end), by_low_x);
+    std::sort(b.begin(), b.begin() + static_cast<std::ptrdiff_t>(b_end), by_low_x);
     std::vector<PairCrossing> out;
-    for (const WorldTriangle& x : a)
-        for (const WorldTriangle& y : b) {
-            if (!overlap(x.box, y.box)) continue;
-            bool shared = false;
-            for (const Vec3f& p : x.p)
-                for (const Vec3f& q : y.p) shared = shared || same_point(p, q);
-            if (shared) continue;
-            PairCrossing pc{x.t, y.t, {}};
-            if (intersect_triangles(x.p, y.p, pc.crossing)) out.push_back(pc);
+    auto test = [&](const WorldTriangle& x, const WorldTriangle& y) {
+        if (!overlap(x.box, y.box)) return;
+        bool shared = false;
+        for (const Vec3f& p : x.p)
+            for (const Vec3f& q : y.p) shared = shared || same_point(p, q);
+        if (shared) return;
+        PairCrossing pc{x.t, y.t, {}};
+        if (intersect_triangles(x.p, y.p, pc.crossing)) out.push_back(pc);
+    };
+    std::size_t i = 0, j = 0;
+    while (i < a_end && j < b_end) {
+        if (a[i].box.lo.x <= b[j].box.lo.x) {
+            for (std::size_t k = j; k < b_end && b[k].box.lo.x <= a[i].box.hi.x; ++k)
+                test(a[i], b[k]);
+            ++i;
+        } else {
+            for (std::size_t k = i; k < a_end && a[k].box.lo.x <= b[j].box.hi.x; ++k)
+                test(a[k], b[j]);
+            ++j;
         }
+    }
+    for (std::size_t k = a_end; k < a.size(); ++k)
+        for (const WorldTriangle& y : b) test(a[k], y);
+    for (std::size_t k = b_end; k < b.size(); ++k)
+        for (std::size_t m = 0; m < a_end; ++m) test(a[m], b[k]);
     std::sort(out.begin(), out.end(), [](const PairCrossing& x, const PairCrossing& y) {
         return std::tie(x.t, x.u) < std::tie(y.t, y.u);
     });
