@@ -92,12 +92,29 @@ EndGroups group_ends(const std::vector<Link>& links) {
         while (table_size < 2 * count) table_size *= 2;
         std::vector<std::uint32_t> table(table_size, kNoIndex);
         std::vector<std::uint32_t> first_end;
+        auto home = [&](const EndpointKey& key) {
+            return hash_words(key.a ^ ((key.instance + 1) * 0x9e3779b9u), key.b,
+                              key.c ^ ((key.c_instance + 1) * 0x85ebca6bu)) &
+                   (table_size - 1);
+        };
+        // Each end's slot is a cache miss on a crowd's table (tens of megabytes): the slots
+        // of the ends kAhead further on are computed and fetched ahead.
+        constexpr std::size_t kAhead = 16;
+        std::size_t ahead[kAhead];
+        for (std::size_t e = 0; e < std::min(kAhead, count); ++e) {
+            ahead[e] = has_key(key_of(e)) ? home(key_of(e)) : 0;
+            __builtin_prefetch(&table[ahead[e]]);
+        }
         for (std::size_t e = 0; e < count; ++e) {
+            std::size_t slot = ahead[e % kAhead];
+            if (e + kAhead < count) {
+                const EndpointKey& next = key_of(e + kAhead);
+                const std::size_t next_slot = has_key(next) ? home(next) : 0;
+                ahead[e % kAhead] = next_slot;
+                __builtin_prefetch(&table[next_slot]);
+            }
             const EndpointKey& key = key_of(e);
             if (!has_key(key)) continue;
-            std::size_t slot = hash_words(key.a ^ ((key.instance + 1) * 0x9e3779b9u), key.b,
-                                          key.c ^ ((key.c_instance + 1) * 0x85ebca6bu)) &
-                               (table_size - 1);
             while (table[slot] != kNoIndex && key_of(first_end[table[slot]]) != key)
                 slot = (slot + 1) & (table_size - 1);
             if (table[slot] == kNoIndex) {
