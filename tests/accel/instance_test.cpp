@@ -105,16 +105,24 @@ std::uint32_t bits(float f) {
 std::vector<Placed> crowd(const Soup& a, const Soup& b, int n, unsigned seed) {
     std::mt19937 rng(seed);
     std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+    // The draws one statement each: the order in which a call's arguments are evaluated is
+    // left open (GCC takes them right to left on x86-64, left to right on aarch64), and the
+    // crowd must be the same on every CPU.
+    auto draw3 = [&] {
+        const float x = u(rng), y = u(rng), z = u(rng);
+        return Vec3f(x, y, z);
+    };
     std::vector<Placed> out;
     const int side = static_cast<int>(std::ceil(std::sqrt(double(n))));
     for (int i = 0; i < n; ++i) {
-        const Vec3f axis(u(rng), u(rng) + 2.0f, u(rng));
-        Vec3f scale(0.6f + 0.3f * u(rng), 0.6f + 0.3f * u(rng), 0.6f + 0.3f * u(rng));
+        const Vec3f axis = draw3() + Vec3f(0.0f, 2.0f, 0.0f);
+        Vec3f scale = Vec3f(0.6f) + draw3() * 0.3f;
         if (i % 5 == 3) scale.x = -scale.x;  // mirrored
-        const Vec3f move(1.2f * static_cast<float>(i % side - side / 2) + 0.3f * u(rng),
-                         0.3f * u(rng),
-                         1.2f * static_cast<float>(i / side - side / 2) + 0.3f * u(rng));
-        out.push_back({i % 3 == 1 ? &b : &a, placement(axis, 3.0 * u(rng), scale, move)});
+        const Vec3f jitter = draw3() * 0.3f;
+        const Vec3f move(1.2f * static_cast<float>(i % side - side / 2) + jitter.x, jitter.y,
+                         1.2f * static_cast<float>(i / side - side / 2) + jitter.z);
+        const double angle = 3.0 * u(rng);
+        out.push_back({i % 3 == 1 ? &b : &a, placement(axis, angle, scale, move)});
     }
     return out;
 }
@@ -218,7 +226,7 @@ TEST(Instances, FarInstancesUnderFewRaysAreTracedRayByRayWithTheSameHits) {
     check_view(accel, nullptr, placed,
                CameraSpec{Vec3f(2, 1.5f, 2.5f), Vec3f(0, 0, 0), Vec3f(0, 1, 0)}, 64, 48, 31, inf,
                hits);
-    EXPECT_GT(hits, 800);
+    EXPECT_GT(hits, 500);
 }
 
 TEST(Instances, WithoutOwnTrianglesAndAxisAlignedViews) {
