@@ -1,6 +1,6 @@
-// Ink lines on instances: culling by normal cones and by the view changes no segment; the
-// mesh edges are those of the flattened scene; intersection lines between instances; strokes
-// styled by their instance's object; per-mesh work kept across frames.
+// Ink lines on instances: culling by the plane tree, normal cones and the view changes no
+// segment; the mesh edges are those of the flattened scene; intersection lines between
+// instances; strokes styled by their instance's object; per-mesh work kept across frames.
 
 #include <gtest/gtest.h>
 
@@ -10,6 +10,7 @@
 #include <cmath>
 #include <map>
 #include <memory>
+#include <numbers>
 #include <set>
 #include <tuple>
 #include <vector>
@@ -98,9 +99,8 @@ TEST(InstanceLines, CullingChangesNoSegment) {
 
 TEST(InstanceLines, ConesChangeNoSegmentCloseToASurface) {
     // A wavy sheet seen from just above it, at grazing angles: silhouettes on the crests near
-    // the eye and far away, from nodes at every distance. (The box's term of the bound, r, is
-    // not what this checks: on a sheet a node's points lie near its tangent plane, so n . (p - c)
-    // stays far below r, and the bound without r drops no line here either.)
+    // the eye and far away, from the plane tree's nodes at every distance (the sheet has no
+    // smooth triangles, so no cone is tested).
     Scene scene;
     scene.materials.emplace_back("sheet");
     auto sheet = std::make_shared<TriangleMesh>();
@@ -135,6 +135,43 @@ TEST(InstanceLines, ConesChangeNoSegmentCloseToASurface) {
             views += !with_cones.empty();
         }
     EXPECT_GE(views, 10);  // the views have lines to keep
+}
+
+TEST(InstanceLines, AnEyeInAFacesPlaneKeepsTheSilhouetteBesideIt) {
+    // A flat strip (in y = 0) bent up by 20 degrees along x = 0. From an eye in the flat part's
+    // plane, n . (eye - p) is exactly 0 for the flat faces, which do not face the eye, and
+    // positive for the bent ones; from an eye below the strip and a hair (1e-4) above the bent
+    // part's plane, it is negative for the flat faces and just positive for the bent ones. The
+    // bend is a silhouette from both, and the plane tree's bound for the node holding it is 0
+    // at one end: culling must keep it (testing the low end against -margin instead of
+    // +margin drops the first, the high end against +margin instead of -margin the second).
+    Scene scene;
+    scene.materials.emplace_back("strip");
+    auto strip = std::make_shared<TriangleMesh>();
+    const float slope = std::tan(20.0f * std::numbers::pi_v<float> / 180.0f);
+    for (const float x : {-2.0f, 0.0f, 2.0f})
+        for (const float z : {-1.0f, 1.0f})
+            strip->positions.emplace_back(x, x > 0 ? x * slope : 0, z);
+    for (std::uint32_t i = 0; i < 2; ++i) {
+        const std::uint32_t a = 2 * i, b = 2 * i + 1, c = 2 * i + 3, d = 2 * i + 2;
+        strip->add_triangle({a, b, c}, 0, 0);
+        strip->add_triangle({a, c, d}, 0, 0);
+    }
+    scene.add_instance(scene.add_mesh(strip), Affine3{}, "strip");
+    const TriangleAccel accel = build_scene_accel(scene);
+    for (const Vec3f& eye : {Vec3f(-6, 0, 0.3f), Vec3f(-6, -6 * slope + 1e-4f, 0.3f)}) {
+        const CameraSpec camera = test_support::looking_at(eye, Vec3f(1, 0.2f, 0));
+        InstanceLineCache a, b;
+        const auto with_cones = instance_lines(scene, accel, camera, a);
+        const auto without = instance_lines(scene, accel, camera, b, {false, true});
+        ASSERT_EQ(with_cones.size(), without.size());
+        for (std::size_t i = 0; i < with_cones.size(); ++i)
+            ASSERT_TRUE(same_segment(with_cones[i], without[i])) << i;
+        const auto bend = std::find_if(with_cones.begin(), with_cones.end(), [](const auto& s) {
+            return s.type == EdgeType::Silhouette && s.p0.x == 0.0f && s.p1.x == 0.0f;
+        });
+        EXPECT_NE(bend, with_cones.end()) << eye.y;
+    }
 }
 
 // The flattened scene's segments of the instances' mesh edges (its own triangles are the

@@ -204,27 +204,40 @@ struct MeshLines {
         std::uint8_t flags;
         std::uint32_t order;  ///< in the mesh's edge order (by welded ends)
     };
-    std::vector<Edge> edges;
-    /// Per slot k of the tree's leaves (tree.prim_indices[k]): the edges its triangle owns,
-    /// owned_first[k] .. owned_first[k + 1] - 1.
-    std::vector<std::uint32_t> owned_first;
-    Bvh tree;  ///< over the triangles
-    // The tree as each instance's walk reads it: in depth-first order, a node's subtree being
-    // the nodes from it up to `skip`, so that a walk only moves forward through memory, one
-    // node per 52 bytes. (Every instance walks it again; a walk that jumped between the
-    // tree's nodes and a second array of cones stalled on both.)
-    enum : std::uint8_t { kHasCandidates = 1, kHasFixed = 2, kHasSmooth = 4 };
+    /// The edges every eye tests: creases, material boundaries and borders (lines from every
+    /// eye), and the candidates whose planes are not finite (which no box bounds).
+    std::vector<Edge> tested_edges;
+    // The edges that are silhouette candidates and nothing else, in a tree over their faces'
+    // planes. Face f is seen from the front from eye E when n . (E - p) > 0 for a point p of
+    // its plane: when the 4D point (n, -n . p) lies on the positive side of the hyperplane
+    // through the origin with normal (E, 1) (the duality of Hertzmann and Zorin 2000). An edge
+    // is a silhouette when its faces' points lie on both sides, so a node whose 4D box lies on
+    // one side holds none. The tree is built over these points, not over positions: on a
+    // bumpy mesh neighbouring faces turn too many ways for a cone around them to prove
+    // anything, while faces that turn alike, wherever they are, cluster here. Depth-first
+    // order with skip indices, so that every instance's walk only moves forward.
+    struct PlaneNode {
+        float lo[4], hi[4];          ///< the box of its edges' two points each
+        std::uint32_t skip;          ///< the first node after its subtree
+        std::uint32_t first, count;  ///< a leaf's edges in plane_edges; count 0 inner
+    };
+    std::vector<PlaneNode> plane_tree;
+    std::vector<Edge> plane_edges;  ///< the candidate-only edges, in the tree's leaf order
+    float plane_reach = 0;          ///< the largest |x| + |y| + |z| of their first ends
+    Bvh tree;                       ///< over the triangles
+    // The smooth contours' hierarchy as each instance's walk reads it (empty when the mesh has
+    // no smooth triangles): the tree's nodes in depth-first order, a node's subtree being the
+    // nodes from it up to `skip`, so that a walk only moves forward through memory.
     struct WalkNode {
         BoundingSphere sphere;  ///< around the node's box
-        Cone poly;              ///< around the normals of its candidate edges' faces
+        Cone smooth;            ///< around the unit corner normals of its smooth triangles
         std::uint32_t skip;     ///< the first node after its subtree
         std::uint32_t first;    ///< a leaf's first slot of tree.prim_indices
         std::uint16_t count;    ///< a leaf's slots; 0 for an inner node
-        std::uint8_t flags;     ///< what lines its triangles can give
+        bool has_smooth;        ///< whether its triangles can give smooth contours
     };
     std::vector<WalkNode> walk;
     std::vector<BBox> walk_box;           ///< per walk node: its box (for the view volume)
-    std::vector<Cone> walk_smooth;        ///< per walk node: the cone of its smooth normals
     std::vector<PairCrossing> crossings;  ///< within the mesh (usable triangles), by (t, u)
 
     [[nodiscard]] bool usable(std::uint32_t t) const { return normal[t] != Vec3f(0.0f); }
@@ -243,6 +256,85 @@ Vec3f face_normal(const std::array<Vec3f, 3>& p) {
     const float len = length(n);
     if (!(len > 0.0f) || !std::isfinite(len)) return Vec3f(0.0f);
     return n / len;
+}
+
+// A face of a candidate edge as a point of 4D space: its normal and its plane's offset.
+std::array<float, 4> plane_point(const Vec3f& n, const Vec3f& p) {
+    return {n.x, n.y, n.z, -dot(n, p)};
+}
+
+// Splits `edges` (in edge order) into MeshLines::tested_edges and the plane tree: median
+// splits of the edges' 4D centres on their widest axis, down to leaves of at most 8 edges (4
+// and 16 measured the same on the crowd of performance.md).
+void build_plane_tree(MeshLines& ml, std::span<const MeshLines::Edge> edges) {
+    constexpr std::uint32_t kLeafEdges = 8;
+    std::vector<const MeshLines::Edge*> candidates;
+    for (const MeshLines::Edge& e : edges) {
+        bool finite = true;
+        for (const Vec3f& n : {e.n0, e.n1})
+            for (const float x : plane_point(n, e.p0)) finite = finite && std::isfinite(x);
+        if (e.flags == MeshLines::kCandidate && finite) candidates.push_back(&e);
+        else ml.tested_edges.push_back(e);
+    }
+    const std::size_t n = candidates.size();
+    std::vector<std::array<float, 4>> lo(n), hi(n), centre(n);
+    float reach = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+        const MeshLines::Edge& e = *candidates[i];
+        reach = std::max(reach, std::abs(e.p0.x) + std::abs(e.p0.y) + std::abs(e.p0.z));
+        const auto a = plane_point(e.n0, e.p0), b = plane_point(e.n1, e.p0);
+        for (int k = 0; k < 4; ++k) {
+            lo[i][k] = std::min(a[k], b[k]);
+            hi[i][k] = std::max(a[k], b[k]);
+            centre[i][k] = 0.5f * a[k] + 0.5f * b[k];
+        }
+    }
+    ml.plane_reach = reach;
+    // Offsets measured in the mesh's size, as normals are in units: a split then weighs a turn
+    // of the faces and a move of their planes alike.
+    const float offset_scale = reach > 0 && std::isfinite(reach) ? 1.0f / reach : 1.0f;
+    for (auto& c : centre) c[3] *= offset_scale;
+    std::vector<std::uint32_t> order(n);
+    for (std::uint32_t i = 0; i < n; ++i) order[i] = i;
+    ml.plane_edges.reserve(n);
+    auto build = [&](auto&& self, std::uint32_t begin, std::uint32_t end) -> void {
+        const auto at = static_cast<std::uint32_t>(ml.plane_tree.size());
+        MeshLines::PlaneNode node{};
+        std::array<float, 4> low, high;
+        for (int k = 0; k < 4; ++k) {
+            node.lo[k] = low[k] = std::numeric_limits<float>::infinity();
+            node.hi[k] = high[k] = -std::numeric_limits<float>::infinity();
+        }
+        for (std::uint32_t i = begin; i < end; ++i)
+            for (int k = 0; k < 4; ++k) {
+                const std::uint32_t e = order[i];
+                node.lo[k] = std::min(node.lo[k], lo[e][k]);
+                node.hi[k] = std::max(node.hi[k], hi[e][k]);
+                low[k] = std::min(low[k], centre[e][k]);
+                high[k] = std::max(high[k], centre[e][k]);
+            }
+        ml.plane_tree.push_back(node);
+        if (end - begin <= kLeafEdges) {
+            ml.plane_tree[at].first = static_cast<std::uint32_t>(ml.plane_edges.size());
+            ml.plane_tree[at].count = end - begin;
+            ml.plane_tree[at].skip = at + 1;
+            for (std::uint32_t i = begin; i < end; ++i)
+                ml.plane_edges.push_back(*candidates[order[i]]);
+            return;
+        }
+        int axis = 0;
+        for (int k = 1; k < 4; ++k)
+            if (high[k] - low[k] > high[axis] - low[axis]) axis = k;
+        const std::uint32_t mid = begin + (end - begin) / 2;
+        std::nth_element(order.begin() + begin, order.begin() + mid, order.begin() + end,
+                         [&](std::uint32_t x, std::uint32_t y) {
+                             return std::tie(centre[x][axis], x) < std::tie(centre[y][axis], y);
+                         });
+        self(self, begin, mid);
+        self(self, mid, end);
+        ml.plane_tree[at].skip = static_cast<std::uint32_t>(ml.plane_tree.size());
+    };
+    if (n > 0) build(build, 0, static_cast<std::uint32_t>(n));
 }
 
 std::shared_ptr<const MeshLines> make_mesh_lines(std::shared_ptr<const TriangleMesh> source,
@@ -294,7 +386,7 @@ std::shared_ptr<const MeshLines> make_mesh_lines(std::shared_ptr<const TriangleM
         return corner_normal(s0.tri(), lo) == corner_normal(s1.tri(), lo) &&
                corner_normal(s0.tri(), s0.hi) == corner_normal(s1.tri(), s1.hi);
     };
-    std::vector<std::uint32_t> owner;
+    std::vector<MeshLines::Edge> edges;
     topology.for_each_edge([&](std::uint32_t i, std::uint32_t j, std::uint32_t lo) {
         const Side& s0 = topology.sides[i];
         MeshLines::Edge edge{lo,
@@ -305,7 +397,7 @@ std::shared_ptr<const MeshLines> make_mesh_lines(std::shared_ptr<const TriangleM
                              Vec3f(0.0f),
                              Vec3f(0.0f),
                              0,
-                             static_cast<std::uint32_t>(ml.edges.size())};
+                             static_cast<std::uint32_t>(edges.size())};
         if (j - i != 2) {
             if (!settings.borders) return;
             edge.flags = MeshLines::kBorder;
@@ -322,64 +414,34 @@ std::shared_ptr<const MeshLines> make_mesh_lines(std::shared_ptr<const TriangleM
                 edge.flags |= MeshLines::kMaterial;
             if (!edge.flags) return;
         }
-        ml.edges.push_back(edge);
-        owner.push_back(s0.tri());
+        edges.push_back(edge);
     });
-    // The hierarchy: the triangles' BVH, each node with cones around the normals its lines are
-    // classified by.
+    build_plane_tree(ml, edges);
+    // The smooth contours' hierarchy: the triangles' BVH (which the crossings search too), each
+    // node with a cone around its smooth triangles' corner normals.
     ml.tree = Bvh::build(mesh.positions, mesh.tri_positions, Bvh::Config{}, nullptr);
-    // Edges by the slot of their owning triangle in the tree's leaves (a stable counting sort
-    // keeps edge order within a triangle; a triangle the tree does not hold goes last), so
-    // that a walk of the tree reads them in order: every instance walks it again, and by
-    // triangle the edges were read at random (a crowd's frame stalled on them).
-    std::vector<std::uint32_t> slot_of(n, static_cast<std::uint32_t>(n));
-    for (std::size_t k = 0; k < ml.tree.prim_indices.size(); ++k)
-        slot_of[ml.tree.prim_indices[k]] = static_cast<std::uint32_t>(k);
-    ml.owned_first.assign(n + 2, 0);
-    for (std::uint32_t t : owner) ++ml.owned_first[slot_of[t] + 1];
-    for (std::size_t k = 0; k <= n; ++k) ml.owned_first[k + 1] += ml.owned_first[k];
-    {
-        std::vector<MeshLines::Edge> sorted(ml.edges.size());
-        std::vector<std::uint32_t> fill(ml.owned_first.begin(), ml.owned_first.end() - 1);
-        for (std::size_t e = 0; e < ml.edges.size(); ++e)
-            sorted[fill[slot_of[owner[e]]]++] = ml.edges[e];
-        ml.edges.swap(sorted);
-    }
     struct Node {
-        Cone poly, smooth;
-        bool candidates = false, fixed = false, smooth_triangles = false;
+        Cone smooth;
+        bool smooth_triangles = false;
     };
     std::vector<Node> nodes(ml.tree.nodes.size());
-    std::vector<Vec3f> poly, smooth;
+    std::vector<Vec3f> smooth;
     for (std::size_t i = ml.tree.nodes.size(); i-- > 0;) {  // children after parents
         const BvhNode& b = ml.tree.nodes[i];
         Node& node = nodes[i];
         if (!b.is_leaf()) {
             const Node& l = nodes[b.first];
             const Node& r = nodes[b.first + 1];
-            node.candidates = l.candidates || r.candidates;
-            node.fixed = l.fixed || r.fixed;
             node.smooth_triangles = l.smooth_triangles || r.smooth_triangles;
-            node.poly = !l.candidates ? r.poly : (!r.candidates ? l.poly : merge(l.poly, r.poly));
             node.smooth = !l.smooth_triangles
                               ? r.smooth
                               : (!r.smooth_triangles ? l.smooth : merge(l.smooth, r.smooth));
             continue;
         }
-        poly.clear();
         smooth.clear();
         bool zero_normal = false;
         for (std::uint32_t k = b.first; k < b.first + b.count; ++k) {
             const std::uint32_t t = ml.tree.prim_indices[k];
-            for (std::uint32_t e = ml.owned_first[k]; e < ml.owned_first[k + 1]; ++e) {
-                const MeshLines::Edge& edge = ml.edges[e];
-                if (edge.flags & MeshLines::kCandidate) {
-                    node.candidates = true;
-                    poly.push_back(edge.n0);
-                    poly.push_back(edge.n1);
-                }
-                if (edge.flags & ~MeshLines::kCandidate) node.fixed = true;
-            }
             if (settings.silhouettes && settings.smooth_contours && usable[t] &&
                 ml.corner_normals[t]) {
                 node.smooth_triangles = true;
@@ -391,12 +453,11 @@ std::shared_ptr<const MeshLines> make_mesh_lines(std::shared_ptr<const TriangleM
                 }
             }
         }
-        node.poly = cone_of(poly);
         node.smooth = zero_normal ? Cone{} : cone_of(smooth);
     }
     // Flattened depth first, left to right: (tree node, or walk node to close, and which).
     std::vector<std::pair<std::uint32_t, bool>> todo;
-    if (!ml.tree.nodes.empty()) todo.push_back({0u, false});
+    if (!nodes.empty() && nodes[0].smooth_triangles) todo.push_back({0u, false});
     while (!todo.empty()) {
         const auto [i, close] = todo.back();
         todo.pop_back();
@@ -407,13 +468,9 @@ std::shared_ptr<const MeshLines> make_mesh_lines(std::shared_ptr<const TriangleM
         const BvhNode& b = ml.tree.nodes[i];
         const Node& node = nodes[i];
         const auto at = static_cast<std::uint32_t>(ml.walk.size());
-        ml.walk.push_back(
-            {sphere_of(b.bounds), node.poly, at + 1, b.first, static_cast<std::uint16_t>(b.count),
-             static_cast<std::uint8_t>((node.candidates ? MeshLines::kHasCandidates : 0) |
-                                       (node.fixed ? MeshLines::kHasFixed : 0) |
-                                       (node.smooth_triangles ? MeshLines::kHasSmooth : 0))});
+        ml.walk.push_back({sphere_of(b.bounds), node.smooth, at + 1, b.first,
+                           static_cast<std::uint16_t>(b.count), node.smooth_triangles});
         ml.walk_box.push_back(b.bounds);
-        ml.walk_smooth.push_back(node.smooth);
         if (b.is_leaf()) continue;
         todo.push_back({at, true});
         todo.push_back({b.first + 1, false});
@@ -553,8 +610,36 @@ void instance_segments(const Placement& pl, const ViewVolume* volume,
         seg.p1 = m.point(q[1]);
         if (seg.p0 != seg.p1) smooth.push_back(seg);
     };
-    // Depth first, left to right: the order of the leaves, whatever is skipped. Nodes before
-    // `inside_end` lie inside the view volume (below a node that does).
+    // The mesh edges: those every eye tests, then the candidates in the plane tree's nodes
+    // that the eye's hyperplane may cut. The bound of n . (E - p) over a node's box is within
+    // a few 2^-24 of |E| + |p| of the exact one, and so is the test of an edge: the margin
+    // covers both (and with an eye that is not finite, culls nothing). No node is culled by
+    // the view: an instance partly in it gives silhouettes that visibility clips away, and
+    // every other instance is in full view or skipped whole.
+    for (const MeshLines::Edge& e : ml.tested_edges) edge_segment(e);
+    const float margin =
+        1e-4f * (std::abs(eye.x) + std::abs(eye.y) + std::abs(eye.z) + ml.plane_reach);
+    const auto plane_nodes = static_cast<std::uint32_t>(ml.plane_tree.size());
+    for (std::uint32_t i = 0; i < plane_nodes;) {
+        const MeshLines::PlaneNode& node = ml.plane_tree[i];
+        if (options.cone_culling) {
+            float low = node.lo[3], high = node.hi[3];
+            for (int k = 0; k < 3; ++k) {
+                const float a = eye[k] * node.lo[k], b = eye[k] * node.hi[k];
+                low += std::min(a, b);
+                high += std::max(a, b);
+            }
+            if (low > margin || high < -margin) {
+                i = node.skip;
+                continue;
+            }
+        }
+        for (std::uint32_t e = node.first; e < node.first + node.count; ++e)
+            edge_segment(ml.plane_edges[e]);
+        ++i;
+    }
+    // The smooth contours: depth first, left to right (the order of the leaves, whatever is
+    // skipped). Nodes before `inside_end` lie inside the view volume (below a node that does).
     const auto nodes = static_cast<std::uint32_t>(ml.walk.size());
     std::uint32_t inside_end = volume == nullptr ? nodes : 0;
     for (std::uint32_t i = 0; i < nodes;) {
@@ -567,35 +652,16 @@ void instance_segments(const Placement& pl, const ViewVolume* volume,
             }
             if (volume->sees_all(world)) inside_end = node.skip;
         }
-        const bool cones = options.cone_culling;
-        const bool candidates = node.flags & MeshLines::kHasCandidates;
-        const bool smooth_triangles = node.flags & MeshLines::kHasSmooth;
-        const int poly = cones && candidates ? facing_bound(node.poly, node.sphere, eye) : 0;
-        const int around =
-            cones && smooth_triangles ? facing_bound(ml.walk_smooth[i], node.sphere, eye) : 0;
-        const bool edges = (node.flags & MeshLines::kHasFixed) || (candidates && poly == 0);
-        const bool contours = smooth_triangles && around == 0;
-        if (!edges && !contours) {
+        if (!node.has_smooth ||
+            (options.cone_culling && facing_bound(node.smooth, node.sphere, eye) != 0)) {
             i = node.skip;
-            continue;
-        }
-        if (node.count == 0) {
-            ++i;
             continue;
         }
         for (std::uint32_t k = node.first; k < node.first + node.count; ++k) {
             const std::uint32_t t = ml.tree.prim_indices[k];
-            if (edges)
-                for (std::uint32_t e = ml.owned_first[k]; e < ml.owned_first[k + 1]; ++e) {
-                    const MeshLines::Edge& edge = ml.edges[e];
-                    // No silhouette in the node: an edge that is only a candidate is not a
-                    // line.
-                    if (poly != 0 && edge.flags == MeshLines::kCandidate) continue;
-                    edge_segment(edge);
-                }
-            if (contours && ml.usable(t) && ml.corner_normals[t]) contour(t);
+            if (ml.usable(t) && ml.corner_normals[t]) contour(t);
         }
-        i = node.skip;
+        ++i;
     }
     // Mesh edges in the mesh's edge order (as the flattened scene lists them: chaining starts
     // strokes in segment order), whichever parts of the hierarchy were skipped; then the smooth
