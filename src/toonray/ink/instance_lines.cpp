@@ -201,8 +201,16 @@ struct MeshLines {
         std::uint32_t lo, hi, t0, t1;
         Vec3f p0;      ///< the position of end lo (read for every edge an eye is tested on)
         Vec3f n0, n1;  ///< the faces' normals, n1 turned for inconsistent winding
+        Vec3f p1;      ///< the position of end hi (a crowd's lines looked it up at random)
         std::uint8_t flags;
         std::uint32_t order;  ///< in the mesh's edge order (by welded ends)
+    };
+    /// An edge that is a line from this eye, as found before the lines are put in edge order.
+    struct EdgeLine {
+        std::uint32_t order;
+        EdgeType type;
+        bool certainly_hidden;
+        const Edge* edge;
     };
     /// The edges every eye tests: creases, material boundaries and borders (lines from every
     /// eye), and the candidates whose planes are not finite (which no box bounds).
@@ -396,6 +404,7 @@ std::shared_ptr<const MeshLines> make_mesh_lines(std::shared_ptr<const TriangleM
                              mesh.positions[ml.welded.vertex_position[lo]],
                              Vec3f(0.0f),
                              Vec3f(0.0f),
+                             mesh.positions[ml.welded.vertex_position[s0.hi]],
                              0,
                              static_cast<std::uint32_t>(edges.size())};
         if (j - i != 2) {
@@ -545,7 +554,7 @@ Placement place(const Scene& scene, std::uint32_t i, const MeshLines* ml, const 
 void instance_segments(const Placement& pl, const ViewVolume* volume,
                        const FeatureEdgeSettings& settings, const InstanceLineOptions& options,
                        std::vector<FeatureSegment>& out, std::vector<FeatureSegment>& smooth,
-                       std::vector<std::pair<std::uint32_t, FeatureSegment>>& edges_found) {
+                       std::vector<MeshLines::EdgeLine>& edges_found) {
     const MeshLines& ml = *pl.ml;
     const TriangleMesh& mesh = *ml.mesh;
     const Affine3& m = *pl.to_world;
@@ -569,15 +578,7 @@ void instance_segments(const Placement& pl, const ViewVolume* volume,
                                front1 == (out_sign < 0) && d0 != 0 && d1 != 0;
             if (certainly_hidden && !settings.certainly_hidden) return;
         }
-        FeatureSegment& seg = edges_found.emplace_back(e.order, FeatureSegment{}).second;
-        seg.p0 = m.point(p0);
-        seg.p1 = m.point(mesh.positions[ml.welded.vertex_position[e.hi]]);
-        seg.key0 = {e.lo, kNoIndex, kNoIndex, inst, kNoIndex};
-        seg.key1 = {e.hi, kNoIndex, kNoIndex, inst, kNoIndex};
-        seg.faces = {e.t0, e.t1};
-        seg.face_instance = {inst, e.t1 != kNoIndex ? inst : kNoIndex};
-        seg.type = type;
-        seg.certainly_hidden = certainly_hidden;
+        edges_found.push_back({e.order, type, certainly_hidden, &e});
     };
     auto contour = [&](std::uint32_t t) {
         const auto& p = ml.corners[t];
@@ -667,8 +668,19 @@ void instance_segments(const Placement& pl, const ViewVolume* volume,
     // strokes in segment order), whichever parts of the hierarchy were skipped; then the smooth
     // contours by triangle.
     std::sort(edges_found.begin(), edges_found.end(),
-              [](const auto& x, const auto& y) { return x.first < y.first; });
-    for (auto& [order, seg] : edges_found) out.push_back(seg);
+              [](const auto& x, const auto& y) { return x.order < y.order; });
+    for (const MeshLines::EdgeLine& line : edges_found) {
+        const MeshLines::Edge& e = *line.edge;
+        FeatureSegment& seg = out.emplace_back();
+        seg.p0 = m.point(e.p0);
+        seg.p1 = m.point(e.p1);
+        seg.key0 = {e.lo, kNoIndex, kNoIndex, inst, kNoIndex};
+        seg.key1 = {e.hi, kNoIndex, kNoIndex, inst, kNoIndex};
+        seg.faces = {e.t0, e.t1};
+        seg.face_instance = {inst, e.t1 != kNoIndex ? inst : kNoIndex};
+        seg.type = line.type;
+        seg.certainly_hidden = line.certainly_hidden;
+    }
     std::sort(smooth.begin(), smooth.end(), [](const FeatureSegment& x, const FeatureSegment& y) {
         return x.faces[0] < y.faces[0];
     });
@@ -887,7 +899,7 @@ void add_instance_segments(const Scene& scene, const TriangleAccel& accel, const
         static_cast<int>(count), kInstancesPerChunk, threads,
         [&](int i0, int i1, std::vector<FeatureSegment>& out) {
             std::vector<FeatureSegment> smooth;
-            std::vector<std::pair<std::uint32_t, FeatureSegment>> edges_found;
+            std::vector<MeshLines::EdgeLine> edges_found;
             for (int i = i0; i < i1; ++i) {
                 const auto u = static_cast<std::uint32_t>(i);
                 const ViewVolume* volume = nullptr;
