@@ -215,11 +215,31 @@ std::vector<EdgePiece> split_by_visibility(std::span<const FeatureSegment> segme
                     out.push_back(piece);
                     continue;
                 }
-                gather_ignored(seg, context.mesh, context.instances, ignored);
+                // The triangles whose hits do not count, gathered when a hit needs them: a
+                // sharp line's are its faces, which a hit is compared with directly.
+                bool have_ignored = false;
+                auto ignored_keys = [&]() -> std::span<const TriangleKey> {
+                    if (!have_ignored)
+                        gather_ignored(seg, context.mesh, context.instances, ignored);
+                    have_ignored = true;
+                    return ignored;
+                };
+                auto is_ignored = [&](const Hit& hit) {
+                    const TriangleKey key = triangle_key(hit.instance, hit.prim);
+                    if (seg.smooth) {
+                        const auto keys = ignored_keys();
+                        return std::binary_search(keys.begin(), keys.end(), key);
+                    }
+                    for (int k = 0; k < 2; ++k)
+                        if (seg.faces[k] != kNoIndex &&
+                            key == triangle_key(seg.face_instance[k], seg.faces[k]))
+                            return true;
+                    return false;
+                };
                 auto state_at = [&](float s) {
                     const float t = c.t_of(s);
                     return count_occluders(context.accel, seg.p0 + (seg.p1 - seg.p0) * t,
-                                           view.eye(), ignored, settings);
+                                           view.eye(), ignored_keys(), settings);
                 };
                 // Samples at the middles of n equal steps of at most `step` pixels; a change
                 // between two samples is found by bisection.
@@ -278,14 +298,12 @@ std::vector<EdgePiece> split_by_visibility(std::span<const FeatureSegment> segme
                     for (int k = 0; k < n; ++k) {
                         const Hit& hit = hits[static_cast<std::size_t>(k)];
                         if (!found[k]) sample_states[static_cast<std::size_t>(k)] = 0;
-                        else if (hit.t >= settings.self_epsilon &&
-                                 !std::binary_search(ignored.begin(), ignored.end(),
-                                                     triangle_key(hit.instance, hit.prim)))
+                        else if (hit.t >= settings.self_epsilon && !is_ignored(hit))
                             sample_states[static_cast<std::size_t>(k)] = 1;
                         else
                             sample_states[static_cast<std::size_t>(k)] =
                                 count_occluders(context.accel, points[static_cast<std::size_t>(k)],
-                                                view.eye(), ignored, settings);
+                                                view.eye(), ignored_keys(), settings);
                     }
                 } else {
                     for (int k = 0; k < n; ++k)
