@@ -42,8 +42,9 @@ struct InstanceLineCache {
     std::size_t mesh_builds = 0;
 };
 
-/// Switches for tests: the culling by normal cones and by the view can be turned off, which
-/// must not change any segment.
+/// Switches for tests: the culling by the silhouette candidates' plane tree and the smooth
+/// contours' normal cones (`cone_culling`) and by the view can be turned off, which must not
+/// change any segment.
 struct InstanceLineOptions {
     bool cone_culling = true;
     bool view_culling = true;
@@ -66,9 +67,9 @@ struct InstanceVisibility {
 /// smooth contours, then the intersection lines within its mesh; then the intersection lines
 /// between instances, and between the scene's own triangles (welded as `own`, in `accel`'s
 /// binary tree) and instances, by pair. Segments on an instance's triangles name it in
-/// FeatureSegment::face_instance and in their endpoint keys. Instances and parts of meshes
-/// whose boxes lie outside the view (grown by a margin beyond visibility's) give none: their
-/// segments would be clipped away. Updates the cache. With `visibility`, only the segments
+/// FeatureSegment::face_instance and in their endpoint keys. Instances whose boxes lie outside
+/// the view (grown by a margin beyond visibility's) give none, and parts of a mesh outside it
+/// give no smooth contours: their segments would be clipped away. Updates the cache. With `visibility`, only the segments
 /// that keep a piece are appended, and their pieces go to visibility->pieces.
 void add_instance_segments(const Scene& scene, const TriangleAccel& accel, const WeldedMesh& own,
                            const ViewPlane& plane, const ScreenProjection& view, float margin,
