@@ -18,6 +18,7 @@
 #include "toonray/accel/scene_accel.h"
 #include "toonray/ink/ink.h"
 #include "toonray/ink/instance_lines.h"
+#include "toonray/ink/strokes.h"
 #include "support/instance_scenes.h"
 #include "ink/ink_scenes.h"
 
@@ -35,6 +36,20 @@ bool same_segment(const FeatureSegment& a, const FeatureSegment& b) {
            a.key1 == b.key1 && a.type == b.type && a.faces == b.faces &&
            a.face_instance == b.face_instance && a.smooth == b.smooth &&
            a.certainly_hidden == b.certainly_hidden;
+}
+
+// Four rows of the test scene's instances (more than one chunk of instances), which cross
+// each other and the ground.
+Scene four_rows() {
+    Scene scene = test_support::instanced_test_scene();
+    const std::size_t row = scene.instances.size();
+    for (int k = 1; k < 4; ++k)
+        for (std::size_t i = 0; i < row; ++i) {
+            Affine3 moved = scene.instances[i].to_world;
+            moved.m[2][3] -= 14.0 * k;
+            scene.add_instance(scene.instances[i].mesh, moved, scene.instances[i].object);
+        }
+    return scene;
 }
 
 std::vector<FeatureSegment> instance_lines(const Scene& scene, const TriangleAccel& accel,
@@ -289,16 +304,55 @@ bool same_piece(const EdgePiece& a, const EdgePiece& b) {
 // Visibility run chunk by chunk as the instances' segments are found gives the pieces that
 // visibility over all of them gives, with only the segments a piece lies on, numbered after
 // the segments already in the list.
-TEST(InstanceLines, VisibilityAsTheSegmentsAreFoundKeepsTheirPiecesOnly) {
-    // Four rows of the test scene's instances: more than one chunk of instances.
-    Scene scene = test_support::instanced_test_scene();
-    const std::size_t row = scene.instances.size();
-    for (int k = 1; k < 4; ++k)
-        for (std::size_t i = 0; i < row; ++i) {
-            Affine3 moved = scene.instances[i].to_world;
-            moved.m[2][3] -= 14.0 * k;
-            scene.add_instance(scene.instances[i].mesh, moved, scene.instances[i].object);
+TEST(InstanceLines, ChainingInPartsOfWholeInstancesGivesTheSameStrokes) {
+    // The pieces of the own triangles' lines, then of the instances' lines and crossings,
+    // chained all at once and in parts of at least 16 pieces.
+    const Scene scene = four_rows();
+    const TriangleAccel accel = build_scene_accel(scene);
+    const WeldedMesh own = weld_vertices(scene);
+    int crossings = 0;
+    for (const Vec3f& eye : {Vec3f(9, 9, 16), Vec3f(-14, 5, 6), Vec3f(2, 3, -15)}) {
+        const CameraSpec camera = test_support::looking_at(eye, Vec3f(0, 1, 0));
+        const ViewPlane plane = make_view_plane(camera, 320, 200);
+        const ScreenProjection view(plane, 320, 200);
+        for (const bool hidden : {false, true}) {
+            VisibilitySettings visibility;
+            visibility.keep_hidden = hidden;
+            visibility.max_invisibility = 1;
+            std::vector<FeatureSegment> segments =
+                find_feature_edges(scene, own, accel.bvh(), eye, FeatureEdgeSettings{}, 2);
+            const std::size_t first = segments.size();
+            InstanceLineCache cache;
+            InstanceVisibility found{visibility, {}};
+            add_instance_segments(scene, accel, own, plane, view, 4.0f, {}, 2, cache, segments, {},
+                                  &found);
+            const VisibilityContext context{scene, own, accel, view, &cache};
+            std::vector<EdgePiece> pieces = split_by_visibility(
+                std::span<const FeatureSegment>(segments).first(first), context, visibility, 2);
+            pieces.insert(pieces.end(), found.pieces.begin(), found.pieces.end());
+            ChainSettings chain;
+            chain.hidden = hidden;
+            const auto cuts = instance_chain_cuts(pieces, segments, first, segments.size(), 16);
+            ASSERT_GT(cuts.size(), 4u);
+            const auto whole = chain_pieces(pieces, chain, {});
+            const auto parts = chain_pieces_in_parts(pieces, cuts, chain, {}, 2);
+            ASSERT_EQ(parts.size(), whole.size());
+            for (std::size_t i = 0; i < whole.size(); ++i) {
+                EXPECT_EQ(parts[i].points, whole[i].points) << i;
+                EXPECT_EQ(parts[i].segment, whole[i].segment) << i;
+                EXPECT_EQ(parts[i].visible, whole[i].visible) << i;
+            }
+            crossings +=
+                static_cast<int>(std::count_if(whole.begin(), whole.end(), [&](const Stroke& s) {
+                    return s.type == EdgeType::Intersection && s.segment >= first;
+                }));
         }
+    }
+    EXPECT_GT(crossings, 0);  // the instances' crossings were among the parts
+}
+
+TEST(InstanceLines, VisibilityAsTheSegmentsAreFoundKeepsTheirPiecesOnly) {
+    const Scene scene = four_rows();
     const TriangleAccel accel = build_scene_accel(scene);
     const WeldedMesh own = weld_vertices(scene);
     std::size_t dropped = 0, hidden_pieces = 0;

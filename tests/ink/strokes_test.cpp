@@ -132,5 +132,52 @@ TEST(ChainPieces, ShortStrokesCanBeDropped) {
     EXPECT_EQ(strokes[0].points.front(), (Point2{5, 5}));
 }
 
+TEST(ChainPieces, PartsThatShareNoKeyChainAsTheWhole) {
+    // The rest (before and after the parts) chains across them: a path of the own triangles
+    // from (0, 0) runs on into a piece after the parts. Three instances' pieces, whose keys
+    // name them, come between: a loop, a path and a fork; the last piece after the parts is a
+    // crossing between two instances (its keys name both) that meets nothing.
+    auto on = [](EdgePiece p, std::uint32_t instance, std::uint32_t other = kNoIndex) {
+        p.key0.instance = p.key1.instance = instance;
+        p.key0.c_instance = p.key1.c_instance = other;
+        return p;
+    };
+    std::vector<EdgePiece> pieces{piece(0, {0, 0}, {10, 0}, 0, 1), piece(1, {10, 0}, {20, 0}, 1, 2),
+                                  piece(2, {50, 50}, {60, 50}, 7, 8)};
+    const std::size_t first = pieces.size();
+    for (const EdgePiece& p :
+         {piece(3, {0, 20}, {10, 20}, 0, 1), piece(4, {10, 20}, {10, 30}, 1, 2),
+          piece(5, {10, 30}, {0, 30}, 2, 3), piece(6, {0, 30}, {0, 20}, 3, 0)})
+        pieces.push_back(on(p, 0));
+    const std::size_t second = pieces.size();
+    for (const EdgePiece& p :
+         {piece(7, {20, 20}, {30, 20}, 0, 1), piece(8, {30, 20}, {40, 25}, 1, 2)})
+        pieces.push_back(on(p, 1));
+    const std::size_t third = pieces.size();
+    for (const EdgePiece& p :
+         {piece(9, {0, 40}, {10, 40}, 0, 1), piece(10, {10, 40}, {20, 40}, 1, 2),
+          piece(11, {10, 40}, {10, 50}, 1, 3)})
+        pieces.push_back(on(p, 2));
+    const std::size_t last = pieces.size();
+    pieces.push_back(piece(12, {20, 0}, {30, 0}, 2, 4));
+    pieces.push_back(on(piece(13, {40, 40}, {45, 45}, 0, 1), 0, 1));
+    const std::vector<std::size_t> cuts{first, second, third, last};
+    const auto whole = ink::chain_pieces(pieces, plain());
+    ASSERT_EQ(whole.size(), 7u);  // own path, the other own piece, loop, path, fork's 2, crossing
+    EXPECT_EQ(whole[0].points.back(), (Point2{30, 0}));  // the own path took the piece after
+    for (int threads : {1, 2}) {
+        const auto parts = ink::chain_pieces_in_parts(pieces, cuts, plain(), {}, threads);
+        ASSERT_EQ(parts.size(), whole.size()) << threads;
+        for (std::size_t i = 0; i < whole.size(); ++i) {
+            EXPECT_EQ(parts[i].points, whole[i].points) << threads << " " << i;
+            EXPECT_EQ(parts[i].segment, whole[i].segment) << threads << " " << i;
+            EXPECT_EQ(parts[i].closed, whole[i].closed) << threads << " " << i;
+        }
+    }
+    // No parts: the whole.
+    const std::vector<std::size_t> none{pieces.size()};
+    EXPECT_EQ(ink::chain_pieces_in_parts(pieces, none, plain(), {}, 2).size(), whole.size());
+}
+
 }  // namespace
 }  // namespace toonray

@@ -130,6 +130,7 @@ void tone_pens(const Scene& scene, const InkSettings& settings, StyleResolver& s
     }
 }
 
+
 }  // namespace
 
 std::uint32_t style_source_triangle(const Scene& scene, const FeatureSegment& segment) {
@@ -273,7 +274,13 @@ void draw_ink_lines(const Scene& scene, const TriangleAccel& accel, const Camera
     }
     if (by_depth) chain.eye = plane.eye;
     chain.world = sketchy;
-    out.strokes = chain_pieces(out.pieces, chain, segment_styles);
+    // A crowd's chaining was a serial stage of its frame, and its tables of line ends the
+    // frame's peak: the instances' pieces are chained in parts, in parallel.
+    out.strokes =
+        chain_pieces_in_parts(out.pieces,
+                              instance_chain_cuts(out.pieces, out.segments, first_instance_segment,
+                                                  end_instance_segment, 4096),
+                              chain, segment_styles, threads);
     // Dots: one-point strokes as wide as their darkness asks.
     for (const ToneDot& dot : dots) {
         const std::uint16_t style = styles.index(dot.prim, EdgeType::Tone, true);

@@ -818,6 +818,27 @@ std::vector<PairCrossing> cross(std::vector<WorldTriangle>& a, std::vector<World
 
 }  // namespace
 
+std::vector<std::size_t> instance_chain_cuts(std::span<const EdgePiece> pieces,
+                                             std::span<const FeatureSegment> segments,
+                                             std::size_t first_segment, std::size_t end_segment,
+                                             std::size_t min_part) {
+    auto of_instances = [&](const EdgePiece& p) {
+        return p.segment >= first_segment && p.segment < end_segment;
+    };
+    // A crossing's first face is on one of its sides: cutting where it changes cuts between
+    // pairs (a pair's crossings come together).
+    auto instance = [&](std::size_t i) { return segments[pieces[i].segment].face_instance[0]; };
+    std::size_t i = static_cast<std::size_t>(
+        std::find_if(pieces.begin(), pieces.end(), of_instances) - pieces.begin());
+    std::vector<std::size_t> cuts{i};
+    for (; i < pieces.size() && of_instances(pieces[i]); ++i)
+        if (i - cuts.back() >= min_part && instance(i) != instance(i - 1)) cuts.push_back(i);
+    if (i > cuts.back()) cuts.push_back(i);
+    if (std::any_of(pieces.begin() + static_cast<std::ptrdiff_t>(i), pieces.end(), of_instances))
+        return {pieces.size()};
+    return cuts;
+}
+
 const WeldedMesh& instance_welded_mesh(const InstanceLineCache& cache, std::uint32_t instance) {
     return cache.of_instance[instance]->welded;
 }

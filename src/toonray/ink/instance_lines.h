@@ -2,12 +2,15 @@
 /// The ink lines of a scene's instances (Scene::instances): feature edges of each distinct mesh
 /// found once, in object space, and kept across frames; silhouettes and smooth contours found
 /// per instance with the eye taken into object space, skipping the parts of the mesh that
-/// cannot hold one (a normal-cone hierarchy) and the instances and parts outside the view;
+/// cannot hold one (a tree over the faces' planes for mesh edges, a normal-cone hierarchy for
+/// smooth contours) and the instances outside the view;
 /// intersection lines within each mesh (found once) and between instances whose boxes overlap.
 /// docs/ink.md, "Instances", has the rules.
 
+#include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <vector>
 
 #include "toonray/accel/triangle_accel.h"
@@ -77,6 +80,19 @@ void add_instance_segments(const Scene& scene, const TriangleAccel& accel, const
                            InstanceLineCache& cache, std::vector<FeatureSegment>& segments,
                            const InstanceLineOptions& options = {},
                            InstanceVisibility* visibility = nullptr);
+
+/// Where chaining may cut the pieces of add_instance_segments' segments [first_segment,
+/// end_segment) of `segments` (which visibility keeps together, in segment order) into parts
+/// of whole instances of at least `min_part` pieces each: chain_pieces_in_parts' cuts (one
+/// cut, pieces.size(), when they are not together). An instance's end keys name it
+/// (EndpointKey::instance), and a crossing's name both its sides (the other instance in
+/// c_instance, or the own triangle crossed in c), so pieces of different instances never
+/// meet, nor crossings of different pairs, nor any of them the rest's.
+[[nodiscard]] std::vector<std::size_t> instance_chain_cuts(std::span<const EdgePiece> pieces,
+                                                           std::span<const FeatureSegment> segments,
+                                                           std::size_t first_segment,
+                                                           std::size_t end_segment,
+                                                           std::size_t min_part);
 
 /// The welded mesh of instance `instance`'s mesh, as add_instance_segments last welded it.
 [[nodiscard]] const WeldedMesh& instance_welded_mesh(const InstanceLineCache& cache,

@@ -2,10 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <tuple>
 
 #include "toonray/core/portable_math.h"
+#include "toonray/ink/chunks.h"
 #include "toonray/ink/hash.h"
 
 namespace toonray::ink {
@@ -295,6 +297,43 @@ std::vector<Stroke> chain_pieces(std::span<const EdgePiece> pieces, const ChainS
         strokes.push_back(std::move(stroke));
     }
     return strokes;
+}
+
+std::vector<Stroke> chain_pieces_in_parts(std::span<const EdgePiece> pieces,
+                                          std::span<const std::size_t> cuts,
+                                          const ChainSettings& settings,
+                                          std::span<const SegmentStyles> segment_styles,
+                                          int threads) {
+    const std::size_t first = cuts.front(), last = cuts.back();
+    if (first == last) return chain_pieces(pieces, settings, segment_styles);
+    std::vector<EdgePiece> rest(pieces.begin(),
+                                pieces.begin() + static_cast<std::ptrdiff_t>(first));
+    rest.insert(rest.end(), pieces.begin() + static_cast<std::ptrdiff_t>(last), pieces.end());
+    // Part 0 is the rest; part k the pieces [cuts[k - 1], cuts[k]).
+    std::vector<std::vector<Stroke>> parts = chunk_outputs<Stroke>(
+        static_cast<int>(cuts.size()), 1, threads, [&](int k0, int k1, std::vector<Stroke>& out) {
+            for (int k = k0; k < k1; ++k) {
+                const auto at = static_cast<std::size_t>(k);
+                out = chain_pieces(k == 0 ? std::span<const EdgePiece>(rest)
+                                          : pieces.subspan(cuts[at - 1], cuts[at] - cuts[at - 1]),
+                                   settings, segment_styles);
+            }
+        });
+    // In the order of their first pieces: the rest's strokes that start before the parts, the
+    // parts', then the rest's others (a stroke of the rest that starts before the parts may
+    // take pieces after them, as it would chaining all at once).
+    std::vector<Stroke>& before = parts.front();
+    const std::uint32_t first_segment =
+        first < pieces.size() ? pieces[first].segment : std::numeric_limits<std::uint32_t>::max();
+    const auto split = std::partition_point(
+        before.begin(), before.end(), [&](const Stroke& s) { return s.segment < first_segment; });
+    std::vector<Stroke> after(std::make_move_iterator(split),
+                              std::make_move_iterator(before.end()));
+    before.erase(split, before.end());
+    parts.push_back(std::move(after));
+    std::vector<Stroke> out;
+    append_parts(parts, out);
+    return out;
 }
 
 }  // namespace toonray::ink

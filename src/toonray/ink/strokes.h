@@ -70,6 +70,17 @@ struct ChainSettings {
                                                const ChainSettings& settings,
                                                std::span<const SegmentStyles> segment_styles = {});
 
+/// chain_pieces' strokes, with the pieces [cuts.front(), cuts.back()) chained in the parts the
+/// cuts make, apart from the rest and from each other and on `threads` threads; the rest (the
+/// pieces before and after) is chained as one. The strokes are chain_pieces' over all the
+/// pieces, in the same order (by their first piece), when no piece of a part shares an
+/// endpoint key with a piece outside it and no segment's pieces are cut apart: that is the
+/// caller's to know (pieces of different instances never meet, ink.cpp). The pieces are in
+/// segment order, as visibility gives them; `cuts` are increasing, at least one.
+[[nodiscard]] std::vector<Stroke> chain_pieces_in_parts(
+    std::span<const EdgePiece> pieces, std::span<const std::size_t> cuts,
+    const ChainSettings& settings, std::span<const SegmentStyles> segment_styles, int threads);
+
 /// Douglas-Peucker: the fewest points of `points` (ends kept) such that every dropped point
 /// is within `tolerance` of the simplified polyline.
 [[nodiscard]] std::vector<Point2> simplify_polyline(std::span<const Point2> points,
