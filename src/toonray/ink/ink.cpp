@@ -130,7 +130,6 @@ void tone_pens(const Scene& scene, const InkSettings& settings, StyleResolver& s
     }
 }
 
-
 }  // namespace
 
 std::uint32_t style_source_triangle(const Scene& scene, const FeatureSegment& segment) {

@@ -314,9 +314,12 @@ std::vector<Stroke> chain_pieces_in_parts(std::span<const EdgePiece> pieces,
         static_cast<int>(cuts.size()), 1, threads, [&](int k0, int k1, std::vector<Stroke>& out) {
             for (int k = k0; k < k1; ++k) {
                 const auto at = static_cast<std::size_t>(k);
-                out = chain_pieces(k == 0 ? std::span<const EdgePiece>(rest)
-                                          : pieces.subspan(cuts[at - 1], cuts[at] - cuts[at - 1]),
-                                   settings, segment_styles);
+                std::vector<Stroke> strokes =
+                    chain_pieces(k == 0 ? std::span<const EdgePiece>(rest)
+                                        : pieces.subspan(cuts[at - 1], cuts[at] - cuts[at - 1]),
+                                 settings, segment_styles);
+                out.insert(out.end(), std::make_move_iterator(strokes.begin()),
+                           std::make_move_iterator(strokes.end()));
             }
         });
     // In the order of their first pieces: the rest's strokes that start before the parts, the
