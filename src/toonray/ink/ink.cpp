@@ -196,13 +196,30 @@ void draw_ink_lines(const Scene& scene, const TriangleAccel& accel, const Camera
     edges.band_thresholds = settings.band_thresholds;
     out.segments = find_feature_edges(scene, out.mesh, accel.bvh(), plane.eye, edges, threads,
                                       &out.intersections);
+    out.timings.edges = seconds_since(start);
+    // The own segments' pieces first: the instances' pieces, a crowd's many, are then appended
+    // to them once rather than copied again behind them.
+    start = std::chrono::steady_clock::now();
+    // The visibility of a smooth line ignores the triangles around its face's corners.
+    auto add_rings_for = [&](std::span<const FeatureSegment> segments) {
+        if (std::any_of(segments.begin(), segments.end(),
+                        [](const FeatureSegment& s) { return s.smooth; }))
+            add_vertex_rings(out.mesh);
+    };
+    add_rings_for(out.segments);
+    const VisibilityContext context{scene, out.mesh, accel, view, &out.instances};
+    InstanceVisibility instance_visibility{
+        visibility, split_by_visibility(out.segments, context, visibility, threads)};
+    out.timings.visibility = seconds_since(start);
+
     // The instances' segments come with their pieces (their visibility is timed with the
     // edges), and only those that keep a piece.
+    start = std::chrono::steady_clock::now();
     const std::size_t first_instance_segment = out.segments.size();
-    InstanceVisibility instance_visibility{visibility, {}};
     add_instance_segments(scene, accel, out.mesh, plane, view, settings.visibility.margin, edges,
                           threads, out.instances, out.segments, {}, &instance_visibility);
     const std::size_t end_instance_segment = out.segments.size();
+    out.pieces = std::move(instance_visibility.pieces);
     add_polyline_segments(scene, out.segments);
     const LightingModel lighting{settings.lights, settings.band_thresholds};
     const std::vector<std::uint8_t> closed = closed_objects(out.intersections);
@@ -215,7 +232,7 @@ void draw_ink_lines(const Scene& scene, const TriangleAccel& accel, const Camera
                                    outward_objects(scene, closed, plane.eye), threads);
         out.segments.insert(out.segments.end(), more.begin(), more.end());
     }
-    out.timings.edges = seconds_since(start);
+    out.timings.edges += seconds_since(start);
 
     // The tone's pens and strokes (after every line's segments, so its strokes come last).
     start = std::chrono::steady_clock::now();
@@ -243,25 +260,19 @@ void draw_ink_lines(const Scene& scene, const TriangleAccel& accel, const Camera
     out.timings.tone = seconds_since(start);
 
     start = std::chrono::steady_clock::now();
-    // The visibility of a smooth line ignores the triangles around its face's corners.
-    if (std::any_of(out.segments.begin(), out.segments.end(),
-                    [](const FeatureSegment& s) { return s.smooth; }))
-        add_vertex_rings(out.mesh);
-    const VisibilityContext context{scene, out.mesh, accel, view, &out.instances};
-    const std::span<const FeatureSegment> all(out.segments);
-    out.pieces =
-        split_by_visibility(all.first(first_instance_segment), context, visibility, threads);
-    std::vector<std::vector<EdgePiece>> later(2);
-    later[0] = std::move(instance_visibility.pieces);
-    later[1] = split_by_visibility(all.subspan(end_instance_segment), context, visibility, threads);
-    for (EdgePiece& piece : later[1])
+    const std::span<const FeatureSegment> rest =
+        std::span(out.segments).subspan(end_instance_segment);
+    add_rings_for(rest);
+    std::vector<std::vector<EdgePiece>> later(1);
+    later[0] = split_by_visibility(rest, context, visibility, threads);
+    for (EdgePiece& piece : later[0])
         piece.segment += static_cast<std::uint32_t>(end_instance_segment);
     append_parts(later, out.pieces);
     // Tone is drawn where it is seen only: its hidden pieces are not strokes.
     if (tone)
         std::erase_if(out.pieces,
                       [](const EdgePiece& p) { return p.type == EdgeType::Tone && !p.visible(); });
-    out.timings.visibility = seconds_since(start);
+    out.timings.visibility += seconds_since(start);
 
     start = std::chrono::steady_clock::now();
     const std::vector<SegmentStyles> segment_styles =
