@@ -897,15 +897,19 @@ void add_instance_segments(const Scene& scene, const TriangleAccel& accel, const
         part.shrink_to_fit();
     };
     // Appends the parts' pieces to visibility->pieces, numbered as `segments` will hold the
-    // parts' segments from index `first` on.
+    // parts' segments (`part_sizes` of them) from index `first` on.
     auto join_pieces = [&](std::vector<std::vector<EdgePiece>>& pieces,
-                           const std::vector<std::vector<FeatureSegment>>& parts,
-                           std::size_t first) {
-        for (std::size_t c = 0; c < parts.size(); ++c) {
+                           const std::vector<std::size_t>& part_sizes, std::size_t first) {
+        for (std::size_t c = 0; c < part_sizes.size(); ++c) {
             for (EdgePiece& piece : pieces[c]) piece.segment += static_cast<std::uint32_t>(first);
-            first += parts[c].size();
+            first += part_sizes[c];
         }
         append_parts(pieces, visibility->pieces);
+    };
+    auto sizes_of = [](const std::vector<std::vector<FeatureSegment>>& parts) {
+        std::vector<std::size_t> sizes;
+        for (const auto& part : parts) sizes.push_back(part.size());
+        return sizes;
     };
 
     // Per instance, in chunks of instances joined in order.
@@ -934,9 +938,9 @@ void add_instance_segments(const Scene& scene, const TriangleAccel& accel, const
             if (visibility)
                 keep_drawn(out, piece_parts[static_cast<std::size_t>(i0 / kInstancesPerChunk)], 1);
         });
-    if (visibility) join_pieces(piece_parts, lines, segments.size());
     if (!settings.intersections) {
         cache.pairs.clear();
+        if (visibility) join_pieces(piece_parts, sizes_of(lines), segments.size());
         append_parts(lines, segments);
         return;
     }
@@ -1034,15 +1038,24 @@ void add_instance_segments(const Scene& scene, const TriangleAccel& accel, const
     });
     std::vector<std::vector<FeatureSegment>> crossings{std::move(crossing_lines)};
     append_parts(own_pairs, crossings[0]);
-    std::size_t first_crossing = segments.size();
-    for (const auto& part : lines) first_crossing += part.size();
     if (visibility) {
-        std::vector<std::vector<EdgePiece>> crossing_pieces(1);
-        keep_drawn(crossings[0], crossing_pieces[0], threads);
-        join_pieces(crossing_pieces, crossings, first_crossing);
+        piece_parts.emplace_back();
+        keep_drawn(crossings[0], piece_parts.back(), threads);
     }
-    append_parts(lines, segments, crossings[0].size());
-    append_parts(crossings, segments);
+    std::vector<std::size_t> part_sizes = sizes_of(lines);
+    part_sizes.push_back(crossings[0].size());
+    const std::size_t first = segments.size();
+    // The pieces and the segments are joined side by side: each join is a copy into fresh
+    // memory, and a crowd's were a serial stage of its frame.
+    parallel_for(2, 1, threads, [&](int j0, int j1) {
+        for (int j = j0; j < j1; ++j) {
+            if (j == 0 && visibility) join_pieces(piece_parts, part_sizes, first);
+            if (j == 1) {
+                append_parts(lines, segments, crossings[0].size());
+                append_parts(crossings, segments);
+            }
+        }
+    });
 }
 
 }  // namespace toonray::ink
