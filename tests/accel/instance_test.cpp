@@ -158,12 +158,21 @@ void check_view(const TriangleAccel& accel, const Soup* own, const std::vector<P
                 std::vector<Hit> tile(dirs.size());
                 std::unique_ptr<bool[]> found(new bool[dirs.size()]);
                 accel.intersect_tile(view.eye, dirs.data(), w, h, tile.data(), found.get(), tmax);
+                // Told that the rays are too sparse for any instance's tree (as visibility's
+                // samples along lines are): each crosses the trees alone.
+                std::vector<Hit> alone(dirs.size());
+                std::unique_ptr<bool[]> found_alone(new bool[dirs.size()]);
+                accel.intersect_tile(view.eye, dirs.data(), w, h, alone.data(), found_alone.get(),
+                                     tmax, std::numeric_limits<float>::infinity());
                 for (std::size_t i = 0; i < dirs.size(); ++i) {
                     const Ray ray{view.eye, dirs[i], tmax};
                     Hit single;
                     const bool f = accel.intersect(ray, single);
                     ASSERT_TRUE(same_hit(tile[i], found[i], single, f))
                         << "tile against single ray at " << x0 + int(i) % w << ","
+                        << y0 + int(i) / w;
+                    ASSERT_TRUE(same_hit(alone[i], found_alone[i], single, f))
+                        << "sparse tile against single ray at " << x0 + int(i) % w << ","
                         << y0 + int(i) / w;
                     ASSERT_EQ(accel.occluded(ray), f);
                     hits += f;

@@ -961,22 +961,24 @@ TR_INLINE bool dense_for(const WideBvh& tree, const Vec3f& origin, float ray_ang
 // intersect_tile does; at each record the groups that reach it are taken into its object space
 // (each lane's direction, as object_ray does) and traced through its tree with their best hits
 // so far, ties going to the lower rank (RankedHit). Groups that are irregular in object space,
-// and all of them when they are sparse for the record's tree (dense_for), are traced there ray
-// by ray.
+// and all of them when they are sparse for the record's tree (dense_for, or an infinite
+// `ray_angle2`), are traced there ray by ray.
 void intersect_tile_instances(const InstanceLevel& lv, const Vec3f& origin, const Vec3f* dirs,
-                              int width, int height, float tmax_in, Hit* hits, bool* found,
-                              TileEntry* stack, std::uint64_t* stack1, TileEntry* bottom,
-                              std::uint64_t* bottom1) {
+                              int width, int height, float tmax_in, float ray_angle2, Hit* hits,
+                              bool* found, TileEntry* stack, std::uint64_t* stack1,
+                              TileEntry* bottom, std::uint64_t* bottom1) {
     TileState s;
     std::uint32_t regular, irregular;
     TileSigns signs;
     const int ng = setup_tile(s, dirs, width, height, tmax_in, regular, irregular, signs);
-    // The squared angle between the first two rays (the tile's spacing, in any space a
-    // similarity takes it to).
-    float ray_angle2 = 0.0f;
-    if (width * height >= 2) {
-        const Vec3f step = normalize(dirs[1]) - normalize(dirs[0]);
-        ray_angle2 = dot(step, step);
+    // Unless given, the squared angle between the first two rays (the tile's spacing, in any
+    // space a similarity takes it to).
+    if (ray_angle2 < 0.0f) {
+        ray_angle2 = 0.0f;
+        if (width * height >= 2) {
+            const Vec3f step = normalize(dirs[1]) - normalize(dirs[0]);
+            ray_angle2 = dot(step, step);
+        }
     }
     alignas(32) std::uint32_t rank[kMaxGroups][8];
     TileState so;  // the groups in a record's object space
@@ -985,7 +987,8 @@ void intersect_tile_instances(const InstanceLevel& lv, const Vec3f& origin, cons
         [&](std::uint32_t ref, std::uint32_t groups) {
             for_each_record(lv, ref, [&](const InstanceRecord& r) {
                 const Ray oray = object_ray(r, Ray{origin, Vec3f(0.0f), tmax_in});
-                const bool sparse = !dense_for(*r.tree, oray.origin, ray_angle2);
+                const bool sparse =
+                    std::isinf(ray_angle2) || !dense_for(*r.tree, oray.origin, ray_angle2);
                 clear_groups(so);
                 TileSigns osigns;
                 std::uint32_t oregular = 0;

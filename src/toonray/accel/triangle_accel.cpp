@@ -319,7 +319,7 @@ bool TriangleAccel::occluded(const Ray& ray) const {
 }
 
 void TriangleAccel::intersect_tile(const Vec3f& origin, const Vec3f* dirs, int width, int height,
-                                   Hit* hits, bool* found, float tmax) const {
+                                   Hit* hits, bool* found, float tmax, float ray_angle2) const {
     if (width <= 0 || height <= 0) return;
     if (width <= kTileSize && height > kTileSize) {
         // A narrow grid (a list of rays a few wide): its tiles are runs of whole rows, which
@@ -327,7 +327,7 @@ void TriangleAccel::intersect_tile(const Vec3f& origin, const Vec3f* dirs, int w
         for (int y0 = 0; y0 < height; y0 += kTileSize) {
             const std::size_t at = static_cast<std::size_t>(y0) * width;
             intersect_tile(origin, dirs + at, width, std::min(kTileSize, height - y0), hits + at,
-                           found + at, tmax);
+                           found + at, tmax, ray_angle2);
         }
         return;
     }
@@ -341,7 +341,7 @@ void TriangleAccel::intersect_tile(const Vec3f& origin, const Vec3f* dirs, int w
                 bool ff[kTileSize * kTileSize];
                 for (int y = 0; y < h; ++y)
                     for (int x = 0; x < w; ++x) d[y * w + x] = dirs[(y0 + y) * width + x0 + x];
-                intersect_tile(origin, d, w, h, hh, ff, tmax);
+                intersect_tile(origin, d, w, h, hh, ff, tmax, ray_angle2);
                 for (int y = 0; y < h; ++y)
                     for (int x = 0; x < w; ++x) {
                         hits[(y0 + y) * width + x0 + x] = hh[y * w + x];
@@ -354,8 +354,8 @@ void TriangleAccel::intersect_tile(const Vec3f& origin, const Vec3f* dirs, int w
         const std::size_t top = level_->tree.max_stack, bottom = level_->bottom_stack;
         Stack<accel::TileEntry> stack(top), stack_b(bottom);
         Stack<std::uint64_t> stack1(top), stack1_b(bottom);
-        kernels().intersect_tile_instances(*level_, origin, dirs, width, height, tmax, hits, found,
-                                           stack.data(), stack1.data(), stack_b.data(),
+        kernels().intersect_tile_instances(*level_, origin, dirs, width, height, tmax, ray_angle2,
+                                           hits, found, stack.data(), stack1.data(), stack_b.data(),
                                            stack1_b.data());
         return;
     }

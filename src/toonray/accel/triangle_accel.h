@@ -85,9 +85,13 @@ public:
     /// rays should be coherent (a pinhole camera's): each kTileSize x kTileSize tile is
     /// traversed once, as a frustum of 4 x 2 ray packets (larger grids are cut into tiles).
     /// With instances, the groups that reach an instance go through its tree as packets only
-    /// when they are dense for it (dense_for in kernels.inl).
+    /// when they are dense for it (dense_for in kernels.inl), judged by `ray_angle2`, the
+    /// squared angle between neighbouring rays: negative for that of the first two, infinite
+    /// for rays too sparse for any instance (each crosses an instance's tree alone, and only
+    /// the top level is traversed by groups). Only speed depends on it.
     void intersect_tile(const Vec3f& origin, const Vec3f* dirs, int width, int height, Hit* hits,
-                        bool* found, float tmax = std::numeric_limits<float>::infinity()) const;
+                        bool* found, float tmax = std::numeric_limits<float>::infinity(),
+                        float ray_angle2 = -1.0f) const;
 
     /// The binary tree over the own triangles (not the instances).
     [[nodiscard]] const Bvh& bvh() const { return bvh_; }
