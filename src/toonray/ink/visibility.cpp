@@ -322,24 +322,29 @@ std::vector<EdgePiece> split_by_visibility(std::span<const FeatureSegment> segme
                     // 1 - self_epsilon on a triangle that counts means hidden, none means visible;
                     // a first hit on an ignored triangle or right at the eye is settled from the
                     // point as above.
-                    const int rows = (n + kPacketWidth - 1) / kPacketWidth;
-                    const std::size_t padded = static_cast<std::size_t>(rows) * kPacketWidth;
-                    dirs.resize(padded);
-                    points.resize(padded);
-                    hits.resize(padded);
-                    if (found_size < padded) {
-                        found_size = std::max(padded, 2 * found_size);
-                        found.reset(new bool[found_size]);
-                    }
+                    auto state_of = [&](const Hit& hit, bool hit_found, const Vec3f& point) {
+                        if (!hit_found) return 0;
+                        if (hit.t >= settings.self_epsilon && !is_ignored(hit)) return 1;
+                        return count_occluders(context.accel, point, view.eye(), ignored_keys(),
+                                               settings);
+                    };
                     if (plan.first_ray >= 0) {
                         // Traced with the batch.
-                        for (std::size_t k = 0; k < static_cast<std::size_t>(n); ++k) {
-                            const auto at = static_cast<std::size_t>(plan.first_ray) + k;
-                            points[k] = batch_points[at];
-                            hits[k] = batch_hits[at];
-                            found[k] = batch_found[at];
+                        for (int k = 0; k < n; ++k) {
+                            const auto at = static_cast<std::size_t>(plan.first_ray + k);
+                            sample_states[static_cast<std::size_t>(k)] =
+                                state_of(batch_hits[at], batch_found[at], batch_points[at]);
                         }
                     } else {
+                        const int rows = (n + kPacketWidth - 1) / kPacketWidth;
+                        const std::size_t padded = static_cast<std::size_t>(rows) * kPacketWidth;
+                        dirs.resize(padded);
+                        points.resize(padded);
+                        hits.resize(padded);
+                        if (found_size < padded) {
+                            found_size = std::max(padded, 2 * found_size);
+                            found.reset(new bool[found_size]);
+                        }
                         for (int k = 0; k < n; ++k) {
                             const std::size_t at = static_cast<std::size_t>(k);
                             points[at] = seg.p0 + (seg.p1 - seg.p0) * c.t_of(sample_s(k));
@@ -365,16 +370,10 @@ std::vector<EdgePiece> split_by_visibility(std::span<const FeatureSegment> segme
                                                          rows, hits.data(), found.get(),
                                                          1.0f - settings.self_epsilon);
                         }
-                    }
-                    for (int k = 0; k < n; ++k) {
-                        const Hit& hit = hits[static_cast<std::size_t>(k)];
-                        if (!found[k]) sample_states[static_cast<std::size_t>(k)] = 0;
-                        else if (hit.t >= settings.self_epsilon && !is_ignored(hit))
-                            sample_states[static_cast<std::size_t>(k)] = 1;
-                        else
-                            sample_states[static_cast<std::size_t>(k)] =
-                                count_occluders(context.accel, points[static_cast<std::size_t>(k)],
-                                                view.eye(), ignored_keys(), settings);
+                        for (int k = 0; k < n; ++k) {
+                            const auto at = static_cast<std::size_t>(k);
+                            sample_states[at] = state_of(hits[at], found[at], points[at]);
+                        }
                     }
                 } else {
                     for (int k = 0; k < n; ++k)
