@@ -224,6 +224,41 @@ TEST(InstanceLines, MeshEdgesAreTheFlattenedScenes) {
     EXPECT_GT(smooth(inst), 50);
 }
 
+// Each instance's mesh edges come in the mesh's edge order, by welded ends (as the flattened
+// scene lists them), however the plane tree found them: here hundreds of silhouettes an
+// instance, of a faceted sphere (no vertex normals, so every silhouette is a mesh edge).
+TEST(InstanceLines, EachInstancesMeshEdgesComeInEdgeOrder) {
+    const auto smooth_ball = test_support::sphere_mesh(40, 80, 0);
+    auto ball = std::make_shared<TriangleMesh>();
+    ball->positions = smooth_ball->positions;
+    for (const auto& tri : smooth_ball->tri_positions) ball->add_triangle(tri, 0, 0);
+    Scene scene;
+    scene.materials.emplace_back("ball");
+    const std::uint32_t mesh = scene.add_mesh(ball);
+    for (int i = 0; i < 3; ++i)
+        scene.add_instance(mesh,
+                           test_support::placed(0, 1, 0, 0.4 * i, Vec3f(1.0f),
+                                                Vec3f(3.0f * static_cast<float>(i - 1), 0, 0)),
+                           "ball." + std::to_string(i));
+    const TriangleAccel accel = build_scene_accel(scene);
+    FeatureEdgeSettings settings;
+    settings.intersections = false;
+    for (const Vec3f& eye : {Vec3f(2, 3, 9), Vec3f(-7, -2, 4)}) {
+        InstanceLineCache cache;
+        const auto lines = instance_lines(scene, accel, test_support::looking_at(eye, Vec3f(0)),
+                                          cache, {}, settings);
+        std::map<std::uint32_t, std::vector<std::pair<std::uint32_t, std::uint32_t>>> ends;
+        for (const FeatureSegment& s : lines)
+            if (!s.smooth) ends[s.key0.instance].push_back({s.key0.a, s.key1.a});
+        ASSERT_EQ(ends.size(), 3u);
+        for (const auto& [instance, edges] : ends) {
+            EXPECT_GT(edges.size(), 100u) << instance;
+            EXPECT_TRUE(std::is_sorted(edges.begin(), edges.end())) << instance;
+            EXPECT_EQ(std::adjacent_find(edges.begin(), edges.end()), edges.end()) << instance;
+        }
+    }
+}
+
 TEST(InstanceLines, IntersectionsAreTheFlattenedScenes) {
     const Scene scene = test_support::instanced_test_scene();
     const Scene flat = flatten_instances(scene);

@@ -1,5 +1,6 @@
 #include "toonray/ink/instance_lines.h"
 
+#include <array>
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -550,11 +551,36 @@ Placement place(const Scene& scene, std::uint32_t i, const MeshLines* ml, const 
     return p;
 }
 
+// Puts `lines` in edge order, by a least-significant-digit radix sort on their orders (all
+// distinct) through `scratch`, a byte a pass for as many bytes as the largest order has. A
+// crowd's instance finds about 900 lines in random order; std::sort's comparisons mispredict
+// about half the time and took 2.4% of the frame (10,000 instances), this about a fifth of that.
+void sort_by_order(std::vector<MeshLines::EdgeLine>& lines,
+                   std::vector<MeshLines::EdgeLine>& scratch) {
+    if (lines.size() < 64) {
+        std::sort(lines.begin(), lines.end(),
+                  [](const auto& x, const auto& y) { return x.order < y.order; });
+        return;
+    }
+    std::uint32_t largest = 0;
+    for (const MeshLines::EdgeLine& line : lines) largest = std::max(largest, line.order);
+    scratch.resize(lines.size());
+    for (int shift = 0; shift < 32 && (largest >> shift) != 0; shift += 8) {
+        std::array<std::uint32_t, 257> start{};
+        for (const MeshLines::EdgeLine& line : lines) ++start[((line.order >> shift) & 0xff) + 1];
+        for (std::size_t b = 1; b < start.size(); ++b) start[b] += start[b - 1];
+        for (const MeshLines::EdgeLine& line : lines)
+            scratch[start[(line.order >> shift) & 0xff]++] = line;
+        lines.swap(scratch);
+    }
+}
+
 // The mesh edges and smooth contours of one instance, then the crossings within its mesh.
 void instance_segments(const Placement& pl, const ViewVolume* volume,
                        const FeatureEdgeSettings& settings, const InstanceLineOptions& options,
                        std::vector<FeatureSegment>& out, std::vector<FeatureSegment>& smooth,
-                       std::vector<MeshLines::EdgeLine>& edges_found) {
+                       std::vector<MeshLines::EdgeLine>& edges_found,
+                       std::vector<MeshLines::EdgeLine>& sort_scratch) {
     const MeshLines& ml = *pl.ml;
     const TriangleMesh& mesh = *ml.mesh;
     const Affine3& m = *pl.to_world;
@@ -667,8 +693,7 @@ void instance_segments(const Placement& pl, const ViewVolume* volume,
     // Mesh edges in the mesh's edge order (as the flattened scene lists them: chaining starts
     // strokes in segment order), whichever parts of the hierarchy were skipped; then the smooth
     // contours by triangle.
-    std::sort(edges_found.begin(), edges_found.end(),
-              [](const auto& x, const auto& y) { return x.order < y.order; });
+    sort_by_order(edges_found, sort_scratch);
     for (const MeshLines::EdgeLine& line : edges_found) {
         const MeshLines::Edge& e = *line.edge;
         FeatureSegment& seg = out.emplace_back();
@@ -924,7 +949,7 @@ void add_instance_segments(const Scene& scene, const TriangleAccel& accel, const
         static_cast<int>(count), kInstancesPerChunk, threads,
         [&](int i0, int i1, std::vector<FeatureSegment>& out) {
             std::vector<FeatureSegment> smooth;
-            std::vector<MeshLines::EdgeLine> edges_found;
+            std::vector<MeshLines::EdgeLine> edges_found, sort_scratch;
             for (int i = i0; i < i1; ++i) {
                 const auto u = static_cast<std::uint32_t>(i);
                 const ViewVolume* volume = nullptr;
@@ -933,7 +958,7 @@ void add_instance_segments(const Scene& scene, const TriangleAccel& accel, const
                     if (!view_volume->sees_all(world[u])) volume = view_volume;
                 }
                 instance_segments(place(scene, u, cache.of_instance[u], eye), volume, settings,
-                                  options, out, smooth, edges_found);
+                                  options, out, smooth, edges_found, sort_scratch);
             }
             if (visibility)
                 keep_drawn(out, piece_parts[static_cast<std::size_t>(i0 / kInstancesPerChunk)], 1);
