@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <memory>
 
 #include "toonray/core/portable_math.h"
@@ -107,7 +108,9 @@ constexpr int kPacketWidth = 4;
 // AVX2, 8 samples would still be faster one by one, but not on the teapot with AVX-512).
 constexpr int kSingleRays = 4;
 
-// Rays traced together from the short segments of a batch (a tile's most, 16 x 16).
+// A batch of segments: at most this many, and at most this many rays traced together from its
+// short segments (as tiles of kPacketWidth x 16, which the accelerator cuts the rows into).
+constexpr std::size_t kBatchSegments = 256;
 constexpr std::size_t kBatchRays = 256;
 
 // The part of one segment inside the view, as a line on the image: A + (B - A) s for s in
@@ -198,7 +201,8 @@ std::vector<EdgePiece> split_by_visibility(std::span<const FeatureSegment> segme
                                            const VisibilitySettings& settings, int threads) {
     const ScreenProjection& view = context.view;
     // Through an instance level, the rays of short segments are traced together, a batch of
-    // segments at a time, and share the top level's traversal (a crowd's visibility 0.93x CPU).
+    // segments at a time, and share the top level's traversal (the crowd of 10,000 instances:
+    // 0.93x to 0.94x the frame's CPU).
     // Without one they go one at a time: a tile of rays from different segments costs more
     // than it saves in one tree of triangles (1.08x on the piano).
     const bool batched = context.accel.instance_count() > 0;
@@ -227,8 +231,10 @@ std::vector<EdgePiece> split_by_visibility(std::span<const FeatureSegment> segme
             plans.clear();
             batch_dirs.clear();
             batch_points.clear();
-            // Segments up to a batch's rays (a short segment's samples never straddle two).
-            while (b1 < i1 && batch_dirs.size() + kSingleRays <= kBatchRays) {
+            // Segments up to a batch's count and rays (a short segment's samples never straddle
+            // two batches).
+            while (b1 < i1 && plans.size() < kBatchSegments &&
+                   batch_dirs.size() + kSingleRays <= kBatchRays) {
                 const FeatureSegment& seg = segments[static_cast<std::size_t>(b1++)];
                 SegmentPlan& plan = plans.emplace_back();
                 plan.in_view = clip_to_view(seg, view, settings.margin, plan.c);
@@ -317,11 +323,11 @@ std::vector<EdgePiece> split_by_visibility(std::span<const FeatureSegment> segme
                 auto sample_s = [&](int k) { return plan.sample_s(k); };
                 sample_states.resize(static_cast<std::size_t>(n));
                 if (settings.max_invisibility <= 1) {
-                    // Only hidden or not: the samples' rays are traced together, from the eye (one
-                    // origin, so a coherent packet) to each point at parameter 1. A first hit before
-                    // 1 - self_epsilon on a triangle that counts means hidden, none means visible;
-                    // a first hit on an ignored triangle or right at the eye is settled from the
-                    // point as above.
+                    // Only hidden or not: rays from the eye to each sample's point at parameter 1
+                    // (a short segment's with its batch, a longer one's as a tile of its own). A
+                    // first hit before 1 - self_epsilon on a triangle that counts means hidden,
+                    // none means visible; a first hit on an ignored triangle or right at the eye is
+                    // settled from the point as above.
                     auto state_of = [&](const Hit& hit, bool hit_found, const Vec3f& point) {
                         if (!hit_found) return 0;
                         if (hit.t >= settings.self_epsilon && !is_ignored(hit)) return 1;
@@ -458,7 +464,7 @@ std::vector<EdgePiece> split_by_visibility(std::span<const FeatureSegment> segme
     const auto count = static_cast<int>(segments.size());
     // On one thread the pieces go straight into one list: a crowd's instances, split a chunk
     // at a time, are otherwise copied out of their parts once more.
-    if (threads <= 1) {
+    if (threads == 1) {
         std::vector<EdgePiece> out;
         split(0, count, out);
         return out;
