@@ -207,9 +207,9 @@ void draw_ink_lines(const Scene& scene, const TriangleAccel& accel, const Camera
             add_vertex_rings(out.mesh);
     };
     add_rings_for(out.segments);
-    const VisibilityContext context{scene, out.mesh, accel, view, &out.instances};
+    const VisibilityContext visibility_context{scene, out.mesh, accel, view, &out.instances};
     InstanceVisibility instance_visibility{
-        visibility, split_by_visibility(out.segments, context, visibility, threads)};
+        visibility, split_by_visibility(out.segments, visibility_context, visibility, threads)};
     out.timings.visibility = seconds_since(start);
 
     // The instances' segments come with their pieces (their visibility is timed with the
@@ -264,7 +264,7 @@ void draw_ink_lines(const Scene& scene, const TriangleAccel& accel, const Camera
         std::span(out.segments).subspan(end_instance_segment);
     add_rings_for(rest);
     std::vector<std::vector<EdgePiece>> later(1);
-    later[0] = split_by_visibility(rest, context, visibility, threads);
+    later[0] = split_by_visibility(rest, visibility_context, visibility, threads);
     for (EdgePiece& piece : later[0])
         piece.segment += static_cast<std::uint32_t>(end_instance_segment);
     append_parts(later, out.pieces);

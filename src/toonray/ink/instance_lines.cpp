@@ -1,7 +1,7 @@
 #include "toonray/ink/instance_lines.h"
 
-#include <array>
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cmath>
 #include <limits>
