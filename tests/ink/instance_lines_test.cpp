@@ -387,12 +387,13 @@ TEST(InstanceLines, ChainingInPartsOfWholeInstancesGivesTheSameStrokes) {
 }
 
 // Short segments' rays are traced together, a batch of segments at a time; each segment's
-// pieces must be those it gets traced alone, on the own triangles and through instances.
+// pieces must be those it gets traced alone, on the own triangles and through instances, with
+// and without hidden pieces, and on any thread count (which cuts the batches differently).
 TEST(InstanceLines, ShortSegmentsTracedTogetherGiveThePiecesOfEachAlone) {
     const Scene scene = four_rows();
     const TriangleAccel accel = build_scene_accel(scene);
     const WeldedMesh own = weld_vertices(scene);
-    std::size_t short_segments = 0, hidden = 0, visible = 0;
+    std::size_t short_segments = 0, hidden = 0, visible = 0, dropped = 0;
     for (const Vec3f& eye : {Vec3f(9, 9, 16), Vec3f(-14, 5, 6)}) {
         const CameraSpec camera = test_support::looking_at(eye, Vec3f(0, 1, 0));
         const ViewPlane plane = make_view_plane(camera, 320, 200);
@@ -402,38 +403,50 @@ TEST(InstanceLines, ShortSegmentsTracedTogetherGiveThePiecesOfEachAlone) {
             find_feature_edges(scene, own, accel.bvh(), eye, FeatureEdgeSettings{}, 2);
         const auto instanced = instance_lines(scene, accel, camera, cache);
         segments.insert(segments.end(), instanced.begin(), instanced.end());
-        const VisibilityContext context{scene, own, accel, view, &cache};
-        VisibilitySettings visibility;
-        visibility.keep_hidden = true;
-        visibility.max_invisibility = 1;
-        const std::vector<EdgePiece> together =
-            split_by_visibility(segments, context, visibility, 1);
-        std::vector<EdgePiece> alone;
         for (std::size_t i = 0; i < segments.size(); ++i) {
-            const auto one =
-                split_by_visibility(std::span(segments).subspan(i, 1), context, visibility, 1);
-            for (EdgePiece piece : one) {
-                piece.segment = static_cast<std::uint32_t>(i);
-                alone.push_back(piece);
-            }
             const Point2 a = view.project(segments[i].p0), b = view.project(segments[i].p1);
             short_segments += std::hypot(a.x - b.x, a.y - b.y) < 3.0f;
         }
-        ASSERT_EQ(together.size(), alone.size());
-        for (std::size_t k = 0; k < alone.size(); ++k) {
-            EXPECT_EQ(together[k].segment, alone[k].segment) << k;
-            EXPECT_EQ(together[k].t0, alone[k].t0) << k;
-            EXPECT_EQ(together[k].t1, alone[k].t1) << k;
-            EXPECT_EQ(together[k].invisibility, alone[k].invisibility) << k;
-            EXPECT_EQ(together[k].key0, alone[k].key0) << k;
-            EXPECT_EQ(together[k].key1, alone[k].key1) << k;
-            (alone[k].visible() ? visible : hidden) += 1;
+        const VisibilityContext context{scene, own, accel, view, &cache};
+        for (const bool keep_hidden : {true, false}) {
+            VisibilitySettings visibility;
+            visibility.keep_hidden = keep_hidden;
+            visibility.max_invisibility = 1;
+            std::vector<EdgePiece> alone;
+            for (std::size_t i = 0; i < segments.size(); ++i) {
+                const auto one =
+                    split_by_visibility(std::span(segments).subspan(i, 1), context, visibility, 1);
+                for (EdgePiece piece : one) {
+                    piece.segment = static_cast<std::uint32_t>(i);
+                    alone.push_back(piece);
+                }
+            }
+            for (const int threads : {1, 2}) {
+                const std::vector<EdgePiece> together =
+                    split_by_visibility(segments, context, visibility, threads);
+                ASSERT_EQ(together.size(), alone.size()) << keep_hidden << " " << threads;
+                for (std::size_t k = 0; k < alone.size(); ++k) {
+                    EXPECT_EQ(together[k].segment, alone[k].segment) << k;
+                    EXPECT_EQ(together[k].t0, alone[k].t0) << k;
+                    EXPECT_EQ(together[k].t1, alone[k].t1) << k;
+                    EXPECT_EQ(together[k].invisibility, alone[k].invisibility) << k;
+                    EXPECT_EQ(together[k].key0, alone[k].key0) << k;
+                    EXPECT_EQ(together[k].key1, alone[k].key1) << k;
+                }
+            }
+            if (keep_hidden) {
+                for (const EdgePiece& piece : alone) (piece.visible() ? visible : hidden) += 1;
+                dropped += alone.size();
+            } else {
+                dropped -= alone.size();  // the hidden pieces that were not kept
+            }
         }
     }
-    // Many batches of short segments, both hidden and seen.
+    // Many batches of short segments, both hidden and seen; without hidden pieces, many fewer.
     EXPECT_GT(short_segments, 2000u);
     EXPECT_GT(hidden, 500u);
     EXPECT_GT(visible, 500u);
+    EXPECT_GT(dropped, 500u);
 }
 
 TEST(InstanceLines, VisibilityAsTheSegmentsAreFoundKeepsTheirPiecesOnly) {
