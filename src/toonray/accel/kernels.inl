@@ -68,15 +68,9 @@ TR_INLINE LaneResultT<V, M> finish(const EdgesT<V, M>& e, V akz, V bkz, V ckz, V
     const V det = e.e0 + e.e1 + e.e2;
     const V az = sz * akz, bz = sz * bkz, cz = sz * ckz;
     const V st = e.e0 * az + e.e1 * bz + e.e2 * cz;
-    const V bound = tmax * det * splat<V>(kTmaxSlack);
-    // On live lanes without a zero, det is nonzero with the edges' sign; flipping st and bound
-    // by it turns the scalar test's det < 0 case into its det > 0 case exactly.
-    const V sign = sign_bits(det);
-    const V st1 = flip_sign(st, sign), bound1 = flip_sign(bound, sign);
-    const M rej = (st1 <= zero) | (st1 > bound1);
     const V inv = splat<V>(1.0f) / det;
     const V t = st * inv;
-    const M ok = andnot(e.zero | (det == zero) | rej, (t > zero) & (t <= tmax) & e.live);
+    const M ok = andnot(e.zero | (det == zero), (t > zero) & (t <= tmax) & e.live);
     return {ok, e.zero, t, e.e1 * inv, e.e2 * inv};
 }
 TR_INLINE LaneResult finish8(const Edges& e, vf8 akz, vf8 bkz, vf8 ckz, vf8 sz, vf8 tmax) {

@@ -53,8 +53,6 @@ TR_INLINE vm8 as_mask(vf8 a) { return {a.m}; }  // the sign bits are the mask
 TR_INLINE vm8 not_mask(vm8 a) {
     return {_mm256_xor_ps(a.m, _mm256_castsi256_ps(_mm256_set1_epi32(-1)))};
 }
-TR_INLINE vf8 sign_bits(vf8 a) { return {_mm256_and_ps(a.m, _mm256_set1_ps(-0.0f))}; }
-TR_INLINE vf8 flip_sign(vf8 a, vf8 sign) { return {_mm256_xor_ps(a.m, sign.m)}; }
 TR_INLINE vm8 mask_from_bits(int bits) {
     const __m256i lane = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
     return {_mm256_castsi256_ps(
@@ -144,13 +142,6 @@ TR_INLINE vm8 not_mask(vm8 a) {
     const __m128 ones = _mm_castsi128_ps(_mm_set1_epi32(-1));
     return {_mm_xor_ps(a.l, ones), _mm_xor_ps(a.h, ones)};
 }
-TR_INLINE vf8 sign_bits(vf8 a) {
-    const __m128 s = _mm_set1_ps(-0.0f);
-    return {_mm_and_ps(a.l, s), _mm_and_ps(a.h, s)};
-}
-TR_INLINE vf8 flip_sign(vf8 a, vf8 sign) {
-    return {_mm_xor_ps(a.l, sign.l), _mm_xor_ps(a.h, sign.h)};
-}
 TR_INLINE vm8 mask_from_bits(int bits) {
     const __m128i lo = _mm_setr_epi32(1, 2, 4, 8), hi = _mm_setr_epi32(16, 32, 64, 128);
     const __m128i b = _mm_set1_epi32(bits);
@@ -223,8 +214,6 @@ TR_INLINE vm4 andnot(vm4 a, vm4 b) { return {_mm_andnot_ps(a.m, b.m)}; }
 TR_INLINE int movemask(vm4 a) { return _mm_movemask_ps(a.m); }
 TR_INLINE vm4 as_mask(vf4 a) { return {a.m}; }
 TR_INLINE vm4 not_mask(vm4 a) { return {_mm_xor_ps(a.m, _mm_castsi128_ps(_mm_set1_epi32(-1)))}; }
-TR_INLINE vf4 sign_bits(vf4 a) { return {_mm_and_ps(a.m, _mm_set1_ps(-0.0f))}; }
-TR_INLINE vf4 flip_sign(vf4 a, vf4 sign) { return {_mm_xor_ps(a.m, sign.m)}; }
 
 template <class V>
 TR_INLINE V splat(float f);

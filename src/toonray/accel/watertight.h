@@ -39,9 +39,6 @@ struct ShearedRay {
     }
 };
 
-// The tmax filter's slack: rounding of tmax * det must not reject a hit at exactly tmax.
-inline constexpr float kTmaxSlack = 1.0f + 1.0f / (1 << 20);
-
 inline bool watertight_test(const ShearedRay& r, const Vec3f& v0, const Vec3f& v1, const Vec3f& v2,
                             float tmax, float& t, float& u, float& v) {
     const Vec3f a = v0 - r.origin, b = v1 - r.origin, c = v2 - r.origin;
@@ -62,12 +59,10 @@ inline bool watertight_test(const ShearedRay& r, const Vec3f& v0, const Vec3f& v
     if (det == 0.0f) return false;
     const float az = r.sz * a[r.kz], bz = r.sz * b[r.kz], cz = r.sz * c[r.kz];
     const float scaled_t = e0 * az + e1 * bz + e2 * cz;
-    // Reject most misses before the division, on scaled values with some slack; the exact
-    // test is on t below.
-    const float bound = tmax * det * kTmaxSlack;
-    if (det > 0.0f ? (scaled_t <= 0.0f || scaled_t > bound)
-                   : (scaled_t >= 0.0f || scaled_t < bound))
-        return false;
+    // Only t itself is tested, after the division. A cheaper test of scaled_t against
+    // tmax * det, with relative slack, fails where those products fall among the denormals:
+    // it then rejected hits at exactly tmax, so a tie went to whichever triangle was met first
+    // rather than to the lower index.
     const float inv = 1.0f / det;
     t = scaled_t * inv;
     u = e1 * inv;
