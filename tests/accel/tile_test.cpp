@@ -208,11 +208,11 @@ TEST(Tile, TiesAmongTheDenormalsGoToTheLowerIndex) {
     }
 }
 
-// Open (docs/robustness.md): copies of a long triangle seen almost along its plane from far
-// away. The computed t lies more than the box culling's 2^-20 before the triangles' box, so
-// the single ray, having found one copy, culls the copy with the lower index; the tile finds
-// it. Found by the render fuzzer.
-TEST(Tile, DISABLED_TiesOnATriangleSeenEdgeOn) {
+// Copies of a long triangle seen almost along its plane from far away (the render fuzzer's
+// find). The computed t lay more than the box culling's 2^-20 before the triangles' box, so the
+// single ray, having found one copy, culled the copy with the lower index, which the tile
+// found. A hit's t is now held to its triangle's box (held_to_box in watertight.h).
+TEST(Tile, TiesOnATriangleSeenEdgeOnGoToTheLowerIndex) {
     Soup s;
     s.positions = {{0.0f, 0.0f, 0.0f}, {0.0f, 9.0f, 2233721.0f}, {54.0f, 5.0f, 3.0f}};
     s.tris = {{0, 1, 2}, {0, 2, 1}, {0, 1, 2}, {0, 2, 1}, {0, 1, 2},

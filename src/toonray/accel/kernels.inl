@@ -7,7 +7,8 @@
 // Exactness: every lane of the triangle tests does the float operations of watertight_test()
 // in its order (no FMA: the translation units turn contraction off); lanes whose edge
 // functions hit an exact zero (which the scalar test redoes in double) are handed to
-// watertight_test() itself. A hit is taken by BestHit's rule, so the result is the lowest
+// watertight_test() itself. A hit is taken by BestHit's rule, with its t held to its
+// triangle's box as watertight_test() holds it (held_to_box), so the result is the lowest
 // (t, triangle index) over the triangles whose test passes, which does not depend on traversal
 // order. occluded1 stops at any lane that BestHit would take as a first hit (0 < t < tmax), so
 // it answers exactly whether intersect1 finds one. Box culling is conservative: the far
@@ -77,6 +78,20 @@ TR_INLINE LaneResult finish8(const Edges& e, vf8 akz, vf8 bkz, vf8 ckz, vf8 sz, 
     return finish<vf8, vm8>(e, akz, bkz, ckz, sz, tmax);
 }
 
+// box_entry() of watertight.h on 8 lanes (vmin and vmax are minps and maxps, whose operand
+// order lane_min and lane_max follow). Hits are held to it (held_to_box) only where one would
+// be taken: a t that rises can only lose, so the others are settled without it.
+TR_INLINE vf8 box_entry8(const vf8 (&p)[3][3], const vf8 (&inv)[3]) {
+    vf8 entry;
+    for (int axis = 0; axis < 3; ++axis) {
+        vf8 d = p[0][axis] * inv[axis];
+        d = vmin(p[1][axis] * inv[axis], d);
+        d = vmin(p[2][axis] * inv[axis], d);
+        entry = axis == 0 ? d : vmax(d, entry);
+    }
+    return entry;
+}
+
 inline float as_float(std::uint32_t u) {
     float f;
     std::memcpy(&f, &u, 4);
@@ -96,7 +111,20 @@ struct LeafRay {
     ShearedRay sr;
     int ox, oy, oz;  // offsets of the kx, ky, kz rows in a TriBlock corner, in floats
     float o[3];      // origin[kx], origin[ky], origin[kz]
+    float inv[3];    // 1 / dir[kx], 1 / dir[ky], 1 / dir[kz]
 };
+
+// Lane i's t of a window held to its triangle's box (held_to_box in watertight.h).
+TR_INLINE float lane_held_to_box(float t, const LeafRay& lr, const TriBlock& b0, const TriBlock& b1,
+                                 int i) {
+    const TriBlock& b = i < 4 ? b0 : b1;
+    const int l = i & 3;
+    const int k[3] = {lr.sr.kx, lr.sr.ky, lr.sr.kz};
+    float p[3][3];
+    for (int c = 0; c < 3; ++c)
+        for (int r = 0; r < 3; ++r) p[c][r] = b.v[c][k[r]][l] - lr.o[r];
+    return held_to_box(t, p, lr.inv);
+}
 
 constexpr std::uint32_t kPrimMask = ~kLeafEnd;
 
@@ -118,9 +146,11 @@ TR_INLINE void leaf_zero_lanes(int zero, const TriBlock& b0, const TriBlock& b1,
     }
 }
 
+// Takes the lanes `ok` that BestHit's rule takes, each with its t held to its box (which only
+// raises t: a lane the rule refuses before is refused after).
 template <class V, class M>
 TR_INLINE void take_lanes(int ok, const LaneResultT<V, M>& r, const TriBlock& b0,
-                          const TriBlock& b1, BestHit& best) {
+                          const TriBlock& b1, const LeafRay& lr, BestHit& best) {
     alignas(32) float ts[8], us[8], vs[8];
     if constexpr (sizeof(V) == sizeof(vf8)) {
         store8(ts, r.t);
@@ -135,7 +165,9 @@ TR_INLINE void take_lanes(int ok, const LaneResultT<V, M>& r, const TriBlock& b0
         int i = __builtin_ctz(static_cast<unsigned>(ok));
         ok &= ok - 1;
         std::uint32_t prim = (i < 4 ? b0.prim[i] : b1.prim[i - 4]) & kPrimMask;
-        if (best.takes(ts[i], prim)) best.take(ts[i], prim, us[i], vs[i]);
+        if (!best.takes(ts[i], prim)) continue;
+        const float t = lane_held_to_box(ts[i], lr, b0, b1, i);
+        if (best.takes(t, prim)) best.take(t, prim, us[i], vs[i]);
     } while (ok);
 }
 
@@ -218,7 +250,7 @@ __attribute__((noinline)) void leaf1(const WideBvh& w, std::uint32_t ref, const 
                  [&](const auto& r, int valid, const TriBlock& b0, const TriBlock& b1) {
                      const int ok = movemask(r.ok) & valid;
                      const int zero = movemask(r.zero) & valid;
-                     if (ok) take_lanes(ok, r, b0, b1, best);
+                     if (ok) take_lanes(ok, r, b0, b1, lr, best);
                      if (zero) leaf_zero_lanes(zero, b0, b1, lr.sr, best);
                      return false;
                  });
@@ -231,8 +263,17 @@ __attribute__((noinline)) bool leaf_occluded(const WideBvh& w, std::uint32_t ref
     bool hit = false;
     leaf_windows(w, ref, lr, tmax,
                  [&](const auto& r, int valid, const TriBlock& b0, const TriBlock& b1) {
-                     if (movemask(r.ok & (r.t < splat<decltype(r.t)>(tmax))) & valid)
-                         return hit = true;
+                     int below = movemask(r.ok & (r.t < splat<decltype(r.t)>(tmax))) & valid;
+                     if (below) {
+                         alignas(32) float ts[8];
+                         if constexpr (sizeof(r.t) == sizeof(vf8)) store8(ts, r.t);
+                         else store4(ts, r.t);
+                         do {
+                             const int i = __builtin_ctz(static_cast<unsigned>(below));
+                             below &= below - 1;
+                             if (lane_held_to_box(ts[i], lr, b0, b1, i) < tmax) return hit = true;
+                         } while (below);
+                     }
                      int zero = movemask(r.zero) & valid;
                      while (zero) {
                          const int i = __builtin_ctz(static_cast<unsigned>(zero));
@@ -262,6 +303,9 @@ TR_INLINE LeafRay leaf_ray(const Ray& ray) {
     lr.o[0] = ray.origin[lr.sr.kx];
     lr.o[1] = ray.origin[lr.sr.ky];
     lr.o[2] = ray.origin[lr.sr.kz];
+    lr.inv[0] = lr.sr.ix;
+    lr.inv[1] = lr.sr.iy;
+    lr.inv[2] = lr.sr.sz;
     return lr;
 }
 
@@ -274,7 +318,8 @@ struct RayBoxes {
 #ifdef TOONRAY_ACCEL_FMA
     // Slab distances as one fused multiply-add per plane, t = p * inv + c with c = -o * inv,
     // made conservative in the constants: c's rounding error is at most |c| 2^-24, so near
-    // planes use c - |c| 2^-21 and far planes c + |c| 2^-21; the far distance is then widened
+    // planes use c - |c| 2^-21 - 2^-146 and far planes c + |c| 2^-21 + 2^-146 (the absolute
+    // term for the denormals, whose roundings are absolute); the far distance is then widened
     // by kBoxSlack as in the plain test. (Infinite or NaN terms give NaN, which never culls.)
     // This visits other boxes than the SSE kernels' two-rounding test, but both only widen the
     // exact slab interval (by far less than kBoxSlack), so neither culls a box that holds the
@@ -298,7 +343,9 @@ struct RayBoxes {
         for (int a = 0; a < 3; ++a) {
 #ifdef TOONRAY_ACCEL_FMA
             const float c = -(ray.origin[a] * inv[a]);
-            const float margin = std::abs(c) * (1.0f / (1 << 21));
+            // Plus a few of the smallest denormals, where the relative margin vanishes and the
+            // roundings do not.
+            const float margin = std::abs(c) * (1.0f / (1 << 21)) + 0x1p-146f;
             in8[a] = set1(inv[a]);
             cn8[a] = set1(c - margin);
             cf8[a] = set1(c + margin);
@@ -600,6 +647,7 @@ constexpr int kMaxGroups = 32;
 
 struct alignas(32) TileState {
     float sx[kMaxGroups][8], sy[kMaxGroups][8], sz[kMaxGroups][8];
+    float ix[kMaxGroups][8], iy[kMaxGroups][8];  // 1 / dir[kx], 1 / dir[ky]
     float tmax[kMaxGroups][8], u[kMaxGroups][8], v[kMaxGroups][8];
     std::uint32_t prim[kMaxGroups][8];
     float ilo[3][kMaxGroups], ihi[3][kMaxGroups];  // per group, per axis: range of 1 / dir
@@ -626,6 +674,8 @@ TR_INLINE void group_zero_lanes(int zero, TileState& s, int g, const Vec3f& orig
         sr.sx = s.sx[g][i];
         sr.sy = s.sy[g][i];
         sr.sz = s.sz[g][i];
+        sr.ix = s.ix[g][i];
+        sr.iy = s.iy[g][i];
         sr.origin = origin;
         const BestHit bh{s.tmax[g][i], s.prim[g][i], s.u[g][i], s.v[g][i]};
         float t, u, v;
@@ -670,9 +720,18 @@ TR_INLINE void leaf_groups(const WideBvh& w, std::uint32_t ref, TileState& s, st
             const vf8 tmax = load8(s.tmax[g]);
             const LaneResult r = finish8(e, a[0][2], a[1][2], a[2][2], load8(s.sz[g]), tmax);
             const vi8 prim = loadi8(s.prim[g]), pv = seti1(p);
-            const vm8 take = r.ok & ((r.t < tmax) | andnot(eqi(prim, none), lt_signed(pv, prim)));
+            const vm8 lower = andnot(eqi(prim, none), lt_signed(pv, prim));
+            vm8 take = r.ok & ((r.t < tmax) | lower);
+            vf8 t = r.t;
             if (movemask(take)) {
-                store8(s.tmax[g], select(take, r.t, tmax));
+                // Held to the triangle's box, a t can only rise: take again.
+                const vf8 inv[3] = {load8(s.ix[g]), load8(s.iy[g]), load8(s.sz[g])};
+                const vf8 bound = box_entry8(a, inv) * set1(kEntrySlack);
+                t = select(t < bound, bound, t);
+                take = take & (t <= tmax) & ((t < tmax) | lower);
+            }
+            if (movemask(take)) {
+                store8(s.tmax[g], select(take, t, tmax));
                 store8(s.u[g], select(take, r.u, load8(s.u[g])));
                 store8(s.v[g], select(take, r.v, load8(s.v[g])));
                 storei8(s.prim[g], selecti(take, pv, prim));
@@ -734,7 +793,9 @@ TR_INLINE bool setup_group(TileState& s, int g, const float (&d)[3][8], TileSign
     s.cls[g] = kz * 2 + (neg[kz] ? 1 : 0);
     store8(s.sx[g], dv[kx] / dv[kz]);
     store8(s.sy[g], dv[ky] / dv[kz]);
-    store8(s.sz[g], set1(1.0f) / dv[kz]);
+    store8(s.sz[g], iv[kz]);
+    store8(s.ix[g], iv[kx]);
+    store8(s.iy[g], iv[ky]);
     for (int a = 0; a < 3; ++a) {
         s.ilo[a][g] = hmin(iv[a]);
         s.ihi[a][g] = hmax(iv[a]);

@@ -22,7 +22,8 @@ namespace {
 // depth). Exact zeros are re-evaluated in double, as the paper prescribes.
 struct ShearedRay {
     int kx, ky, kz;
-    float sx, sy, sz;
+    float sx, sy, sz;  // sz = 1 / dir[kz]
+    float ix, iy;      // 1 / dir[kx], 1 / dir[ky]
     Vec3f origin;
 
     ShearedRay() = default;
@@ -36,8 +37,48 @@ struct ShearedRay {
         sx = dir[kx] / dir[kz];
         sy = dir[ky] / dir[kz];
         sz = 1.0f / dir[kz];
+        ix = 1.0f / dir[kx];
+        iy = 1.0f / dir[ky];
     }
 };
+
+// The min and max of the SIMD kernels (minps, maxps): the first operand when it compares less
+// (greater), else the second. Written as compares, every build picks the same value, NaN or
+// signed zero.
+inline float lane_min(float a, float b) { return a < b ? a : b; }
+inline float lane_max(float a, float b) { return a > b ? a : b; }
+
+// Where the ray enters the triangle's bounding box: per axis the nearest corner's slab
+// distance, the least of (corner - origin) * (1 / dir) over the corners, and the farthest of
+// the three axes. `p` holds the corners relative to the origin in the ray's kx, ky, kz order,
+// `inv` the inverse direction in that order. The SIMD kernels do the same operations lane by
+// lane.
+inline float box_entry(const float (&p)[3][3], const float (&inv)[3]) {
+    float entry = 0.0f;
+    for (int axis = 0; axis < 3; ++axis) {
+        float d = p[0][axis] * inv[axis];
+        d = lane_min(p[1][axis] * inv[axis], d);
+        d = lane_min(p[2][axis] * inv[axis], d);
+        entry = axis == 0 ? d : lane_max(d, entry);
+    }
+    return entry;
+}
+
+// A hit's t is raised to the ray's entry into the triangle's box, less this fraction. The
+// traversal culls a box that the ray enters beyond the best t (widened by kBoxSlack), which is
+// only safe if no triangle's t lies before its box. For a triangle seen almost edge-on, far
+// away, the computed t can: its error grows with the triangle's depth along the ray, and two
+// traversals then disagreed on a tie (one culled the box of the lower index). With t held to
+// its box, every box holding a hit at the best t is entered within kBoxSlack of it (the box
+// tests round no more than this slack and kBoxSlack allow). Well-conditioned hits lie well
+// within it and keep their t.
+inline constexpr float kEntrySlack = 1.0f - 1.0f / (1 << 21);
+
+// t held to the triangle's box: at least box_entry(p, inv) * kEntrySlack.
+inline float held_to_box(float t, const float (&p)[3][3], const float (&inv)[3]) {
+    const float bound = box_entry(p, inv) * kEntrySlack;
+    return t < bound ? bound : t;
+}
 
 inline bool watertight_test(const ShearedRay& r, const Vec3f& v0, const Vec3f& v1, const Vec3f& v2,
                             float tmax, float& t, float& u, float& v) {
@@ -67,7 +108,12 @@ inline bool watertight_test(const ShearedRay& r, const Vec3f& v0, const Vec3f& v
     t = scaled_t * inv;
     u = e1 * inv;
     v = e2 * inv;
-    return t > 0.0f && t <= tmax;
+    if (!(t > 0.0f)) return false;
+    const float corners[3][3] = {
+        {a[r.kx], a[r.ky], a[r.kz]}, {b[r.kx], b[r.ky], b[r.kz]}, {c[r.kx], c[r.ky], c[r.kz]}};
+    const float inv_dir[3] = {r.ix, r.iy, r.sz};
+    t = held_to_box(t, corners, inv_dir);
+    return t <= tmax;
 }
 
 // The box tests' slack on the far distance (pbrt's 1 + 2 gamma(3), rounded up): rounding never
