@@ -257,6 +257,26 @@ TEST(Instances, WithoutOwnTrianglesAndAxisAlignedViews) {
     EXPECT_GT(hits, 200);
 }
 
+TEST(Instances, TiesOnATriangleSeenEdgeOnGoToTheOwnTrianglesThenTheLowestInstance) {
+    // The render fuzzer's copies of a long triangle seen almost along its plane from far away
+    // (Tile.TiesOnATriangleSeenEdgeOnGoToTheLowerIndex), as the own triangles and as two
+    // instances in the same place: every hit ties three ways, and each tile, single ray and
+    // occlusion query must agree with brute force.
+    Soup s;
+    s.positions = {{0.0f, 0.0f, 0.0f}, {0.0f, 9.0f, 2233721.0f}, {54.0f, 5.0f, 3.0f}};
+    s.tris = {{0, 1, 2}, {0, 2, 1}, {0, 1, 2}, {0, 2, 1}, {0, 1, 2},
+              {0, 2, 1}, {0, 1, 2}, {0, 2, 2}, {0, 2, 1}, {0, 1, 2}};
+    const auto a = accel_of(s);
+    const std::vector<Placed> placed{{&s, Affine3{}}, {&s, Affine3{}}};
+    TriangleAccel accel;
+    accel.build(s.positions, s.tris);
+    accel.set_instances(accel_instances(placed, a, s, a));
+    int hits = 0;
+    check_view(accel, &s, placed, auto_camera(s.positions, 24, 16), 24, 16, 1,
+               std::numeric_limits<float>::infinity(), hits);
+    EXPECT_GE(hits, 1);  // the triangle is edge-on: a pixel
+}
+
 TEST(Instances, TiesGoToTheOwnTrianglesThenTheLowestInstance) {
     const Soup grid = random_soup(50, 5, 0.4f);
     const auto a = accel_of(grid);

@@ -223,7 +223,54 @@ TEST(Tile, TiesOnATriangleSeenEdgeOnGoToTheLowerIndex) {
     for (const std::string& isa : isas()) {
         IsaGuard guard(isa);
         SCOPED_TRACE(isa);
-        check_view(s, accel, view, 24, 16, 24, 16, 1);
+        int hits = 0;
+        check_view(s, accel, view, 24, 16, 24, 16, 1, &hits);
+        EXPECT_GE(hits, 1);  // the triangle is edge-on: a pixel
+        // Occlusion by the same held t: a hit strictly inside tmax only.
+        for (int y = 0; y < 16; ++y)
+            for (int x = 0; x < 24; ++x) {
+                const Vec3f dir = normalize(view.pixel_point(x + 0.5f, y + 0.5f) - view.eye);
+                Hit hit;
+                if (!accel.intersect(Ray{view.eye, dir}, hit)) continue;
+                EXPECT_FALSE(accel.occluded(Ray{view.eye, dir, hit.t})) << x << "," << y;
+                EXPECT_TRUE(accel.occluded(Ray{
+                    view.eye, dir, std::nextafter(hit.t, std::numeric_limits<float>::infinity())}))
+                    << x << "," << y;
+            }
+    }
+}
+
+TEST(Tile, AxisAlignedRaysOnTriangleEdgesAndCornersHit) {
+    // Rays straight down onto a square's edges, diagonal and corners: their zero direction
+    // components make a corner's slab distance 0 * inf, which the box entry must ignore as the
+    // box tests do (it once made the entry infinite and lost these hits).
+    Soup s;
+    s.positions = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+    s.tris = {{2, 0, 1}, {0, 2, 3}};
+    TriangleAccel accel;
+    accel.build(s.positions, s.tris);
+    struct Expected {
+        float x, y;
+        std::uint32_t prim;
+    };
+    // Triangle 0 is the half below the diagonal, 1 the half above; ties go to 0.
+    const Expected cases[] = {{0.5f, 0.0f, 0},   {0.5f, 0.5f, 0}, {1.0f, 1.0f, 0}, {0.0f, 0.0f, 0},
+                              {0.25f, 0.75f, 1}, {0.0f, 0.5f, 1}, {0.5f, 1.0f, 1}, {1.0f, 0.5f, 0}};
+    for (const std::string& isa : isas()) {
+        IsaGuard guard(isa);
+        for (const Expected& c : cases) {
+            SCOPED_TRACE(isa + " at " + std::to_string(c.x) + "," + std::to_string(c.y));
+            const Ray ray{Vec3f(c.x, c.y, 1.0f), Vec3f(0.0f, 0.0f, -1.0f)};
+            Hit hit;
+            ASSERT_TRUE(accel.intersect(ray, hit));
+            EXPECT_EQ(hit.t, 1.0f);
+            EXPECT_EQ(hit.prim, c.prim);
+            const Hit expected = brute_force(s, ray);
+            EXPECT_EQ(expected.prim, c.prim);
+            EXPECT_EQ(expected.t, 1.0f);
+            EXPECT_TRUE(accel.occluded(Ray{ray.origin, ray.dir, 1.5f}));
+            EXPECT_FALSE(accel.occluded(Ray{ray.origin, ray.dir, 1.0f}));
+        }
     }
 }
 

@@ -21,7 +21,9 @@ constexpr int kNearHi[3] = {24, 32, 40};  // offsets of hi[axis]
 
 template <class V, class M>
 struct LaneResultT {
-    M ok;    // hit with 0 < t <= tmax (and no exact zero edge function)
+    M ok;    // hit with 0 < t <= tmax (and no exact zero edge function), t not yet held to the
+             // triangle's box (held_to_box): a lane that is not ok fails the scalar test, one
+             // that is may still fail it
     M zero;  // an edge function is exactly zero: redo in scalar
     V t, u, v;
 };
@@ -78,16 +80,20 @@ TR_INLINE LaneResult finish8(const Edges& e, vf8 akz, vf8 bkz, vf8 ckz, vf8 sz, 
     return finish<vf8, vm8>(e, akz, bkz, ckz, sz, tmax);
 }
 
-// box_entry() of watertight.h on 8 lanes (vmin and vmax are minps and maxps, whose operand
-// order lane_min and lane_max follow). Hits are held to it (held_to_box) only where one would
-// be taken: a t that rises can only lose, so the others are settled without it.
-TR_INLINE vf8 box_entry8(const vf8 (&p)[3][3], const vf8 (&inv)[3]) {
-    vf8 entry;
+// box_entry() of watertight.h for a regular tile group (finite, non-zero inverse directions)
+// on 8 lanes, for corners `p`: per axis the least product of a corner and the inverse
+// direction. Multiplying by a positive number keeps the corners' order and by a negative one
+// reverses it, so that is the product of the corner box_entry picks, whenever the lane can be
+// a hit (a NaN corner makes its t NaN; a zero product's sign does not matter to a positive t).
+// vmin and vmax are minps and maxps. Hits are held to it (held_to_box) only where one would be
+// taken: a t that rises can only lose, so the others are settled without it.
+TR_INLINE vf8 group_box_entry(const vf8 (&p)[3][3], const vf8 (&inv)[3]) {
+    vf8 entry = set1(0.0f);
     for (int axis = 0; axis < 3; ++axis) {
         vf8 d = p[0][axis] * inv[axis];
         d = vmin(p[1][axis] * inv[axis], d);
         d = vmin(p[2][axis] * inv[axis], d);
-        entry = axis == 0 ? d : vmax(d, entry);
+        entry = vmax(d, entry);
     }
     return entry;
 }
@@ -111,7 +117,6 @@ struct LeafRay {
     ShearedRay sr;
     int ox, oy, oz;  // offsets of the kx, ky, kz rows in a TriBlock corner, in floats
     float o[3];      // origin[kx], origin[ky], origin[kz]
-    float inv[3];    // 1 / dir[kx], 1 / dir[ky], 1 / dir[kz]
 };
 
 // Lane i's t of a window held to its triangle's box (held_to_box in watertight.h).
@@ -123,7 +128,8 @@ TR_INLINE float lane_held_to_box(float t, const LeafRay& lr, const TriBlock& b0,
     float p[3][3];
     for (int c = 0; c < 3; ++c)
         for (int r = 0; r < 3; ++r) p[c][r] = b.v[c][k[r]][l] - lr.o[r];
-    return held_to_box(t, p, lr.inv);
+    const float inv[3] = {lr.sr.ix, lr.sr.iy, lr.sr.sz};
+    return held_to_box(t, p, inv);
 }
 
 constexpr std::uint32_t kPrimMask = ~kLeafEnd;
@@ -303,9 +309,6 @@ TR_INLINE LeafRay leaf_ray(const Ray& ray) {
     lr.o[0] = ray.origin[lr.sr.kx];
     lr.o[1] = ray.origin[lr.sr.ky];
     lr.o[2] = ray.origin[lr.sr.kz];
-    lr.inv[0] = lr.sr.ix;
-    lr.inv[1] = lr.sr.iy;
-    lr.inv[2] = lr.sr.sz;
     return lr;
 }
 
@@ -726,7 +729,7 @@ TR_INLINE void leaf_groups(const WideBvh& w, std::uint32_t ref, TileState& s, st
             if (movemask(take)) {
                 // Held to the triangle's box, a t can only rise: take again.
                 const vf8 inv[3] = {load8(s.ix[g]), load8(s.iy[g]), load8(s.sz[g])};
-                const vf8 bound = box_entry8(a, inv) * set1(kEntrySlack);
+                const vf8 bound = group_box_entry(a, inv) * set1(kEntrySlack);
                 t = select(t < bound, bound, t);
                 take = take & (t <= tmax) & ((t < tmax) | lower);
             }

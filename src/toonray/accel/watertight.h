@@ -43,23 +43,24 @@ struct ShearedRay {
 };
 
 // The min and max of the SIMD kernels (minps, maxps): the first operand when it compares less
-// (greater), else the second. Written as compares, every build picks the same value, NaN or
-// signed zero.
+// (greater), else the second (so the second when either is NaN). Written as compares, every
+// build picks the same value.
 inline float lane_min(float a, float b) { return a < b ? a : b; }
 inline float lane_max(float a, float b) { return a > b ? a : b; }
 
-// Where the ray enters the triangle's bounding box: per axis the nearest corner's slab
-// distance, the least of (corner - origin) * (1 / dir) over the corners, and the farthest of
-// the three axes. `p` holds the corners relative to the origin in the ray's kx, ky, kz order,
-// `inv` the inverse direction in that order. The SIMD kernels do the same operations lane by
-// lane.
+// Where the ray enters the triangle's bounding box, as the box tests find a box's entry: per
+// axis the corner nearest along the ray (the lowest, or the highest when the inverse direction's
+// sign bit is set, so that -0 counts as negative as -inf does) times the inverse direction, and
+// the farthest of those and 0. A NaN (a corner in the plane of a direction component that is
+// zero: 0 * inf) is ignored, as the box tests ignore it. `p` holds the corners relative to the
+// origin in the ray's kx, ky, kz order, `inv` the inverse direction in that order. The SIMD
+// kernels do the same operations lane by lane.
 inline float box_entry(const float (&p)[3][3], const float (&inv)[3]) {
     float entry = 0.0f;
     for (int axis = 0; axis < 3; ++axis) {
-        float d = p[0][axis] * inv[axis];
-        d = lane_min(p[1][axis] * inv[axis], d);
-        d = lane_min(p[2][axis] * inv[axis], d);
-        entry = axis == 0 ? d : lane_max(d, entry);
+        const float lo = lane_min(lane_min(p[0][axis], p[1][axis]), p[2][axis]);
+        const float hi = lane_max(lane_max(p[0][axis], p[1][axis]), p[2][axis]);
+        entry = lane_max((std::signbit(inv[axis]) ? hi : lo) * inv[axis], entry);
     }
     return entry;
 }
