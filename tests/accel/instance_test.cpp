@@ -275,6 +275,12 @@ TEST(Instances, TiesOnATriangleSeenEdgeOnGoToTheOwnTrianglesThenTheLowestInstanc
     check_view(accel, &s, placed, auto_camera(s.positions, 24, 16), 24, 16, 1,
                std::numeric_limits<float>::infinity(), hits);
     EXPECT_GE(hits, 1);  // the triangle is edge-on: a pixel
+    // Without the own triangles the tie is between the instances.
+    TriangleAccel instances_only;
+    instances_only.set_instances(accel_instances(placed, a, s, a));
+    check_view(instances_only, nullptr, placed, auto_camera(s.positions, 24, 16), 24, 16, 1,
+               std::numeric_limits<float>::infinity(), hits);
+    EXPECT_GE(hits, 1);
 }
 
 TEST(Instances, TiesGoToTheOwnTrianglesThenTheLowestInstance) {

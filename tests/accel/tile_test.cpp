@@ -260,16 +260,19 @@ TEST(Tile, AxisAlignedRaysOnTriangleEdgesAndCornersHit) {
         IsaGuard guard(isa);
         for (const Expected& c : cases) {
             SCOPED_TRACE(isa + " at " + std::to_string(c.x) + "," + std::to_string(c.y));
-            const Ray ray{Vec3f(c.x, c.y, 1.0f), Vec3f(0.0f, 0.0f, -1.0f)};
-            Hit hit;
-            ASSERT_TRUE(accel.intersect(ray, hit));
-            EXPECT_EQ(hit.t, 1.0f);
-            EXPECT_EQ(hit.prim, c.prim);
-            const Hit expected = brute_force(s, ray);
-            EXPECT_EQ(expected.prim, c.prim);
-            EXPECT_EQ(expected.t, 1.0f);
-            EXPECT_TRUE(accel.occluded(Ray{ray.origin, ray.dir, 1.5f}));
-            EXPECT_FALSE(accel.occluded(Ray{ray.origin, ray.dir, 1.0f}));
+            // +0 and -0 components: the box entry picks the corner by the sign bit.
+            for (const Vec3f& dir : {Vec3f(0.0f, 0.0f, -1.0f), Vec3f(-0.0f, -0.0f, -1.0f)}) {
+                const Ray ray{Vec3f(c.x, c.y, 1.0f), dir};
+                Hit hit;
+                ASSERT_TRUE(accel.intersect(ray, hit));
+                EXPECT_EQ(hit.t, 1.0f);
+                EXPECT_EQ(hit.prim, c.prim);
+                const Hit expected = brute_force(s, ray);
+                EXPECT_EQ(expected.prim, c.prim);
+                EXPECT_EQ(expected.t, 1.0f);
+                EXPECT_TRUE(accel.occluded(Ray{ray.origin, ray.dir, 1.5f}));
+                EXPECT_FALSE(accel.occluded(Ray{ray.origin, ray.dir, 1.0f}));
+            }
         }
     }
 }

@@ -80,11 +80,12 @@ TR_INLINE LaneResult finish8(const Edges& e, vf8 akz, vf8 bkz, vf8 ckz, vf8 sz, 
     return finish<vf8, vm8>(e, akz, bkz, ckz, sz, tmax);
 }
 
-// box_entry() of watertight.h for a regular tile group (finite, non-zero inverse directions)
-// on 8 lanes, for corners `p`: per axis the least product of a corner and the inverse
-// direction. Multiplying by a positive number keeps the corners' order and by a negative one
-// reverses it, so that is the product of the corner box_entry picks, whenever the lane can be
-// a hit (a NaN corner makes its t NaN; a zero product's sign does not matter to a positive t).
+// box_entry() of watertight.h for a regular tile group (finite inverse directions, one sign
+// per axis) on 8 lanes, for corners `p`: per axis the least product of a corner and the
+// inverse direction. Multiplying by a positive number keeps the corners' order and by a
+// negative one reverses it, so that is the product of the corner box_entry picks, whenever
+// the lane can be a hit (an infinite or NaN corner makes its t NaN; a zero product's sign, as
+// from an inverse of -0, does not matter: the entry starts from +0).
 // vmin and vmax are minps and maxps. Hits are held to it (held_to_box) only where one would be
 // taken: a t that rises can only lose, so the others are settled without it.
 TR_INLINE vf8 group_box_entry(const vf8 (&p)[3][3], const vf8 (&inv)[3]) {
@@ -643,8 +644,8 @@ bool occluded1_instances(const InstanceLevel& lv, const Ray& ray, std::uint64_t*
 // Each group keeps the interval of its rays' inverse directions; a node's children are culled
 // for the whole tile at once, then for each group (8 groups per vector), and leaves are tested
 // one triangle against a group's 8 rays at a time. Groups whose rays do not share the shear
-// permutation, or have a zero, infinite or sign-changing direction component, are traced ray
-// by ray instead.
+// permutation, or have a zero or NaN direction component or one whose sign changes, are traced
+// ray by ray instead.
 
 constexpr int kMaxGroups = 32;
 
@@ -769,7 +770,7 @@ TR_INLINE void clear_groups(TileState& s) {
 }
 
 // Group g's shear and inverse-direction intervals from its 8 directions d[axis][lane]; false
-// when its rays must be traced one by one (no common shear permutation, or a zero, infinite or
+// when its rays must be traced one by one (no common shear permutation, or a zero, NaN or
 // sign-changing direction component).
 TR_INLINE bool setup_group(TileState& s, int g, const float (&d)[3][8], TileSigns& signs) {
     const float inf = std::numeric_limits<float>::infinity();

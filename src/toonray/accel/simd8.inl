@@ -3,9 +3,10 @@
 // TOONRAY_ACCEL_AVX2 they are single AVX2 registers, otherwise pairs of SSE registers. Every
 // operation is one IEEE operation per lane (no fused multiply-add, no reciprocal estimates), so
 // lanes compute exactly what scalar code computes. Comparisons are ordered: false with NaN, as
-// in C++. min(a, b) and max(a, b) return b when either is NaN (the SSE/AVX rule: a if a < b, else
-// b), which the box tests use to ignore NaN distances. Masks (vm8) may carry meaning in their sign bits only (as_mask):
-// movemask, blends and bitwise combinations look at nothing else.
+// in C++. min(a, b) and max(a, b) return b when either is NaN (the SSE/AVX rule: a if a < b,
+// else b), which the box tests use to ignore NaN distances. Masks (vm8) may carry meaning in
+// their sign bits only (as_mask): movemask, blends and bitwise combinations look at nothing
+// else.
 
 #define TR_INLINE inline __attribute__((always_inline))
 

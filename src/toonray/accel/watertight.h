@@ -53,8 +53,10 @@ inline float lane_max(float a, float b) { return a > b ? a : b; }
 // sign bit is set, so that -0 counts as negative as -inf does) times the inverse direction, and
 // the farthest of those and 0. A NaN (a corner in the plane of a direction component that is
 // zero: 0 * inf) is ignored, as the box tests ignore it. `p` holds the corners relative to the
-// origin in the ray's kx, ky, kz order, `inv` the inverse direction in that order. The SIMD
-// kernels do the same operations lane by lane.
+// origin in the ray's kx, ky, kz order, `inv` the inverse direction in that order. The
+// single-ray kernels do the same operations; a regular tile group takes the least product over
+// the corners per axis, the same value for every lane that can be a hit (group_box_entry in
+// kernels.inl).
 inline float box_entry(const float (&p)[3][3], const float (&inv)[3]) {
     float entry = 0.0f;
     for (int axis = 0; axis < 3; ++axis) {
