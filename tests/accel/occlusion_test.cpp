@@ -22,6 +22,7 @@ using test_support::IsaGuard;
 using test_support::isas;
 using test_support::random_soup;
 using test_support::Soup;
+using test_support::unit_square;
 
 bool brute_force_occluded(const Soup& s, const Ray& ray) {
     for (const auto& tri : s.tris) {
@@ -110,9 +111,7 @@ TEST(Occlusion, RealMeshesAgreeWithIntersect) {
 TEST(Occlusion, SharedEdgesLetNoRayThrough) {
     // Two triangles sharing the diagonal of a unit square; rays straight down through points on
     // the diagonal are blocked, exactly as intersect finds them.
-    Soup s;
-    s.positions = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
-    s.tris = {{0, 1, 2}, {0, 2, 3}};
+    const Soup s = unit_square({{0, 1, 2}, {0, 2, 3}});
     TriangleAccel accel;
     accel.build(s.positions, s.tris);
     for (const std::string& isa : isas()) {

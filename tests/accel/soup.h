@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "toonray/core/math.h"
@@ -31,6 +32,12 @@ inline Soup random_soup(int count, unsigned seed, float size = 0.2f) {
         s.tris.push_back({base, base + 1, base + 2});
     }
     return s;
+}
+
+/// The unit square in the plane z = 0, corners (0,0), (1,0), (1,1), (0,1), as the two
+/// triangles `tris` (rays straight down meet its edges, diagonal and corners exactly).
+inline Soup unit_square(std::vector<std::array<std::uint32_t, 3>> tris) {
+    return {{{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}}, std::move(tris)};
 }
 
 /// The triangles of tests/data/<name>.

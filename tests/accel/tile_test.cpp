@@ -26,6 +26,7 @@ using test_support::IsaGuard;
 using test_support::isas;
 using test_support::random_soup;
 using test_support::Soup;
+using test_support::unit_square;
 
 // An axis-aligned grid of unit squares in the plane z = 0 (two triangles each): rays from a
 // camera looking straight down hit shared edges and corners exactly.
@@ -244,9 +245,7 @@ TEST(Tile, AxisAlignedRaysOnTriangleEdgesAndCornersHit) {
     // Rays straight down onto a square's edges, diagonal and corners: their zero direction
     // components make a corner's slab distance 0 * inf, which the box entry must ignore as the
     // box tests do (it once made the entry infinite and lost these hits).
-    Soup s;
-    s.positions = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
-    s.tris = {{2, 0, 1}, {0, 2, 3}};
+    const Soup s = unit_square({{2, 0, 1}, {0, 2, 3}});
     TriangleAccel accel;
     accel.build(s.positions, s.tris);
     struct Expected {

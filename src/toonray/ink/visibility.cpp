@@ -320,7 +320,6 @@ std::vector<EdgePiece> split_by_visibility(std::span<const FeatureSegment> segme
                 };
                 const float image_length = plan.image_length;
                 const int n = plan.n;
-                auto sample_s = [&](int k) { return plan.sample_s(k); };
                 sample_states.resize(static_cast<std::size_t>(n));
                 if (settings.max_invisibility <= 1) {
                     // Only hidden or not: rays from the eye to each sample's point at parameter 1
@@ -353,7 +352,7 @@ std::vector<EdgePiece> split_by_visibility(std::span<const FeatureSegment> segme
                         }
                         for (int k = 0; k < n; ++k) {
                             const std::size_t at = static_cast<std::size_t>(k);
-                            points[at] = seg.p0 + (seg.p1 - seg.p0) * c.t_of(sample_s(k));
+                            points[at] = seg.p0 + (seg.p1 - seg.p0) * c.t_of(plan.sample_s(k));
                             dirs[at] = points[at] - view.eye();
                         }
                         // Without instances a packet (one group of the tile) does not pay for
@@ -383,7 +382,7 @@ std::vector<EdgePiece> split_by_visibility(std::span<const FeatureSegment> segme
                     }
                 } else {
                     for (int k = 0; k < n; ++k)
-                        sample_states[static_cast<std::size_t>(k)] = state_at(sample_s(k));
+                        sample_states[static_cast<std::size_t>(k)] = state_at(plan.sample_s(k));
                 }
                 // Every sample hidden alike: one hidden piece, which only hidden lines keep (most
                 // of a crowd's segments are one such sample).
@@ -397,7 +396,7 @@ std::vector<EdgePiece> split_by_visibility(std::span<const FeatureSegment> segme
                 for (int k = 0; k < n; ++k) {
                     const int state = sample_states[static_cast<std::size_t>(k)];
                     if (k > 0 && state != previous) {
-                        float lo = sample_s(k - 1), hi = sample_s(k);
+                        float lo = plan.sample_s(k - 1), hi = plan.sample_s(k);
                         while ((hi - lo) * image_length > settings.precision) {
                             const float mid = 0.5f * (lo + hi);
                             if (mid <= lo || mid >= hi) break;
