@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -12,6 +13,7 @@
 #include <vector>
 
 #include "toonray/accel/triangle_accel.h"
+#include "toonray/accel/wide_bvh.h"
 #include "toonray/scene/camera.h"
 #include "toonray/scene/obj_loader.h"
 #include "accel/isas.h"
@@ -302,6 +304,77 @@ TEST(Tile, DegenerateDirectionsAgreeWithSingleRays) {
             }
         }
     }
+}
+
+// Rays said to be too sparse for the tree (as a frame's refined samples along the edges of a
+// dense mesh are) are traced one by one: whatever the spacing given, every ray gets exactly the
+// single ray's hit within tmax, and every result is written.
+TEST(Tile, SparseRaysGetTheSingleRaysHits) {
+    Soup s = from_obj("spot.obj");
+    TriangleAccel accel;
+    accel.build(s.positions, s.tris);
+    const int width = 160, height = 90;
+    const ViewPlane view = make_view_plane(framing(s, width, height), width, height);
+    // Every third pixel, as a list four rays wide and longer than a tile.
+    std::vector<Vec3f> dirs;
+    for (int p = 0; p < width * height; p += 3)
+        dirs.push_back(normalize(
+            view.pixel_point(float(p % width) + 0.5f, float(p / width) + 0.5f) - view.eye));
+    while (dirs.size() % 4) dirs.push_back(dirs.back());
+    const int rows = static_cast<int>(dirs.size() / 4);
+    ASSERT_GT(rows, 16);
+    // A tmax that cuts off about half the hits.
+    std::vector<float> ts;
+    for (const Vec3f& d : dirs) {
+        Hit h;
+        if (accel.intersect(Ray{view.eye, d}, h)) ts.push_back(h.t);
+    }
+    ASSERT_GT(ts.size(), 400u);
+    std::nth_element(ts.begin(), ts.begin() + ts.size() / 2, ts.end());
+    const float inf = std::numeric_limits<float>::infinity();
+    const float cut = ts[ts.size() / 2];
+    for (const std::string& isa : isas()) {
+        IsaGuard guard(isa);
+        // The camera's spacing and a finer one (packets), a coarse one and none (ray by ray).
+        for (const float ray_angle2 : {-1.0f, 1e-12f, 1.0f, inf})
+            for (const float tmax : {inf, cut}) {
+                SCOPED_TRACE(isa + " spacing " + std::to_string(ray_angle2) + " tmax " +
+                             std::to_string(tmax));
+                std::vector<Hit> hits(dirs.size(), Hit{0.5f, 7u, 0.25f, 0.25f});
+                std::unique_ptr<bool[]> found(new bool[dirs.size()]);
+                std::fill(found.get(), found.get() + dirs.size(), true);
+                accel.intersect_tile(view.eye, dirs.data(), 4, rows, hits.data(), found.get(), tmax,
+                                     ray_angle2);
+                int hit = 0, missed = 0;
+                for (std::size_t i = 0; i < dirs.size(); ++i) {
+                    Hit single;
+                    const bool f = accel.intersect(Ray{view.eye, dirs[i], tmax}, single);
+                    ASSERT_EQ(found[i], f) << "ray " << i;
+                    ASSERT_EQ(hits[i].prim, single.prim) << "ray " << i;
+                    ASSERT_EQ(bits(hits[i].t), bits(single.t)) << "ray " << i;
+                    ASSERT_EQ(bits(hits[i].u), bits(single.u)) << "ray " << i;
+                    ASSERT_EQ(bits(hits[i].v), bits(single.v)) << "ray " << i;
+                    (f ? hit : missed) += 1;
+                }
+                EXPECT_GT(hit, 100);
+                EXPECT_GT(missed, 100);
+            }
+    }
+}
+
+// Packets pay when the rays over a tree's bounding sphere are at least its blocks.
+TEST(Tile, DenseForCountsTheRaysOverTheTreesSphere) {
+    accel::WideBvh tree;
+    tree.centre = Vec3f(0.0f, 0.0f, 10.0f);
+    tree.radius = 1.0f;
+    tree.blocks.resize(100);
+    // Seen from the origin the sphere covers about pi / 100 sr.
+    EXPECT_TRUE(tree.dense_for(Vec3f(0.0f), 1e-4f));   // about 314 rays
+    EXPECT_FALSE(tree.dense_for(Vec3f(0.0f), 1e-3f));  // about 31
+    EXPECT_FALSE(tree.dense_for(Vec3f(0.0f), std::numeric_limits<float>::infinity()));
+    EXPECT_TRUE(tree.dense_for(Vec3f(0.0f, 0.0f, 10.5f), 1.0f));  // inside the sphere
+    tree.blocks.resize(1000);
+    EXPECT_FALSE(tree.dense_for(Vec3f(0.0f), 1e-4f));
 }
 
 TEST(Tile, TmaxAndEmptyAccelerator) {

@@ -35,7 +35,7 @@ struct KernelTable {
                                  std::uint64_t* stack, std::uint64_t* bottom);
     bool (*occluded1_instances)(const InstanceLevel& lv, const Ray& ray, std::uint64_t* stack,
                                 std::uint64_t* bottom);
-    /// `ray_angle2`: the squared angle between neighbouring rays, for dense_for; negative: the
+    /// `ray_angle2`: the squared angle between neighbouring rays, for WideBvh::dense_for; negative: the
     /// angle between the first two rays; infinite: every record's tree ray by ray.
     void (*intersect_tile_instances)(const InstanceLevel& lv, const Vec3f& origin,
                                      const Vec3f* dirs, int width, int height, float tmax,

@@ -999,28 +999,11 @@ void intersect_tile(const WideBvh& w, const Vec3f& origin, const Vec3f* dirs, in
     }
 }
 
-// Whether a tile's groups should go through a record's tree as groups: when the rays spaced
-// as the tile's (`ray_angle2`: the squared angle between neighbouring rays) cover at least
-// one ray per block of four triangles over the tree's bounding sphere, seen from the origin
-// in object space. Otherwise each ray goes alone: inside a far instance many triangles lie
-// under one pixel, and a tile's groups reached most of its leaves to find a few hits (at one
-// sample a pixel, a crowd of 10,000 instances of a 70k-triangle mesh visited 49M leaves by
-// groups against 1M ray by ray, and took ten times as long), while the piano's instanced keys,
-// a few hundred triangles each under many pixels, took twice as long ray by ray. Either way
-// the hits are the same; this only chooses the faster traversal.
-TR_INLINE bool dense_for(const WideBvh& tree, const Vec3f& origin, float ray_angle2) {
-    const Vec3f d = origin - tree.centre;
-    const float dist2 = dot(d, d), r2 = tree.radius * tree.radius;
-    if (!(dist2 > r2)) return true;  // at or inside the sphere (or NaN)
-    const float rays = 3.14159265f * r2 / (dist2 * ray_angle2);
-    return rays >= static_cast<float>(tree.blocks.size());
-}
-
 // A tile through the instance level: the top tree is traversed with the tile's groups as
 // intersect_tile does; at each record the groups that reach it are taken into its object space
 // (each lane's direction, as object_ray does) and traced through its tree with their best hits
 // so far, ties going to the lower rank (RankedHit). Groups that are irregular in object space,
-// and all of them when they are sparse for the record's tree (dense_for, or an infinite
+// and all of them when they are sparse for the record's tree (WideBvh::dense_for, or an infinite
 // `ray_angle2`), are traced there ray by ray.
 void intersect_tile_instances(const InstanceLevel& lv, const Vec3f& origin, const Vec3f* dirs,
                               int width, int height, float tmax_in, float ray_angle2, Hit* hits,
@@ -1047,7 +1030,7 @@ void intersect_tile_instances(const InstanceLevel& lv, const Vec3f& origin, cons
             for_each_record(lv, ref, [&](const InstanceRecord& r) {
                 const Ray oray = object_ray(r, Ray{origin, Vec3f(0.0f), tmax_in});
                 const bool sparse =
-                    std::isinf(ray_angle2) || !dense_for(*r.tree, oray.origin, ray_angle2);
+                    std::isinf(ray_angle2) || !r.tree->dense_for(oray.origin, ray_angle2);
                 clear_groups(so);
                 TileSigns osigns;
                 std::uint32_t oregular = 0;

@@ -321,6 +321,15 @@ bool TriangleAccel::occluded(const Ray& ray) const {
 void TriangleAccel::intersect_tile(const Vec3f& origin, const Vec3f* dirs, int width, int height,
                                    Hit* hits, bool* found, float tmax, float ray_angle2) const {
     if (width <= 0 || height <= 0) return;
+    if (!level_ && ray_angle2 >= 0.0f &&
+        (std::isinf(ray_angle2) || !wide_->dense_for(origin, ray_angle2))) {
+        const std::size_t n = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
+        for (std::size_t i = 0; i < n; ++i) {
+            hits[i] = Hit{};
+            found[i] = intersect(Ray{origin, dirs[i], tmax}, hits[i]);
+        }
+        return;
+    }
     if (width <= kTileSize && height > kTileSize) {
         // A narrow grid (a list of rays a few wide): its tiles are runs of whole rows, which
         // lie next to each other in memory already.

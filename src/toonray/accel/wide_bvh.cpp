@@ -293,4 +293,12 @@ void WideBvh::build_over_boxes(const Bvh& bvh, std::span<const float> leaf_areas
         *this, bvh, leaf_areas, costs, [&](std::uint32_t p) { return boxes[p]; }, slots.data()));
 }
 
+bool WideBvh::dense_for(const Vec3f& origin, float ray_angle2) const {
+    const Vec3f d = origin - centre;
+    const float dist2 = dot(d, d), r2 = radius * radius;
+    if (!(dist2 > r2)) return true;  // at or inside the sphere (or NaN)
+    const float rays = 3.14159265f * r2 / (dist2 * ray_angle2);
+    return rays >= static_cast<float>(blocks.size());
+}
+
 }  // namespace toonray::accel

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 
 #include "toonray/core/saturating.h"
 #include "toonray/render/classic.h"
@@ -329,9 +330,19 @@ void BucketSampler::trace_refined(const SamplerFrame& frame) {
         hit_found_size_ = padded;
         hit_found_ = std::make_unique<bool[]>(hit_found_size_);
     }
-    frame.accel.intersect_tile(frame.view.eye, rest_dirs_.data(), kListWidth,
-                               static_cast<int>(padded / kListWidth), hits_.data(),
-                               hit_found_.get());
+    // The refined rays lie along edges, a few in a block of pixels. Spread evenly over the
+    // bucket they would be sqrt(pixels / n) pixels apart: as packets, rays that sparse reach
+    // most of a dense mesh's leaves near the edges (a 1.1M-triangle scan took 10,000
+    // instructions a ray, against 1,500 ray by ray), so the accelerator is told the spacing
+    // and chooses (TriangleAccel::intersect_tile).
+    const int cx = decided_.x0 + dw / 2, cy = decided_.y0 + dh / 2;
+    const Vec3f step =
+        sample_direction(frame.view, cx + 1, cy, 1) - sample_direction(frame.view, cx, cy, 1);
+    const float ray_angle2 =
+        dot(step, step) * static_cast<float>(dw) * static_cast<float>(dh) / static_cast<float>(n);
+    frame.accel.intersect_tile(
+        frame.view.eye, rest_dirs_.data(), kListWidth, static_cast<int>(padded / kListWidth),
+        hits_.data(), hit_found_.get(), std::numeric_limits<float>::infinity(), ray_angle2);
     shade_into(frame, static_cast<int>(n), rest_dirs_.data(), hits_.data(), hit_found_.get(), rest_,
                0);
 }
