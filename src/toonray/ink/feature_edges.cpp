@@ -671,12 +671,6 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
     // stored: at a million triangles a copy is 40 MB more at the frame's peak, whose first
     // touch costs more than the reads.
     const IndexedCorners corners_of{scene.positions, scene.tri_positions};
-    std::vector<Vec3f> normal;
-    std::vector<std::uint8_t> corner_normals, usable_triangle, eye_side;
-    normal.reserve(n);
-    corner_normals.reserve(n);
-    usable_triangle.reserve(n);
-    eye_side.reserve(n);
     // A full intersection search (without a cache of the same triangles' crossings) skips
     // patches that cannot cross themselves, which read the normals rounded (3 bytes a
     // triangle: the float normals are freed before the search) and the triangles across each
@@ -684,21 +678,48 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
     const bool intersections = settings.intersections && !bvh.nodes.empty();
     const bool some_fresh = cache && cache->corners.size() == n && cache->tested.size() == n;
     const bool patches_searched = intersections && !some_fresh;
-    std::vector<RoundedNormal> rounded;
-    if (patches_searched) rounded.reserve(n);
+    // Sized first and written through pointers, which the stores do not make the loop read
+    // again.
+    std::vector<Vec3f> normal(n);
+    std::vector<std::uint8_t> corner_normals(n), usable_triangle(n), eye_side(n);
+    std::vector<RoundedNormal> rounded(patches_searched ? n : 0);
     constexpr std::uint8_t kEyeInFront = 1, kEyeBehind = 2;
-    for (std::size_t t = 0; t < n; ++t) {
-        const auto p = corners_of(t);
-        const Vec3f& nt = normal.emplace_back(face_normal(p));
-        if (patches_searched) rounded.push_back(round_normal(nt));
-        usable_triangle.push_back(nt != Vec3f(0.0f));
-        const float facing = dot(nt, eye - p[0]);
-        eye_side.push_back(facing > 0 ? kEyeInFront : facing < 0 ? kEyeBehind : 0);
-        corner_normals.push_back(has_corner_normals(scene, t));
-        const std::uint32_t o = scene.tri_object[t];
-        for (const Vec3f& q : p) object_box[o].extend(q);
-        volume[o] += static_cast<double>(dot(p[0], cross(p[1], p[2])));
-    }
+    const bool normals_given = !scene.tri_normals.empty();
+    auto triangle_pass = [&](auto one_object) {
+        Vec3f* const normal_out = normal.data();
+        RoundedNormal* const rounded_out = rounded.data();
+        std::uint8_t* const usable_out = usable_triangle.data();
+        std::uint8_t* const side_out = eye_side.data();
+        std::uint8_t* const corner_normals_out = corner_normals.data();
+        // One object's box and volume are summed in locals, in the same order.
+        BBox box;
+        double sum = 0.0;
+        for (std::size_t t = 0; t < n; ++t) {
+            const auto p = corners_of(t);
+            const Vec3f nt = face_normal(p);
+            normal_out[t] = nt;
+            if (patches_searched) rounded_out[t] = round_normal(nt);
+            usable_out[t] = nt != Vec3f(0.0f);
+            const float facing = dot(nt, eye - p[0]);
+            side_out[t] = facing > 0 ? kEyeInFront : facing < 0 ? kEyeBehind : 0;
+            corner_normals_out[t] = normals_given && has_corner_normals(scene, t);
+            const double v = static_cast<double>(dot(p[0], cross(p[1], p[2])));
+            if constexpr (decltype(one_object)::value) {
+                for (const Vec3f& q : p) box.extend(q);
+                sum += v;
+            } else {
+                const std::uint32_t o = scene.tri_object[t];
+                for (const Vec3f& q : p) object_box[o].extend(q);
+                volume[o] += v;
+            }
+        }
+        if constexpr (decltype(one_object)::value) {
+            object_box[0] = box;
+            volume[0] = sum;
+        }
+    };
+    if (objects == 1) triangle_pass(std::true_type{});
+    else triangle_pass(std::false_type{});
     auto usable = [&](std::size_t t) { return usable_triangle[t] != 0; };
 
     // A cache that has seen a frame before: frames follow each other, and this one's mesh
@@ -731,11 +752,16 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
             outward[o] = volume[o] > 0.0 ? 1 : -1;
     // Triangles turned away from the eye on those objects: every point inside them is hidden
     // by the solid, so an intersection line on one is certainly hidden.
+    // In the same pass, the triangles that take part in the intersection search: usable ones,
+    // and without hidden lines only those not turned away.
     std::vector<std::uint8_t>& turned_away = eye_side;  // in its place
+    std::vector<std::uint8_t> live_triangle(intersections ? n : 0);
     for (std::size_t t = 0; t < n; ++t) {
         const int out = outward[scene.tri_object[t]];
-        turned_away[t] =
+        const bool away =
             out != 0 && usable(t) && eye_side[t] == (out > 0 ? kEyeBehind : kEyeInFront);
+        turned_away[t] = away;
+        if (intersections) live_triangle[t] = usable(t) && (settings.certainly_hidden || !away);
     }
 
     const float cos_crease =
@@ -767,15 +793,30 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
         settings.materials &&
         std::adjacent_find(scene.tri_material.begin(), scene.tri_material.begin() + n,
                            std::not_equal_to<>()) != scene.tri_material.begin() + n;
-    topology.for_each_edge([&](std::uint32_t i, std::uint32_t j, std::uint32_t lo) {
+    // Read through locals: the stores below (the sides' links, the segments) would otherwise
+    // make the loop read the arrays' addresses and the settings again for every edge.
+    const Vec3f* const normal_of = normal.data();
+    const std::uint32_t* const material_of = scene.tri_material.data();
+    const std::uint32_t* const position_of = mesh.vertex_position.data();
+    const Vec3f* const positions = scene.positions.data();
+    const bool silhouettes = settings.silhouettes, creases = settings.creases;
+    // The lower end of the edges from one vertex, and the eye seen from it.
+    std::uint32_t at_vertex = kNoIndex;
+    Vec3f p0(0.0f), to_eye(0.0f);
+    topology.for_each_edge([&](std::uint32_t i, std::uint32_t j,
+                               std::uint32_t lo) __attribute__((always_inline)) {
         if (i + kAhead + 2 <= side_count) {
             for (std::size_t k = i + kAhead; k < i + kAhead + 2; ++k) {
-                __builtin_prefetch(&normal[sides[k].tri()]);
-                if (materials) __builtin_prefetch(&scene.tri_material[sides[k].tri()]);
+                __builtin_prefetch(&normal_of[sides[k].tri()]);
+                if (materials) __builtin_prefetch(&material_of[sides[k].tri()]);
             }
         }
         const Side& s0 = sides[i];
-        const Vec3f p0 = scene.positions[mesh.vertex_position[lo]];
+        if (lo != at_vertex) {
+            at_vertex = lo;
+            p0 = positions[position_of[lo]];
+            to_eye = eye - p0;
+        }
         EdgeType type = EdgeType::Border;
         bool certainly_hidden = false;
         if (j - i != 2) {
@@ -785,15 +826,15 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
             // Consistently wound neighbours run the shared side in opposite directions.
             const bool consistent = s0.forward() != s1.forward();
             if (patches_searched) MeshTopology::link_across(s0, s1, across);
-            const Vec3f n0 = normal[s0.tri()];
-            const Vec3f n1 = consistent ? normal[s1.tri()] : -normal[s1.tri()];
-            const float d0 = dot(n0, eye - p0), d1 = dot(n1, eye - p0);
+            const Vec3f n0 = normal_of[s0.tri()];
+            const Vec3f n1 = consistent ? normal_of[s1.tri()] : -normal_of[s1.tri()];
+            const float d0 = dot(n0, to_eye), d1 = dot(n1, to_eye);
             const bool front0 = d0 > 0, front1 = d1 > 0;
-            if (settings.silhouettes && front0 != front1 &&
+            if (silhouettes && front0 != front1 &&
                 !(settings.smooth_contours && smooth_across(lo, s0, s1)))
                 type = EdgeType::Silhouette;
-            else if (settings.creases && dot(n0, n1) < cos_crease) type = EdgeType::Crease;
-            else if (materials && scene.tri_material[s0.tri()] != scene.tri_material[s1.tri()])
+            else if (creases && dot(n0, n1) < cos_crease) type = EdgeType::Crease;
+            else if (materials && material_of[s0.tri()] != material_of[s1.tri()])
                 type = EdgeType::Material;
             else if (settings.bands && !smooth_across(lo, s0, s1) &&
                      bands_differ(edge_bands, lo, s0.hi, s0.tri(), s1.tri(), n0, n1))
@@ -806,7 +847,7 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
         }
         FeatureSegment& seg = segments.emplace_back();
         seg.p0 = p0;
-        seg.p1 = scene.positions[mesh.vertex_position[s0.hi]];
+        seg.p1 = positions[position_of[s0.hi]];
         seg.key0 = {lo, kNoIndex, kNoIndex};
         seg.key1 = {s0.hi, kNoIndex, kNoIndex};
         seg.faces = {s0.tri(), j - i > 1 ? sides[i + 1].tri() : kNoIndex};
@@ -815,7 +856,8 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
     });
 
     // Smooth contours: where n . (p - eye), interpolated linearly from the corners, is zero.
-    if (settings.silhouettes && settings.smooth_contours) {
+    // (Only triangles with a normal at every corner have them.)
+    if (settings.silhouettes && settings.smooth_contours && normals_given) {
         // g at a corner depends on its position and normal only, which most triangles around
         // a vertex share: kept per position for the last normal it was computed with.
         std::vector<std::uint32_t> g_normal(scene.positions.size(), kNoIndex);
@@ -864,11 +906,6 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
 
     // Intersection lines: each triangle against the triangles whose boxes overlap its own.
     if (intersections) {
-        // Triangles that take part: usable ones, and without hidden lines only those not turned
-        // away from the eye on a closed solid.
-        std::vector<std::uint8_t> live_triangle(n);
-        for (std::size_t t = 0; t < n; ++t)
-            live_triangle[t] = usable(t) && (settings.certainly_hidden || !turned_away[t]);
         // With a cache of the same triangles, a pair is tested only if one of its triangles
         // is stale: its corners changed since the cache's frame, or it did not take part then.
         // Without one, every triangle is.
