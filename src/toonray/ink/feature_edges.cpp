@@ -811,7 +811,8 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
                 if (materials) __builtin_prefetch(&material_of[sides[k].tri()]);
             }
         }
-        const Side& s0 = sides[i];
+        // Copies: the links' stores below could otherwise change them.
+        const Side s0 = sides[i];
         if (lo != at_vertex) {
             at_vertex = lo;
             p0 = positions[position_of[lo]];
@@ -822,7 +823,7 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
         if (j - i != 2) {
             if (!settings.borders) return;
         } else {
-            const Side& s1 = sides[i + 1];
+            const Side s1 = sides[i + 1];
             // Consistently wound neighbours run the shared side in opposite directions.
             const bool consistent = s0.forward() != s1.forward();
             if (patches_searched) MeshTopology::link_across(s0, s1, across);
