@@ -45,8 +45,9 @@ bool position_less(const Vec3f& a, const Vec3f& b) {
     return std::tie(a.x, a.y, a.z) < std::tie(b.x, b.y, b.z);
 }
 
-// Unit geometric normal (p1 - p0) x (p2 - p0), or zero for a degenerate triangle.
-Vec3f face_normal(const std::array<Vec3f, 3>& p) {
+// Unit geometric normal (p1 - p0) x (p2 - p0), or zero for a degenerate triangle. Inlined: as
+// a call it made the per-triangle pass keep its sums in memory.
+[[gnu::always_inline]] inline Vec3f face_normal(const std::array<Vec3f, 3>& p) {
     const Vec3f n = cross(p[1] - p[0], p[2] - p[0]);
     const float len = length(n);
     if (!(len > 0.0f) || !std::isfinite(len)) return Vec3f(0.0f);
@@ -684,7 +685,8 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
     std::vector<std::uint8_t> corner_normals(n), usable_triangle(n), eye_side(n);
     std::vector<RoundedNormal> rounded(patches_searched ? n : 0);
     constexpr std::uint8_t kEyeInFront = 1, kEyeBehind = 2;
-    const bool normals_given = !scene.tri_normals.empty();
+    // (A scene without normals has no triangle with a normal at every corner.)
+    const bool normals_given = !scene.tri_normals.empty() && !scene.normals.empty();
     auto triangle_pass = [&](auto one_object) {
         Vec3f* const normal_out = normal.data();
         RoundedNormal* const rounded_out = rounded.data();
