@@ -83,13 +83,14 @@ public:
     /// directions row by row, and hits/found receive, for each, exactly what
     /// intersect(Ray{origin, dir, tmax}, hit) gives (misses get Hit{} and false). Neighbouring
     /// rays should be coherent (a pinhole camera's): each kTileSize x kTileSize tile is
-    /// traversed once, as a frustum of 4 x 2 ray packets (larger grids are cut into tiles).
-    /// `ray_angle2` is the squared angle between neighbouring rays: negative for that of the
-    /// first two, infinite for rays too sparse for any tree. With instances, the groups that
-    /// reach an instance go through its tree as packets only when they are dense for it
-    /// (WideBvh::dense_for; otherwise each crosses it alone, and only the top level is
-    /// traversed by groups). Without, a non-negative `ray_angle2` sparse for the tree sends
-    /// each ray through it alone. Only speed depends on it.
+    /// traversed once, as a frustum of 4 x 2 ray packets (larger grids are cut into tiles),
+    /// unless `ray_angle2` says the rays are sparse. `ray_angle2` is the squared angle between
+    /// neighbouring rays, infinite for rays too sparse for any tree. With instances, the groups
+    /// that reach an instance go through its tree as packets only when they are dense for it
+    /// (WideBvh::dense_for, with a negative `ray_angle2` taken from the first two rays;
+    /// otherwise each crosses it alone, and only the top level is traversed by groups).
+    /// Without, a `ray_angle2` of zero or more that is sparse for the tree sends each ray
+    /// through it alone, and a negative one always packets. Only speed depends on it.
     void intersect_tile(const Vec3f& origin, const Vec3f* dirs, int width, int height, Hit* hits,
                         bool* found, float tmax = std::numeric_limits<float>::infinity(),
                         float ray_angle2 = -1.0f) const;
