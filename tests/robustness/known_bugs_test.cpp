@@ -9,6 +9,7 @@
 #include "robustness_util.h"
 #include "toonray/accel/triangle_accel.h"
 #include "toonray/render/renderer.h"
+#include "toonray/scene/camera.h"
 #include "toonray/scene/obj_loader.h"
 
 using namespace toonray;
@@ -39,4 +40,38 @@ TEST(KnownBugs, BvhBinningWithExtremeCoordinates) {
             scene, accel, camera, test_support::default_lights(scene, camera), settings);
         EXPECT_EQ(image.width(), 32) << name;
     }
+}
+
+// Open (docs/robustness.md, "Open in the accelerator"): the eye 1e-8 in front of a triangle's
+// plane, rays leaving it. The watertight test's rounding puts the crossing, which is behind the
+// eye, at t = +4.5e-8, so brute force over the triangles finds a hit there; the traversal culls
+// the triangle's box, which the ray leaves before t = 0, and finds none. Every camera ray must
+// find brute force's triangle (the render fuzzer's check, which found it).
+TEST(KnownBugs, DISABLED_AHitPastItsTrianglesBoxIsFoundByTheTraversal) {
+    Scene scene;
+    Warnings warnings;
+    load_obj(robustness::data("fuzz-open/render/hit_past_its_box.obj"), scene, warnings);
+    TriangleAccel accel;
+    accel.build(scene.positions, scene.tri_positions);
+    const int width = 24, height = 16;
+    const CameraSpec camera =
+        scene.camera ? *scene.camera : auto_camera(scene.positions, width, height);
+    const ViewPlane view = make_view_plane(camera, width, height);
+    for (int y = 0; y < height; ++y)
+        for (int x = 0; x < width; ++x) {
+            const Ray ray{view.eye, normalize(view.pixel_point(x + 0.5f, y + 0.5f) - view.eye)};
+            Hit expected;
+            for (std::uint32_t i = 0; i < scene.tri_positions.size(); ++i) {
+                const auto& tri = scene.tri_positions[i];
+                Ray r = ray;
+                r.tmax = expected.t;
+                float t, u, v;
+                if (intersect_triangle(r, scene.positions[tri[0]], scene.positions[tri[1]],
+                                       scene.positions[tri[2]], t, u, v))
+                    expected = Hit{t, i, u, v};
+            }
+            Hit hit;
+            accel.intersect(ray, hit);
+            EXPECT_EQ(hit.prim, expected.prim) << "pixel " << x << "," << y;
+        }
 }
