@@ -2,7 +2,7 @@
 # coverage hooks (without its main), and unless TOONRAY_FUZZ_SANITIZERS is off AddressSanitizer
 # and UndefinedBehaviorSanitizer, with every UB report fatal so the fuzzer sees it as a crash.
 # Without the sanitizers (the `fuzz-fast` preset, `scripts/fuzz.sh --fast`) the render fuzzer
-# runs about nine times the inputs a second: for long runs that look for wrong results (the
+# runs about six times the inputs a second: for long runs that look for wrong results (the
 # checks the fuzzers make themselves, such as the accelerator's exactness) rather than memory
 # errors.
 # Needs clang.

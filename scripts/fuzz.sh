@@ -6,7 +6,7 @@
 #   scripts/fuzz.sh [--fast] [SECONDS] [TARGET...]
 #
 # --fast builds in build-fuzz-fast/ (the `fuzz-fast` preset: libFuzzer's coverage without the
-# sanitizers): the render target runs about 4,000 inputs a second against 450, for long runs
+# sanitizers): the render target runs about 4,000 inputs a second against 700, for long runs
 # after wrong results (the checks the targets make themselves, such as the accelerator's
 # exactness), which a sanitizer build meets only by luck. It finds no memory errors: run the
 # default build too.
