@@ -9,7 +9,7 @@
 # sanitizers): the render target runs about 4,000 inputs a second against 700, for long runs
 # after wrong results (the checks the targets make themselves, such as the accelerator's
 # exactness), which a sanitizer build meets only by luck. It finds no memory errors: run the
-# default build too.
+# default build too. Where this header says build-clang/, read build-fuzz-fast/ then.
 #
 # SECONDS per target (default 60); TARGETs default to all: obj mtl camera note_script midi
 # camera_path options png render shading gltf glb line_style settings tone. Before fuzzing,
@@ -67,7 +67,8 @@ if ! ninja -C "$build" -j "$(nproc)" $(printf 'fuzz_%s ' "${targets[@]}") >"$bui
 fi
 exec 9>&-  # releases the lock
 
-# Leaks are crashes too (ASan's default under libFuzzer, said here so that it stays so).
+# Leaks are crashes too (ASan's default under libFuzzer, said here so that it stays so; the fast
+# build has no ASan, and these are then unused).
 export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:allocator_may_return_null=0}
 export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
 

@@ -1,6 +1,6 @@
-// Inputs that reached bugs in modules this suite may not change, reported to their owners
-// (docs/robustness.md, "Open"), kept as tests once fixed. A bug still open is added here as a
-// DISABLED_ test (run it with --gtest_also_run_disabled_tests under scripts/sanitize.sh).
+// Inputs that reached bugs (docs/robustness.md, "Open"), kept as tests once fixed. A bug still
+// open is added here as a DISABLED_ test (run it with --gtest_also_run_disabled_tests under
+// scripts/sanitize.sh).
 
 #include <gtest/gtest.h>
 
@@ -45,8 +45,9 @@ TEST(KnownBugs, BvhBinningWithExtremeCoordinates) {
 // Open (docs/robustness.md, "Open in the accelerator"): the eye 1e-8 in front of a triangle's
 // plane, rays leaving it. The watertight test's rounding puts the crossing, which is behind the
 // eye, at t = +4.5e-8, so brute force over the triangles finds a hit there; the traversal culls
-// the triangle's box, which the ray leaves before t = 0, and finds none. Every camera ray must
-// find brute force's triangle (the render fuzzer's check, which found it).
+// the triangle's box, which the ray leaves before t = 0, and finds none. Every camera ray's
+// single-ray traversal must find brute force's triangle (the render fuzzer checks the tile
+// against the single ray as well).
 TEST(KnownBugs, DISABLED_AHitPastItsTrianglesBoxIsFoundByTheTraversal) {
     Scene scene;
     Warnings warnings;
