@@ -99,6 +99,20 @@ TR_INLINE vf8 group_box_entry(const vf8 (&p)[3][3], const vf8 (&inv)[3]) {
     return entry;
 }
 
+// box_behind() of watertight.h on 8 lanes: the corners `p` shared, the inverse directions per
+// lane (a lane's sign bit picks the far side, as box_behind's signbit does).
+TR_INLINE vm8 group_box_behind(const vf8 (&p)[3][3], const vf8 (&inv)[3]) {
+    const vf8 zero = set1(0.0f);
+    vm8 behind = zero < zero;
+    for (int axis = 0; axis < 3; ++axis) {
+        const vf8 lo = vmin(vmin(p[0][axis], p[1][axis]), p[2][axis]);
+        const vf8 hi = vmax(vmax(p[0][axis], p[1][axis]), p[2][axis]);
+        const vm8 negative = as_mask(inv[axis]);
+        behind = behind | (negative & (lo > zero)) | andnot(negative, hi < zero);
+    }
+    return behind;
+}
+
 inline float as_float(std::uint32_t u) {
     float f;
     std::memcpy(&f, &u, 4);
@@ -732,6 +746,9 @@ TR_INLINE void leaf_groups(const WideBvh& w, std::uint32_t ref, TileState& s, st
                 const vf8 inv[3] = {load8(s.ix[g]), load8(s.iy[g]), load8(s.sz[g])};
                 const vf8 bound = group_box_entry(a, inv) * set1(kEntrySlack);
                 t = select(t < bound, bound, t);
+                // Refused (NaN) where the box is behind the origin.
+                t = select(group_box_behind(a, inv), set1(std::numeric_limits<float>::quiet_NaN()),
+                           t);
                 take = take & (t <= tmax) & ((t < tmax) | lower);
             }
             if (movemask(take)) {

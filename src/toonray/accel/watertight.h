@@ -7,6 +7,7 @@
 /// and the copies must not be merged by the linker.
 
 #include <cmath>
+#include <limits>
 #include <utility>
 
 #include "toonray/accel/ray.h"
@@ -77,8 +78,27 @@ inline float box_entry(const float (&p)[3][3], const float (&inv)[3]) {
 // within it and keep their t.
 inline constexpr float kEntrySlack = 1.0f - 1.0f / (1 << 21);
 
-// t held to the triangle's box: at least box_entry(p, inv) * kEntrySlack.
+// Whether the triangle's box lies wholly behind the ray's origin along some axis: its far side
+// there (the highest corner, or the lowest when the inverse direction's sign bit is set) is on
+// the origin's near side. Then no point of the triangle is at t >= 0, and the box tests find
+// the box's exit before 0 and cull it; a positive t from the watertight test is its rounding
+// (an origin within an ulp or so of the triangle's plane, the ray leaving it). The corners are
+// differences of floats, whose signs are exact, so this is decided exactly, the same way on
+// every path.
+inline bool box_behind(const float (&p)[3][3], const float (&inv)[3]) {
+    for (int axis = 0; axis < 3; ++axis) {
+        const float lo = lane_min(lane_min(p[0][axis], p[1][axis]), p[2][axis]);
+        const float hi = lane_max(lane_max(p[0][axis], p[1][axis]), p[2][axis]);
+        if (std::signbit(inv[axis]) ? lo > 0.0f : hi < 0.0f) return true;
+    }
+    return false;
+}
+
+// t held to the triangle's box: at least box_entry(p, inv) * kEntrySlack, and NaN (no hit:
+// every comparison with it fails) when the box is behind the origin (box_behind). Either only
+// raises t or refuses it, so a lane refused by its t before is refused after.
 inline float held_to_box(float t, const float (&p)[3][3], const float (&inv)[3]) {
+    if (box_behind(p, inv)) return std::numeric_limits<float>::quiet_NaN();
     const float bound = box_entry(p, inv) * kEntrySlack;
     return t < bound ? bound : t;
 }
