@@ -50,6 +50,50 @@ TEST(WeldVertices, JoinsEqualPositionsWithinAnObjectOnly) {
     }
 }
 
+// One object: ids are numbered by first use over the triangles' corners, one per canonical
+// position (the lowest index of the positions with its coordinates), with repeated positions
+// (a box with split vertices) and without (the same box's triangles reversed over 8 positions).
+TEST(WeldVertices, OneObjectNumbersPositionsByFirstUse) {
+    Scene split;
+    add_box(split, Vec3f(0.0f), Vec3f(1.0f), 0);  // 24 vertices, 8 positions
+    Scene shared = split;
+    // The same triangles over the 8 distinct positions, in reverse order.
+    std::vector<Vec3f> distinct;
+    for (auto& tri : shared.tri_positions)
+        for (std::uint32_t& p : tri) {
+            const Vec3f position = shared.positions[p];
+            const auto at = std::find(distinct.begin(), distinct.end(), position);
+            p = static_cast<std::uint32_t>(at - distinct.begin());
+            if (at == distinct.end()) distinct.push_back(position);
+        }
+    shared.positions = distinct;
+    std::reverse(shared.tri_positions.begin(), shared.tri_positions.end());
+    for (const Scene* s : {&split, &shared}) {
+        std::vector<std::uint32_t> canonical(s->positions.size()),
+            id_of(s->positions.size(), kNoIndex);
+        for (std::size_t i = 0; i < s->positions.size(); ++i)
+            canonical[i] = static_cast<std::uint32_t>(
+                std::find(s->positions.begin(), s->positions.end(), s->positions[i]) -
+                s->positions.begin());
+        std::vector<std::uint32_t> first_use;
+        for (const auto& tri : s->tri_positions)
+            for (std::uint32_t p : tri)
+                if (id_of[canonical[p]] == kNoIndex) {
+                    id_of[canonical[p]] = static_cast<std::uint32_t>(first_use.size());
+                    first_use.push_back(canonical[p]);
+                }
+        for (bool one_object : {false, true}) {  // one object either way
+            const ink::WeldedMesh mesh = ink::weld_vertices(*s, one_object);
+            ASSERT_EQ(mesh.vertex_position, first_use);
+            ASSERT_EQ(mesh.tri_vertices.size(), s->tri_positions.size());
+            for (std::size_t t = 0; t < s->tri_positions.size(); ++t)
+                for (int k = 0; k < 3; ++k)
+                    EXPECT_EQ(mesh.tri_vertices[t][k], id_of[canonical[s->tri_positions[t][k]]]);
+        }
+    }
+    EXPECT_EQ(ink::weld_vertices(split).vertex_count(), 8u);
+}
+
 TEST(FeatureEdges, BoxWithSplitVerticesHasCreasesAndSilhouettesButNoBorders) {
     Scene s;
     add_box(s, Vec3f(-1.0f), Vec3f(1.0f));
