@@ -15,6 +15,9 @@
 // distance is widened by kBoxSlack as before; the AVX2/AVX-512 single-ray box test uses FMA
 // with its rounding error folded into the constants; interval (frustum) tests bound the per-ray
 // slab distances exactly (float multiplication is monotonic); and NaN distances never cull.
+// Conservative for the exact slabs, that is: a hit whose rounded t lies outside its box, on a
+// ray that misses the box, is kept by the FMA test's wider margins and culled by the SSE one
+// (docs/robustness.md, "Open in the accelerator").
 
 constexpr int kNearLo[3] = {0, 8, 16};    // offsets of lo[axis] in a WideNode, in floats
 constexpr int kNearHi[3] = {24, 32, 40};  // offsets of hi[axis]
@@ -100,7 +103,8 @@ TR_INLINE vf8 group_box_entry(const vf8 (&p)[3][3], const vf8 (&inv)[3]) {
 }
 
 // box_behind() of watertight.h on 8 lanes: the corners `p` shared, the inverse directions per
-// lane (a lane's sign bit picks the far side, as box_behind's signbit does).
+// lane (a lane's sign bit picks the far side, as box_behind's signbit does). A regular group's
+// directions have no zero component, so no lane's inverse is infinite.
 TR_INLINE vm8 group_box_behind(const vf8 (&p)[3][3], const vf8 (&inv)[3]) {
     const vf8 zero = set1(0.0f);
     vm8 behind = zero < zero;

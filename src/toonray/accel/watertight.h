@@ -80,16 +80,21 @@ inline constexpr float kEntrySlack = 1.0f - 1.0f / (1 << 21);
 
 // Whether the triangle's box lies wholly behind the ray's origin along some axis: its far side
 // there (the highest corner, or the lowest when the inverse direction's sign bit is set) is on
-// the origin's near side. Then no point of the triangle is at t >= 0, and the box tests find
-// the box's exit before 0 and cull it; a positive t from the watertight test is its rounding
-// (an origin within an ulp or so of the triangle's plane, the ray leaving it). The corners are
-// differences of floats, whose signs are exact, so this is decided exactly, the same way on
-// every path.
+// the origin's near side. Along an axis the ray does not move on (a zero direction component:
+// an infinite inverse), either side of the origin will do. Then no point of the triangle is at
+// t >= 0, and the box tests find the box's exit before 0 (or its entry at infinity) and cull
+// it; a positive t from the watertight test is its rounding (an origin within an ulp or so of
+// the triangle's plane, the ray leaving it). The corners are differences of floats, whose signs
+// are exact, so this is decided exactly, the same way on every path.
 inline bool box_behind(const float (&p)[3][3], const float (&inv)[3]) {
     for (int axis = 0; axis < 3; ++axis) {
         const float lo = lane_min(lane_min(p[0][axis], p[1][axis]), p[2][axis]);
         const float hi = lane_max(lane_max(p[0][axis], p[1][axis]), p[2][axis]);
-        if (std::signbit(inv[axis]) ? lo > 0.0f : hi < 0.0f) return true;
+        if (std::isinf(inv[axis])) {
+            if (lo > 0.0f || hi < 0.0f) return true;
+        } else if (std::signbit(inv[axis]) ? lo > 0.0f : hi < 0.0f) {
+            return true;
+        }
     }
     return false;
 }

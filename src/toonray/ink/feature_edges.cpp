@@ -115,7 +115,7 @@ WeldedMesh weld_vertices_without_rings(const TriangleMesh& scene, bool one_objec
         object_of(single ? 0 : scene.positions.size());
     if (single) {
         // One object: an id per canonical position, in a loop with nothing else to decide
-        // (a third of the general loop's instructions at a million triangles).
+        // (welding at 1.1M triangles: 155M instructions with the general loop, 85M with this).
         auto weld_one_object = [&](auto shared) {
             const std::array<std::uint32_t, 3>* const corners = scene.tri_positions.data();
             std::array<std::uint32_t, 3>* const out = mesh.tri_vertices.data();
@@ -135,6 +135,7 @@ WeldedMesh weld_vertices_without_rings(const TriangleMesh& scene, bool one_objec
                     out[t][k] = id;
                 }
             mesh.vertex_position.resize(count);
+            mesh.vertex_position.shrink_to_fit();  // fewer ids than positions where they repeat
         };
         if (shared_bits) weld_one_object(std::true_type{});
         else weld_one_object(std::false_type{});
