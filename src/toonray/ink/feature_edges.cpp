@@ -703,7 +703,7 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
     // A full intersection search (without a cache of the same triangles' crossings) skips
     // patches that cannot cross themselves, which read the normals rounded (3 bytes a
     // triangle: the float normals are freed before the search) and the triangles across each
-    // side (MeshTopology::triangles_across, found with the edges below).
+    // side (MeshTopology::triangles_across, found from the mesh edges after the edge loop).
     const bool intersections = settings.intersections && !bvh.nodes.empty();
     const bool some_fresh = cache && cache->corners.size() == n && cache->tested.size() == n;
     const bool patches_searched = intersections && !some_fresh;
@@ -809,10 +809,6 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
                corner_normal(s0.tri(), s0.hi) == corner_normal(s1.tri(), s1.hi);
     };
     const EdgeBands edge_bands{scene, mesh, settings, eye, corner_normals};
-    // The triangles across the sides (MeshTopology::triangles_across), for a full intersection
-    // search.
-    std::vector<std::array<std::uint32_t, 3>> across;
-    if (patches_searched) across.assign(n, {kNoIndex, kNoIndex, kNoIndex});
     // One segment per edge that is a line: each is classified first, and made only if drawn.
     // The edges come by vertex, their faces from all over the per-triangle arrays: those of the
     // sides a few edges ahead are fetched while this one is classified.
@@ -856,7 +852,6 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
             const Side s1 = sides[i + 1];
             // Consistently wound neighbours run the shared side in opposite directions.
             const bool consistent = s0.forward() != s1.forward();
-            if (patches_searched) MeshTopology::link_across(s0, s1, across);
             const Vec3f n0 = normal_of[s0.tri()];
             const Vec3f n1 = consistent ? normal_of[s1.tri()] : -normal_of[s1.tri()];
             const float d0 = dot(n0, to_eye), d1 = dot(n1, to_eye);
@@ -959,6 +954,13 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
         // the search makes its slots: the frame's peak.
         std::vector<Vec3f>().swap(normal);
         std::vector<std::uint8_t>().swap(corner_normals);
+        // The triangles across the sides, for a full search: found from the mesh edges once the
+        // normals are freed, rather than beside them in the edge loop, which was the frame's
+        // peak (1.1M triangles: 13 MiB less peak memory and 0.983x the CPU, for 53M more
+        // instructions).
+        const std::vector<std::array<std::uint32_t, 3>> across =
+            patches_searched ? topology.triangles_across(n)
+                             : std::vector<std::array<std::uint32_t, 3>>();
         kept.reset();  // `topology` is not read from here on
         const SurfacePatches patches{rounded, across};
         std::vector<PairCrossing> found =
