@@ -111,8 +111,7 @@ WeldedMesh weld_vertices_without_rings(const TriangleMesh& scene, bool one_objec
                                          std::not_equal_to<>()) == scene.tri_object.begin() + n;
     WeldedMesh mesh;
     mesh.tri_vertices.resize(n);
-    std::vector<std::uint32_t> id_of(scene.positions.size(), kNoIndex),
-        object_of(single ? 0 : scene.positions.size());
+    std::vector<std::uint32_t> id_of(scene.positions.size(), kNoIndex);
     if (single) {
         // One object: an id per canonical position, in a loop with nothing else to decide
         // (welding at 1.1M triangles: 155M instructions with the general loop, 85M with this).
@@ -141,6 +140,8 @@ WeldedMesh weld_vertices_without_rings(const TriangleMesh& scene, bool one_objec
         else weld_one_object(std::false_type{});
         return mesh;
     }
+    // Several objects: each canonical position keeps the object of its first use.
+    std::vector<std::uint32_t> object_of(scene.positions.size());
     std::map<std::pair<std::uint32_t, std::uint32_t>, std::uint32_t> shared;
     auto new_id = [&](std::uint32_t c) {
         mesh.vertex_position.push_back(c);
@@ -151,12 +152,12 @@ WeldedMesh weld_vertices_without_rings(const TriangleMesh& scene, bool one_objec
             // Every position its own canonical one when none shares its bits with another.
             const std::uint32_t position = scene.tri_positions[t][k],
                                 c = shared_bits ? canonical[position] : position,
-                                object = single ? 0u : scene.tri_object[t];
+                                object = scene.tri_object[t];
             std::uint32_t& id = mesh.tri_vertices[t][k];
             if (id_of[c] == kNoIndex) {
                 id = id_of[c] = new_id(c);
-                if (!single) object_of[c] = object;
-            } else if (single || object_of[c] == object) {
+                object_of[c] = object;
+            } else if (object_of[c] == object) {
                 id = id_of[c];
             } else {
                 auto [it, inserted] = shared.try_emplace({object, c}, 0u);
