@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "toonray/accel/triangle_accel.h"
+#include "toonray/accel/watertight.h"
 #include "toonray/scene/obj_loader.h"
 #include "accel/isas.h"
 #include "accel/soup.h"
@@ -275,4 +276,52 @@ TEST(Bvh, ACrossingBehindTheOriginIsNoHitOnAnyPath) {
         // Rays towards the plane from (2^-e, 1, 1.5) at these slopes reach it inside the quad.
         EXPECT_EQ(tile_hits, 24 * 2 * kSide * kSide);
     }
+}
+
+TEST(BoxHold, TheFusedTestKeepsEveryBoxItsShortcutVouchesFor) {
+    // held_to_box skips the fused box test where fused_test_keeps vouches for it from the
+    // two-rounding interval; if that were ever wrong, paths with and without the fused test
+    // would disagree. Triangles at scales from 2^-60 to 2^60, some flat along an axis, and
+    // rays aimed at a corner of their box, so that entry and exit often nearly meet.
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+    std::uniform_int_distribution<int> exponent(-60, 60), axis_of(0, 2);
+    int vouched = 0, tight = 0, fused_tight = 0;
+    for (int i = 0; i < 300000; ++i) {
+        const float scale = std::ldexp(1.0f, exponent(rng));
+        const float reach = std::ldexp(scale, i % 24 - 12);  // the origin's distance
+        const Vec3f centre(u(rng) * scale * 8.0f, u(rng) * scale * 8.0f, u(rng) * scale * 8.0f);
+        float q[3][3];
+        for (auto& corner : q)
+            for (int a = 0; a < 3; ++a) corner[a] = centre[a] + u(rng) * scale;
+        if (i % 3 == 0) {  // flat along one axis, as an axis-aligned face
+            const int a = axis_of(rng);
+            q[1][a] = q[2][a] = q[0][a];
+        }
+        // Near the box, or near the coordinates' zero, where the fused test's margins vanish.
+        const Vec3f around = i % 2 ? centre : Vec3f(0, 0, 0);
+        const float o[3] = {around.x + u(rng) * reach, around.y + u(rng) * reach,
+                            around.z + u(rng) * reach};
+        // Towards a corner of the box, nudged by a few ulps of the direction.
+        float dir[3];
+        for (int a = 0; a < 3; ++a) {
+            const float lo = std::min({q[0][a], q[1][a], q[2][a]});
+            const float hi = std::max({q[0][a], q[1][a], q[2][a]});
+            const float d = ((rng() & 1) ? lo : hi) - o[a];
+            dir[a] = d * (1.0f + u(rng) * 0x1p-20f);
+        }
+        const float inv[3] = {1.0f / dir[0], 1.0f / dir[1], 1.0f / dir[2]};
+        const accel::BoxInterval box = accel::two_rounding_interval(q, o, inv);
+        if (box.behind || !box.kept()) continue;
+        const accel::BoxInterval fused = accel::fused_interval(q, o, inv);
+        const bool fused_kept = fused.kept();
+        fused_tight += fused.entry > fused.exit ? 1 : 0;
+        if (!accel::fused_test_keeps(box.entry, box.exit)) continue;
+        ++vouched;
+        if (box.entry >= box.exit) ++tight;
+        ASSERT_TRUE(fused_kept) << "ray " << i << ": entry " << box.entry << ", exit " << box.exit;
+    }
+    EXPECT_GT(vouched, 100000);
+    EXPECT_GT(tight, 1000);        // boxes the ray only grazes, where the shortcut's bound is tight
+    EXPECT_GT(fused_tight, 1000);  // the fused test keeping a box only by its kBoxSlack
 }

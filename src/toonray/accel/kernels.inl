@@ -14,10 +14,10 @@
 // it answers exactly whether intersect1 finds one. Box culling is conservative: the far
 // distance is widened by kBoxSlack as before; the AVX2/AVX-512 single-ray box test uses FMA
 // with its rounding error folded into the constants; interval (frustum) tests bound the per-ray
-// slab distances exactly (float multiplication is monotonic); and NaN distances never cull.
-// Conservative for the exact slabs, that is: a hit whose rounded t lies outside its box, on a
-// ray that misses the box, is kept by the FMA test's wider margins and culled by the SSE one
-// (docs/robustness.md, "Open in the accelerator").
+// two-rounding slab distances exactly (float multiplication is monotonic); and NaN distances
+// never cull. A hit whose rounding puts it on a ray that one of these tests finds missing its
+// triangle's box is refused on every path (held_to_box in watertight.h), so the box tests cull
+// no hit that another path would take.
 
 constexpr int kNearLo[3] = {0, 8, 16};    // offsets of lo[axis] in a WideNode, in floats
 constexpr int kNearHi[3] = {24, 32, 40};  // offsets of hi[axis]
@@ -83,40 +83,6 @@ TR_INLINE LaneResult finish8(const Edges& e, vf8 akz, vf8 bkz, vf8 ckz, vf8 sz, 
     return finish<vf8, vm8>(e, akz, bkz, ckz, sz, tmax);
 }
 
-// box_entry() of watertight.h for a regular tile group (finite inverse directions, one sign
-// per axis) on 8 lanes, for corners `p`: per axis the least product of a corner and the
-// inverse direction. Multiplying by a positive number keeps the corners' order and by a
-// negative one reverses it, so that is the product of the corner box_entry picks, whenever
-// the lane can be a hit (an infinite or NaN corner makes its t NaN; a zero product's sign, as
-// from an inverse of -0, does not matter: the entry starts from +0).
-// vmin and vmax are minps and maxps. Hits are held to it (held_to_box) only where one would be
-// taken: a t that rises can only lose, so the others are settled without it.
-TR_INLINE vf8 group_box_entry(const vf8 (&p)[3][3], const vf8 (&inv)[3]) {
-    vf8 entry = set1(0.0f);
-    for (int axis = 0; axis < 3; ++axis) {
-        vf8 d = p[0][axis] * inv[axis];
-        d = vmin(p[1][axis] * inv[axis], d);
-        d = vmin(p[2][axis] * inv[axis], d);
-        entry = vmax(d, entry);
-    }
-    return entry;
-}
-
-// box_behind() of watertight.h on 8 lanes: the corners `p` shared, the inverse directions per
-// lane (a lane's sign bit picks the far side, as box_behind's signbit does). A regular group's
-// directions have no zero component, so no lane's inverse is infinite.
-TR_INLINE vm8 group_box_behind(const vf8 (&p)[3][3], const vf8 (&inv)[3]) {
-    const vf8 zero = set1(0.0f);
-    vm8 behind = zero < zero;
-    for (int axis = 0; axis < 3; ++axis) {
-        const vf8 lo = vmin(vmin(p[0][axis], p[1][axis]), p[2][axis]);
-        const vf8 hi = vmax(vmax(p[0][axis], p[1][axis]), p[2][axis]);
-        const vm8 negative = as_mask(inv[axis]);
-        behind = behind | (negative & (lo > zero)) | andnot(negative, hi < zero);
-    }
-    return behind;
-}
-
 inline float as_float(std::uint32_t u) {
     float f;
     std::memcpy(&f, &u, 4);
@@ -144,11 +110,11 @@ TR_INLINE float lane_held_to_box(float t, const LeafRay& lr, const TriBlock& b0,
     const TriBlock& b = i < 4 ? b0 : b1;
     const int l = i & 3;
     const int k[3] = {lr.sr.kx, lr.sr.ky, lr.sr.kz};
-    float p[3][3];
+    float q[3][3];
     for (int c = 0; c < 3; ++c)
-        for (int r = 0; r < 3; ++r) p[c][r] = b.v[c][k[r]][l] - lr.o[r];
+        for (int r = 0; r < 3; ++r) q[c][r] = b.v[c][k[r]][l];
     const float inv[3] = {lr.sr.ix, lr.sr.iy, lr.sr.sz};
-    return held_to_box(t, p, inv);
+    return held_to_box(t, q, lr.o, inv);
 }
 
 constexpr std::uint32_t kPrimMask = ~kLeafEnd;
@@ -339,14 +305,12 @@ struct RayBoxes {
     std::size_t nr[3], fr[3];
 #ifdef TOONRAY_ACCEL_FMA
     // Slab distances as one fused multiply-add per plane, t = p * inv + c with c = -o * inv,
-    // made conservative in the constants: c's rounding error is at most |c| 2^-24, so near
-    // planes use c - |c| 2^-21 - 2^-146 and far planes c + |c| 2^-21 + 2^-146 (the absolute
-    // term for the denormals, whose roundings are absolute); the far distance is then widened
-    // by kBoxSlack as in the plain test. (Infinite or NaN terms give NaN, which never culls.)
-    // This visits other boxes than the SSE kernels' two-rounding test, but both only widen the
-    // exact slab interval (by far less than kBoxSlack), so neither culls a box that holds the
-    // closest hit, and the hit (lowest t, then index, over the FMA-free triangle tests) is the
-    // same: every ISA gives the same pixels (tile_test.cpp, scripts/compare-frames.sh).
+    // made conservative in the constants (fused_slab in watertight.h); the far distance is
+    // then widened by kBoxSlack as in the plain test. This visits other boxes than the SSE
+    // kernels' two-rounding test, but a hit in a box that either test culls is refused on
+    // every path (held_to_box), so the hit (lowest t, then index, over the FMA-free triangle
+    // tests) is the same: every ISA gives the same pixels (tile_test.cpp,
+    // scripts/compare-frames.sh).
     vf8 in8[3], cn8[3], cf8[3];
 #else
     vf8 o8[3], i8[3];
@@ -364,13 +328,10 @@ struct RayBoxes {
         fr[2] = 40 - 24 * nz;
         for (int a = 0; a < 3; ++a) {
 #ifdef TOONRAY_ACCEL_FMA
-            const float c = -(ray.origin[a] * inv[a]);
-            // Plus a few of the smallest denormals, where the relative margin vanishes and the
-            // roundings do not.
-            const float margin = std::abs(c) * (1.0f / (1 << 21)) + 0x1p-146f;
+            const FusedSlab slab = fused_slab(ray.origin[a], inv[a]);
             in8[a] = set1(inv[a]);
-            cn8[a] = set1(c - margin);
-            cf8[a] = set1(c + margin);
+            cn8[a] = set1(slab.near);
+            cf8[a] = set1(slab.far);
 #else
             o8[a] = set1(ray.origin[a]);
             i8[a] = set1(inv[a]);
@@ -710,6 +671,50 @@ TR_INLINE void group_zero_lanes(int zero, TileState& s, int g, const Vec3f& orig
     } while (zero);
 }
 
+// held_to_box() of watertight.h for a regular group's 8 lanes: the corners relative to the
+// origin `p` shared (those of triangle j of block b, in the group's kx, ky, kz order `k`), the
+// inverse directions per lane, with no zero component (finite inverses). The same operations
+// lane by lane: a lane's sign bit picks the sides as signbit does, vmin and vmax are lane_min
+// and lane_max, multiplying by -1 is negation, and exact_fmadd rounds once as std::fma does.
+TR_INLINE vf8 group_held_to_box(vf8 t, const vf8 (&p)[3][3], const vf8 (&inv)[3], const TriBlock& b,
+                                int j, const int (&k)[3], const Vec3f& origin) {
+    const vf8 zero = set1(0.0f), inf = set1(std::numeric_limits<float>::infinity());
+    vf8 entry = zero, exit = inf;
+    vm8 culled = zero < zero;
+    for (int r = 0; r < 3; ++r) {
+        const vf8 lo = vmin(vmin(p[0][r], p[1][r]), p[2][r]);
+        const vf8 hi = vmax(vmax(p[0][r], p[1][r]), p[2][r]);
+        const vm8 negative = as_mask(inv[r]);
+        culled = culled | (negative & (lo > zero)) | andnot(negative, hi < zero);  // behind
+        entry = vmax(select(negative, hi, lo) * inv[r], entry);
+        exit = vmin(select(negative, lo, hi) * inv[r], exit);
+    }
+    const vf8 slack = set1(kBoxSlack);
+    culled = culled | not_mask(entry <= exit * slack);
+    // fused_test_keeps lane by lane; the fused test only where some lane needs it.
+    const vm8 kept = (exit >= set1(0x1p-100f)) & (exit <= set1(0x1p100f)) &
+                     (entry <= exit * set1(1.0f + 0x1p-22f));
+    if (movemask(culled | kept) != 0xff) {
+        vf8 fused_entry = zero, fused_exit = inf;
+        for (int r = 0; r < 3; ++r) {
+            const float q0 = b.v[0][k[r]][j], q1 = b.v[1][k[r]][j], q2 = b.v[2][k[r]][j];
+            const vf8 lo = set1(lane_min(lane_min(q0, q1), q2));
+            const vf8 hi = set1(lane_max(lane_max(q0, q1), q2));
+            const vm8 negative = as_mask(inv[r]);
+            const vf8 c = (set1(origin[k[r]]) * inv[r]) * set1(-1.0f);  // fused_slab
+            const vf8 margin = vabs(c) * set1(1.0f / (1 << 21)) + set1(0x1p-146f);
+            fused_entry =
+                vmax(exact_fmadd(select(negative, hi, lo), inv[r], c - margin), fused_entry);
+            fused_exit =
+                vmin(exact_fmadd(select(negative, lo, hi), inv[r], c + margin), fused_exit);
+        }
+        culled = culled | not_mask(fused_entry <= fused_exit * slack);
+    }
+    const vf8 bound = entry * set1(kEntrySlack);
+    return select(culled, set1(std::numeric_limits<float>::quiet_NaN()),
+                  select(t < bound, bound, t));
+}
+
 // Tests the rays of `groups` against every triangle of a leaf, triangle by triangle: the
 // triangle's corners relative to the origin, in a permutation's order, are shared by all groups
 // of that permutation (usually all of them).
@@ -746,13 +751,9 @@ TR_INLINE void leaf_groups(const WideBvh& w, std::uint32_t ref, TileState& s, st
             vm8 take = r.ok & ((r.t < tmax) | lower);
             vf8 t = r.t;
             if (movemask(take)) {
-                // Held to the triangle's box, a t can only rise: take again.
+                // Held to the triangle's box, a t can only rise or be refused: take again.
                 const vf8 inv[3] = {load8(s.ix[g]), load8(s.iy[g]), load8(s.sz[g])};
-                const vf8 bound = group_box_entry(a, inv) * set1(kEntrySlack);
-                t = select(t < bound, bound, t);
-                // Refused (NaN) where the box is behind the origin.
-                t = select(group_box_behind(a, inv), set1(std::numeric_limits<float>::quiet_NaN()),
-                           t);
+                t = group_held_to_box(t, a, inv, b, j, s.k[g], origin);
                 take = take & (t <= tmax) & ((t < tmax) | lower);
             }
             if (movemask(take)) {

@@ -38,6 +38,8 @@ TR_INLINE vf8 vmin(vf8 a, vf8 b) { return {_mm256_min_ps(a.m, b.m)}; }
 #ifdef TOONRAY_ACCEL_FMA
 // Only where rounding once is accounted for (the box tests), never in the triangle tests.
 TR_INLINE vf8 fmadd(vf8 a, vf8 b, vf8 c) { return {_mm256_fmadd_ps(a.m, b.m, c.m)}; }
+// a * b + c rounded once, as std::fma: what the other builds compute of the fused box test.
+TR_INLINE vf8 exact_fmadd(vf8 a, vf8 b, vf8 c) { return fmadd(a, b, c); }
 #endif
 TR_INLINE vf8 vmax(vf8 a, vf8 b) { return {_mm256_max_ps(a.m, b.m)}; }
 TR_INLINE vf8 vabs(vf8 a) { return {_mm256_andnot_ps(_mm256_set1_ps(-0.0f), a.m)}; }
@@ -122,6 +124,17 @@ TR_BIN(operator/, _mm_div_ps)
 TR_BIN(vmin, _mm_min_ps)
 TR_BIN(vmax, _mm_max_ps)
 #undef TR_BIN
+// a * b + c rounded once, lane by lane through std::fma (the CPU's fused multiply-add where it
+// has one, else the library's exact emulation): the AVX2 kernels' fused box test, which only
+// the refusal of hits (held_to_box in watertight.h) computes here.
+TR_INLINE vf8 exact_fmadd(vf8 a, vf8 b, vf8 c) {
+    alignas(16) float x[8], y[8], z[8];
+    store8(x, a);
+    store8(y, b);
+    store8(z, c);
+    for (int i = 0; i < 8; ++i) x[i] = std::fma(x[i], y[i], z[i]);
+    return load8(x);
+}
 TR_INLINE vf8 vabs(vf8 a) {
     const __m128 s = _mm_set1_ps(-0.0f);
     return {_mm_andnot_ps(s, a.l), _mm_andnot_ps(s, a.h)};

@@ -49,25 +49,6 @@ struct ShearedRay {
 inline float lane_min(float a, float b) { return a < b ? a : b; }
 inline float lane_max(float a, float b) { return a > b ? a : b; }
 
-// Where the ray enters the triangle's bounding box, as the box tests find a box's entry: per
-// axis the corner nearest along the ray (the lowest, or the highest when the inverse direction's
-// sign bit is set, so that -0 counts as negative as -inf does) times the inverse direction, and
-// the farthest of those and 0. A NaN (a corner in the plane of a direction component that is
-// zero: 0 * inf) is ignored, as the box tests ignore it. `p` holds the corners relative to the
-// origin in the ray's kx, ky, kz order, `inv` the inverse direction in that order. The
-// single-ray kernels do the same operations; a regular tile group takes the least product over
-// the corners per axis, the same value for every lane that can be a hit (group_box_entry in
-// kernels.inl).
-inline float box_entry(const float (&p)[3][3], const float (&inv)[3]) {
-    float entry = 0.0f;
-    for (int axis = 0; axis < 3; ++axis) {
-        const float lo = lane_min(lane_min(p[0][axis], p[1][axis]), p[2][axis]);
-        const float hi = lane_max(lane_max(p[0][axis], p[1][axis]), p[2][axis]);
-        entry = lane_max((std::signbit(inv[axis]) ? hi : lo) * inv[axis], entry);
-    }
-    return entry;
-}
-
 // A hit's t is raised to the ray's entry into the triangle's box, less this fraction. The
 // traversal culls a box that the ray enters beyond the best t (widened by kBoxSlack), which is
 // only safe if no triangle's t lies before its box. For a triangle seen almost edge-on, far
@@ -78,33 +59,113 @@ inline float box_entry(const float (&p)[3][3], const float (&inv)[3]) {
 // within it and keep their t.
 inline constexpr float kEntrySlack = 1.0f - 1.0f / (1 << 21);
 
-// Whether the triangle's box lies wholly behind the ray's origin along some axis: its far side
-// there (the highest corner, or the lowest when the inverse direction's sign bit is set) is on
-// the origin's near side. Along an axis the ray does not move on (a zero direction component:
-// an infinite inverse), either side of the origin will do. Then no point of the triangle is at
-// t >= 0, and the box tests find the box's exit before 0 (or its entry at infinity) and cull
-// it; a positive t from the watertight test is its rounding (an origin within an ulp or so of
-// the triangle's plane, the ray leaving it). The corners are differences of floats, whose signs
-// are exact, so this is decided exactly, the same way on every path.
-inline bool box_behind(const float (&p)[3][3], const float (&inv)[3]) {
-    for (int axis = 0; axis < 3; ++axis) {
-        const float lo = lane_min(lane_min(p[0][axis], p[1][axis]), p[2][axis]);
-        const float hi = lane_max(lane_max(p[0][axis], p[1][axis]), p[2][axis]);
-        if (std::isinf(inv[axis])) {
-            if (lo > 0.0f || hi < 0.0f) return true;
-        } else if (std::signbit(inv[axis]) ? lo > 0.0f : hi < 0.0f) {
-            return true;
-        }
-    }
-    return false;
+// The box tests' slack on the far distance (pbrt's 1 + 2 gamma(3), rounded up): rounding never
+// culls a box whose triangle is hit at exactly tmax, so ties reach the triangle test and are
+// broken by index.
+inline constexpr float kBoxSlack = 1.0f + 1.0f / (1 << 20);
+
+// The fused box test's constants on one axis (the AVX2 and AVX-512 single-ray kernels,
+// RayBoxes in kernels.inl): a plane at p is entered at fma(p, inv, near) and left at
+// fma(p, inv, far). c = -origin * inv rounds by at most |c| 2^-24, so near and far are c less
+// and plus |c| 2^-21, and a few of the smallest denormals, where the relative margin vanishes
+// and the roundings do not. (Infinite or NaN terms give NaN, which never culls.)
+struct FusedSlab {
+    float near, far;
+};
+inline FusedSlab fused_slab(float origin, float inv) {
+    const float c = -(origin * inv);
+    const float margin = std::abs(c) * (1.0f / (1 << 21)) + 0x1p-146f;
+    return {c - margin, c + margin};
 }
 
-// t held to the triangle's box: at least box_entry(p, inv) * kEntrySlack, and NaN (no hit:
-// every comparison with it fails) when the box is behind the origin (box_behind). Either only
-// raises t or refuses it, so a lane refused by its t before is refused after.
-inline float held_to_box(float t, const float (&p)[3][3], const float (&inv)[3]) {
-    if (box_behind(p, inv)) return std::numeric_limits<float>::quiet_NaN();
-    const float bound = box_entry(p, inv) * kEntrySlack;
+// Whether the fused box test keeps a box that the two-rounding test finds entered at `entry`
+// and left at `exit` (the box not behind the origin), without computing it. Per axis the
+// fused near distance is at most the exact (q - o) * inv plus 2^-24 of it (the margins of
+// fused_slab outweigh the rounding of c) and 2^-145, and the two-rounding one within 2 * 2^-24
+// of it and 2^-150 (a subnormal difference q - o is exact): so the fused entry is at most
+// entry (1 + 2^-22) + 2^-145, and likewise the fused exit at least exit (1 - 2^-22) - 2^-145.
+// With entry <= exit (1 + 2^-22) (a flat box has entry = exit) and exit within [2^-100,
+// 2^100], where the absolute terms vanish and nothing overflows, the fused test's kBoxSlack
+// (1 + 2^-20) then covers both. An axis the ray does not move on (an infinite inverse) enters
+// neither interval unless the box is behind or its entry is infinite; one where c overflows
+// only widens the fused interval. The caller computes the fused test where this fails.
+inline bool fused_test_keeps(float entry, float exit) {
+    return exit >= 0x1p-100f && exit <= 0x1p100f && entry <= exit * (1.0f + 0x1p-22f);
+}
+
+// A triangle's box as a box test finds it: where the ray enters and leaves it, and (for the
+// two-rounding test) whether it lies behind the origin; see held_to_box.
+struct BoxInterval {
+    float entry = 0.0f, exit = std::numeric_limits<float>::infinity();
+    bool behind = false;
+    /// Not culled by the box test, with no hit yet.
+    [[nodiscard]] bool kept() const { return entry <= exit * kBoxSlack; }
+};
+
+// The two-rounding test's interval of the box of corners `q` for origin `o` and inverse
+// direction `inv` (all in the ray's kx, ky, kz order), with "behind" decided from the signs of
+// the corners relative to the origin.
+inline BoxInterval two_rounding_interval(const float (&q)[3][3], const float (&o)[3],
+                                         const float (&inv)[3]) {
+    BoxInterval box;
+    for (int axis = 0; axis < 3; ++axis) {
+        const float p0 = q[0][axis] - o[axis], p1 = q[1][axis] - o[axis], p2 = q[2][axis] - o[axis];
+        const float lo = lane_min(lane_min(p0, p1), p2), hi = lane_max(lane_max(p0, p1), p2);
+        const bool negative = std::signbit(inv[axis]);
+        if (std::isinf(inv[axis])) box.behind = box.behind || lo > 0.0f || hi < 0.0f;
+        else box.behind = box.behind || (negative ? lo > 0.0f : hi < 0.0f);
+        box.entry = lane_max((negative ? hi : lo) * inv[axis], box.entry);
+        box.exit = lane_min((negative ? lo : hi) * inv[axis], box.exit);
+    }
+    return box;
+}
+
+// The fused test's interval of the same box (its `behind` is not computed).
+inline BoxInterval fused_interval(const float (&q)[3][3], const float (&o)[3],
+                                  const float (&inv)[3]) {
+    BoxInterval box;
+    for (int axis = 0; axis < 3; ++axis) {
+        const bool negative = std::signbit(inv[axis]);
+        const float lo = lane_min(lane_min(q[0][axis], q[1][axis]), q[2][axis]);
+        const float hi = lane_max(lane_max(q[0][axis], q[1][axis]), q[2][axis]);
+        const FusedSlab slab = fused_slab(o[axis], inv[axis]);
+        box.entry = lane_max(std::fma(negative ? hi : lo, inv[axis], slab.near), box.entry);
+        box.exit = lane_min(std::fma(negative ? lo : hi, inv[axis], slab.far), box.exit);
+    }
+    return box;
+}
+
+// A hit's t held to its triangle's box, or NaN (no hit: every comparison with it fails) when
+// the box refuses it. `q` holds the corners, `o` the origin and `inv` the inverse direction,
+// all in the ray's kx, ky, kz order. Per axis, with the corners
+// relative to the origin p = q - o, the box's near side is its lowest corner (the highest when
+// the inverse direction's sign bit is set, so that -0 counts as negative as -inf does).
+//
+// - Entry: t is raised to at least the ray's entry into the box less kEntrySlack, as the box
+//   tests find a box's entry: the farthest of 0 and the near sides' p * inv (a NaN, 0 * inf
+//   from a corner in the plane of a zero direction component, is ignored as the box tests
+//   ignore it). A regular tile group computes the same per lane (group_held_to_box).
+// - Behind: refused when the box lies wholly behind the origin along some axis (its far side
+//   on the origin's near side; along an axis the ray does not move on, an infinite inverse,
+//   either side). No point of the triangle is then at t >= 0; a positive t from the watertight
+//   test is its rounding (an origin within an ulp of the triangle's plane, the ray leaving
+//   it). Signs of float differences are exact, so this is decided the same way on every path.
+// - Culled: refused when a box test would cull the box with no hit yet: the two-rounding test
+//   of the SSE kernels and of the tiles' intervals, p * inv, or the fused test,
+//   fma(q, inv, slab), each with kBoxSlack, as the kernels do them. Both tests are monotonic in
+//   the box, so a box either culls holds no triangle whose box both keep: whichever test a path
+//   runs, it never culls a hit that another path takes. Only a hit whose rounding puts it on a
+//   ray that misses its box is refused (the eye within a rounding of a long triangle's edge).
+//   The fused test is computed only where fused_test_keeps cannot vouch for it.
+//
+// Either only raises t or refuses it, so a lane refused by its t before is refused after.
+inline float held_to_box(float t, const float (&q)[3][3], const float (&o)[3],
+                         const float (&inv)[3]) {
+    const BoxInterval box = two_rounding_interval(q, o, inv);
+    if (box.behind || !box.kept()) return std::numeric_limits<float>::quiet_NaN();
+    if (!fused_test_keeps(box.entry, box.exit) && !fused_interval(q, o, inv).kept())
+        return std::numeric_limits<float>::quiet_NaN();
+    const float bound = box.entry * kEntrySlack;
     return t < bound ? bound : t;
 }
 
@@ -137,17 +198,14 @@ inline bool watertight_test(const ShearedRay& r, const Vec3f& v0, const Vec3f& v
     u = e1 * inv;
     v = e2 * inv;
     if (!(t > 0.0f)) return false;
-    const float corners[3][3] = {
-        {a[r.kx], a[r.ky], a[r.kz]}, {b[r.kx], b[r.ky], b[r.kz]}, {c[r.kx], c[r.ky], c[r.kz]}};
+    const float corners[3][3] = {{v0[r.kx], v0[r.ky], v0[r.kz]},
+                                 {v1[r.kx], v1[r.ky], v1[r.kz]},
+                                 {v2[r.kx], v2[r.ky], v2[r.kz]}};
+    const float origin[3] = {r.origin[r.kx], r.origin[r.ky], r.origin[r.kz]};
     const float inv_dir[3] = {r.ix, r.iy, r.sz};
-    t = held_to_box(t, corners, inv_dir);
+    t = held_to_box(t, corners, origin, inv_dir);
     return t <= tmax;
 }
-
-// The box tests' slack on the far distance (pbrt's 1 + 2 gamma(3), rounded up): rounding never
-// culls a box whose triangle is hit at exactly tmax, so ties reach the triangle test and are
-// broken by index.
-inline constexpr float kBoxSlack = 1.0f + 1.0f / (1 << 20);
 
 // Best hit so far. A candidate hit is taken when it is nearer, or at the same distance with a
 // lower triangle index (but a first hit must be strictly inside the ray's tmax): the result is
