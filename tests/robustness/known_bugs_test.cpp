@@ -48,8 +48,9 @@ TEST(KnownBugs, BvhBinningWithExtremeCoordinates) {
 
 namespace {
 
-// Every camera ray of `name`'s camera through the single-ray traversal, on every instruction
-// set this CPU has, must find the triangle and t that brute force over the triangles finds.
+// Every camera ray of `name`'s camera, on every instruction set this CPU has, must find the
+// triangle and t that brute force over the triangles finds: as a single ray, in occlusion and
+// in tiles.
 void expect_camera_rays_match_brute_force(const char* name) {
     Scene scene;
     Warnings warnings;
@@ -117,7 +118,7 @@ void expect_camera_rays_match_brute_force(const char* name) {
 }  // namespace
 
 // Fixed by refusing a hit whose triangle's box lies behind the ray's origin along some axis
-// (box_behind in accel/watertight.h, on every path). It was: the eye 1e-8 in front of a
+// (the "behind" rule of held_to_box in accel/watertight.h, on every path). It was: the eye 1e-8 in front of a
 // triangle's plane, rays leaving it. The watertight test's rounding put the crossing, which is
 // behind the eye, at t = +4.5e-8, so brute force over the triangles found a hit there; the
 // traversal culled the triangle's box, which the ray leaves before t = 0, and found none.

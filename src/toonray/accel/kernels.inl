@@ -708,7 +708,8 @@ TR_INLINE vf8 group_held_to_box(vf8 t, const vf8 (&p)[3][3], const vf8 (&inv)[3]
             fused_exit =
                 vmin(exact_fmadd(select(negative, lo, hi), inv[r], c + margin), fused_exit);
         }
-        culled = culled | not_mask(fused_entry <= fused_exit * slack);
+        // Only on the lanes the shortcut does not vouch for, as the scalar hold.
+        culled = culled | andnot(kept, not_mask(fused_entry <= fused_exit * slack));
     }
     const vf8 bound = entry * set1(kEntrySlack);
     return select(culled, set1(std::numeric_limits<float>::quiet_NaN()),

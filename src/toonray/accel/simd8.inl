@@ -40,6 +40,8 @@ TR_INLINE vf8 vmin(vf8 a, vf8 b) { return {_mm256_min_ps(a.m, b.m)}; }
 TR_INLINE vf8 fmadd(vf8 a, vf8 b, vf8 c) { return {_mm256_fmadd_ps(a.m, b.m, c.m)}; }
 // a * b + c rounded once, as std::fma: what the other builds compute of the fused box test.
 TR_INLINE vf8 exact_fmadd(vf8 a, vf8 b, vf8 c) { return fmadd(a, b, c); }
+#else
+#error "the AVX2 kernels are compiled with FMA (kernels_avx2.cpp, kernels_avx512.cpp)"
 #endif
 TR_INLINE vf8 vmax(vf8 a, vf8 b) { return {_mm256_max_ps(a.m, b.m)}; }
 TR_INLINE vf8 vabs(vf8 a) { return {_mm256_andnot_ps(_mm256_set1_ps(-0.0f), a.m)}; }

@@ -88,7 +88,10 @@ inline FusedSlab fused_slab(float origin, float inv) {
 // 2^100], where the absolute terms vanish and nothing overflows, the fused test's kBoxSlack
 // (1 + 2^-20) then covers both. An axis the ray does not move on (an infinite inverse) enters
 // neither interval unless the box is behind or its entry is infinite; one where c overflows
-// only widens the fused interval. The caller computes the fused test where this fails.
+// only widens the fused interval. The bound assumes finite corners relative to the origin: a
+// difference q - o that overflows can leave the interval vouched for while the fused test
+// culls the box, but then the watertight test has no hit to hold (its sheared corners are
+// infinite or NaN, so its t is NaN). The caller computes the fused test where this fails.
 inline bool fused_test_keeps(float entry, float exit) {
     return exit >= 0x1p-100f && exit <= 0x1p100f && entry <= exit * (1.0f + 0x1p-22f);
 }
