@@ -67,4 +67,15 @@ inline bool is_finite(const Vec3f& a) {
     return std::isfinite(a.x) && std::isfinite(a.y) && std::isfinite(a.z);
 }
 
+/// The unit geometric normal of triangle p0 p1 p2, (p1 - p0) x (p2 - p0) normalised, or zero
+/// for a degenerate triangle (a zero, infinite or NaN cross product). Always inlined: as a call
+/// it made the ink's per-triangle pass keep its sums in memory.
+[[gnu::always_inline]] inline Vec3f unit_face_normal(const Vec3f& p0, const Vec3f& p1,
+                                                     const Vec3f& p2) {
+    const Vec3f n = cross(p1 - p0, p2 - p0);
+    const float len = length(n);
+    if (!(len > 0.0f) || !std::isfinite(len)) return Vec3f(0.0f);
+    return n / len;
+}
+
 }  // namespace toonray

@@ -45,15 +45,6 @@ bool position_less(const Vec3f& a, const Vec3f& b) {
     return std::tie(a.x, a.y, a.z) < std::tie(b.x, b.y, b.z);
 }
 
-// Unit geometric normal (p1 - p0) x (p2 - p0), or zero for a degenerate triangle. Inlined: as
-// a call it made the per-triangle pass keep its sums in memory.
-[[gnu::always_inline]] inline Vec3f face_normal(const std::array<Vec3f, 3>& p) {
-    const Vec3f n = cross(p[1] - p[0], p[2] - p[0]);
-    const float len = length(n);
-    if (!(len > 0.0f) || !std::isfinite(len)) return Vec3f(0.0f);
-    return n / len;
-}
-
 bool has_corner_normals(const Scene& scene, std::size_t t) {
     if (t >= scene.tri_normals.size()) return false;
     for (std::uint32_t n : scene.tri_normals[t])
@@ -727,7 +718,7 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
         double sum = 0.0;
         for (std::size_t t = 0; t < n; ++t) {
             const auto p = corners_of(t);
-            const Vec3f nt = face_normal(p);
+            const Vec3f nt = unit_face_normal(p[0], p[1], p[2]);
             normal_out[t] = nt;
             if (patches_searched) rounded_out[t] = round_normal(nt);
             usable_out[t] = nt != Vec3f(0.0f);

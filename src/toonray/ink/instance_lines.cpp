@@ -260,13 +260,6 @@ struct MeshLines {
 
 namespace {
 
-Vec3f face_normal(const std::array<Vec3f, 3>& p) {
-    const Vec3f n = cross(p[1] - p[0], p[2] - p[0]);
-    const float len = length(n);
-    if (!(len > 0.0f) || !std::isfinite(len)) return Vec3f(0.0f);
-    return n / len;
-}
-
 // A face of a candidate edge as a point of 4D space: its normal and its plane's offset.
 std::array<float, 4> plane_point(const Vec3f& n, const Vec3f& p) {
     return {n.x, n.y, n.z, -dot(n, p)};
@@ -364,7 +357,7 @@ std::shared_ptr<const MeshLines> make_mesh_lines(std::shared_ptr<const TriangleM
         const auto& v = mesh.tri_positions[t];
         auto& p = ml.corners[t];
         p = {mesh.positions[v[0]], mesh.positions[v[1]], mesh.positions[v[2]]};
-        ml.normal[t] = face_normal(p);
+        ml.normal[t] = unit_face_normal(p[0], p[1], p[2]);
         usable[t] = ml.normal[t] != Vec3f(0.0f);
         bool corner = true;
         for (std::uint32_t k : mesh.tri_normals[t])
@@ -783,7 +776,7 @@ void own_triangles_in(const Scene& scene, const Bvh& bvh, const BBox& region,
             const auto& v = scene.tri_positions[t];
             WorldTriangle w{
                 t, {scene.positions[v[0]], scene.positions[v[1]], scene.positions[v[2]]}, {}};
-            if (face_normal(w.p) == Vec3f(0.0f)) continue;
+            if (unit_face_normal(w.p[0], w.p[1], w.p[2]) == Vec3f(0.0f)) continue;
             for (const Vec3f& q : w.p) w.box.extend(q);
             if (overlap(w.box, region)) out.push_back(w);
         }

@@ -44,10 +44,7 @@ Vec3f corner(const Scene& scene, std::uint32_t t, int k) {
 
 // The unit face normal, or zero for a degenerate triangle.
 Vec3f face_normal(const Scene& scene, std::uint32_t t) {
-    const Vec3f p0 = corner(scene, t, 0);
-    const Vec3f n = cross(corner(scene, t, 1) - p0, corner(scene, t, 2) - p0);
-    const float len = length(n);
-    return len > 0.0f && std::isfinite(len) ? n / len : Vec3f(0.0f);
+    return unit_face_normal(corner(scene, t, 0), corner(scene, t, 1), corner(scene, t, 2));
 }
 
 // Where g (given at the corners) crosses zero on the triangle's edges: the segment between the

@@ -214,7 +214,7 @@ using RoundedNormal = std::array<std::int8_t, 3>;
 }
 
 /// What lets the intersection search skip whole subtrees whose triangles cannot cross one
-/// another: per triangle, its unit normal (face_normal) rounded, and the triangles across its
+/// another: per triangle, its unit normal (unit_face_normal) rounded, and the triangles across its
 /// sides (MeshTopology::triangles_across).
 struct SurfacePatches {
     std::span<const RoundedNormal> normals;
