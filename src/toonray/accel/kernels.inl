@@ -692,8 +692,8 @@ TR_INLINE vf8 group_held_to_box(vf8 t, const vf8 (&p)[3][3], const vf8 (&inv)[3]
     const vf8 slack = set1(kBoxSlack);
     culled = culled | not_mask(entry <= exit * slack);
     // fused_test_keeps lane by lane; the fused test only where some lane needs it.
-    const vm8 kept = (exit >= set1(0x1p-100f)) & (exit <= set1(0x1p100f)) &
-                     (entry <= exit * set1(1.0f + 0x1p-22f));
+    const vm8 kept = (exit >= set1(kVouchedExitMin)) & (exit <= set1(kVouchedExitMax)) &
+                     (entry <= exit * set1(kVouchedRoom));
     if (movemask(culled | kept) != 0xff) {
         vf8 fused_entry = zero, fused_exit = inf;
         for (int r = 0; r < 3; ++r) {
@@ -702,7 +702,7 @@ TR_INLINE vf8 group_held_to_box(vf8 t, const vf8 (&p)[3][3], const vf8 (&inv)[3]
             const vf8 hi = set1(lane_max(lane_max(q0, q1), q2));
             const vm8 negative = as_mask(inv[r]);
             const vf8 c = (set1(origin[k[r]]) * inv[r]) * set1(-1.0f);  // fused_slab
-            const vf8 margin = vabs(c) * set1(1.0f / (1 << 21)) + set1(0x1p-146f);
+            const vf8 margin = vabs(c) * set1(kFusedMargin) + set1(kFusedFloor);
             fused_entry =
                 vmax(exact_fmadd(select(negative, hi, lo), inv[r], c - margin), fused_entry);
             fused_exit =

@@ -69,12 +69,14 @@ inline constexpr float kBoxSlack = 1.0f + 1.0f / (1 << 20);
 // fma(p, inv, far). c = -origin * inv rounds by at most |c| 2^-24, so near and far are c less
 // and plus |c| 2^-21, and a few of the smallest denormals, where the relative margin vanishes
 // and the roundings do not. (Infinite or NaN terms give NaN, which never culls.)
+// The margin's relative and absolute parts, shared with the tile's lane-by-lane copy.
+inline constexpr float kFusedMargin = 1.0f / (1 << 21), kFusedFloor = 0x1p-146f;
 struct FusedSlab {
     float near, far;
 };
 inline FusedSlab fused_slab(float origin, float inv) {
     const float c = -(origin * inv);
-    const float margin = std::abs(c) * (1.0f / (1 << 21)) + 0x1p-146f;
+    const float margin = std::abs(c) * kFusedMargin + kFusedFloor;
     return {c - margin, c + margin};
 }
 
@@ -92,8 +94,11 @@ inline FusedSlab fused_slab(float origin, float inv) {
 // difference q - o that overflows can leave the interval vouched for while the fused test
 // culls the box, but then the watertight test has no hit to hold (its sheared corners are
 // infinite or NaN, so its t is NaN). The caller computes the fused test where this fails.
+// Its constants are shared with the tile's lane-by-lane copy (group_held_to_box).
+inline constexpr float kVouchedExitMin = 0x1p-100f, kVouchedExitMax = 0x1p100f,
+                       kVouchedRoom = 1.0f + 0x1p-22f;
 inline bool fused_test_keeps(float entry, float exit) {
-    return exit >= 0x1p-100f && exit <= 0x1p100f && entry <= exit * (1.0f + 0x1p-22f);
+    return exit >= kVouchedExitMin && exit <= kVouchedExitMax && entry <= exit * kVouchedRoom;
 }
 
 // A triangle's box as a box test finds it: where the ray enters and leaves it, and (for the
