@@ -8,6 +8,7 @@
 #include <cmath>
 #include <map>
 #include <numbers>
+#include <random>
 #include <tuple>
 
 #include "ink/ink_scenes.h"
@@ -477,6 +478,77 @@ TEST(FindCrossings, SkippingPatchesThatCannotCrossThemselvesFindsTheSamePairs) {
     const auto all = found(nullptr);
     ASSERT_GT(all.size(), 150u);
     EXPECT_EQ(found(&patches), all);
+}
+
+// The four-at-a-time per-triangle pass gives the scalar pass's bits: normals, rounded normals,
+// usability, the eye's side, the volume summed in order and the box; on triangles of every
+// kind: ordinary, degenerate (a repeated corner, collinear corners), so large that the normal
+// overflows, so small that it underflows, and with the eye in a triangle's plane.
+TEST(FeatureEdges, TheTrianglePassByFourGivesTheScalarPassesBits) {
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
+    std::uniform_int_distribution<int> kind(0, 9);
+    const Vec3f eye(0.3f, 2.0f, 5.0f);
+    std::vector<Vec3f> positions;
+    std::vector<std::array<std::uint32_t, 3>> triangles;
+    const std::size_t n = 4003;  // the last three are left to the scalar pass
+    for (std::size_t t = 0; t < n; ++t) {
+        const auto first = static_cast<std::uint32_t>(positions.size());
+        const int k = kind(rng);
+        const float scale = k == 7 ? 3e19f : k == 8 ? 1e-22f : 10.0f;
+        for (int c = 0; c < 3; ++c)
+            positions.push_back(Vec3f(unit(rng), unit(rng), unit(rng)) * scale);
+        if (k == 5) positions[first + 2] = positions[first + 1];  // repeated corner
+        if (k == 6)                                               // collinear
+            positions[first + 2] =
+                positions[first] + (positions[first + 1] - positions[first]) * 2.0f;
+        if (k == 9)  // in the plane y = eye.y: the eye is in the triangle's plane
+            for (int c = 0; c < 3; ++c) positions[first + static_cast<std::uint32_t>(c)].y = eye.y;
+        triangles.push_back({first, first + 1, first + 2});
+    }
+    const ink::IndexedCorners corners_of{positions, triangles};
+    std::vector<Vec3f> normal(n);
+    std::vector<ink::RoundedNormal> rounded(n);
+    std::vector<std::uint8_t> usable(n), side(n);
+    BBox box;
+    double volume = 0.0;
+    const std::size_t done = ink::facts_by_four(
+        corners_of, eye, n, {normal.data(), rounded.data(), usable.data(), side.data()}, box,
+        volume);
+    ASSERT_EQ(done, 4000u);
+
+    BBox expected_box;
+    double expected_volume = 0.0;
+    int zero = 0, in_plane = 0;
+    for (std::size_t t = 0; t < done; ++t) {
+        const auto p = corners_of(static_cast<std::uint32_t>(t));
+        const Vec3f nt = unit_face_normal(p[0], p[1], p[2]);
+        using Bits = std::array<std::uint32_t, 3>;
+        EXPECT_EQ(std::bit_cast<Bits>(normal[t]), std::bit_cast<Bits>(nt)) << t;
+        EXPECT_EQ(rounded[t], ink::round_normal(nt)) << t;
+        EXPECT_EQ(usable[t], nt != Vec3f(0.0f) ? 1 : 0) << t;
+        const float facing = dot(nt, eye - p[0]);
+        EXPECT_EQ(side[t], facing > 0 ? ink::kEyeInFront : facing < 0 ? ink::kEyeBehind : 0) << t;
+        zero += nt == Vec3f(0.0f);
+        in_plane += nt != Vec3f(0.0f) && facing == 0;
+        expected_volume += static_cast<double>(dot(p[0], cross(p[1], p[2])));
+        for (const Vec3f& q : p) expected_box.extend(q);
+    }
+    EXPECT_EQ(std::bit_cast<std::uint64_t>(volume), std::bit_cast<std::uint64_t>(expected_volume));
+    EXPECT_EQ(box.lo, expected_box.lo);
+    EXPECT_EQ(box.hi, expected_box.hi);
+    // Every kind occurs: degenerate and overflowing triangles have no normal.
+    EXPECT_GT(zero, 600);
+    EXPECT_GT(in_plane, 100);
+
+    // Without rounded normals (no intersection search), the rest is the same.
+    std::vector<Vec3f> normal2(n);
+    BBox box2;
+    double volume2 = 0.0;
+    ink::facts_by_four(corners_of, eye, n, {normal2.data(), nullptr, usable.data(), side.data()},
+                       box2, volume2);
+    EXPECT_EQ(std::bit_cast<std::uint64_t>(volume2), std::bit_cast<std::uint64_t>(volume));
+    EXPECT_TRUE(std::equal(normal.begin(), normal.begin() + 4000, normal2.begin()));
 }
 
 TEST(FeatureEdges, SameForAnyThreadCount) {

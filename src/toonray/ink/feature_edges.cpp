@@ -596,6 +596,116 @@ template std::vector<PairCrossing> find_crossings(const Bvh&, const IndexedCorne
 
 namespace {
 
+// Corner c of triangles t .. t + 3, by axis (lane j: triangle t + j). Three floats a position:
+// a 16-byte load could read past the last.
+void corner_by_four(const IndexedCorners& corners_of, std::size_t t, int c, __m128& x, __m128& y,
+                    __m128& z) {
+    __m128 r[4];
+    for (std::size_t j = 0; j < 4; ++j) {
+        const Vec3f& p = corners_of.positions[corners_of.triangles[t + j][c]];
+        const __m128 xy = _mm_castsi128_ps(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(&p.x)));
+        r[j] = _mm_movelh_ps(xy, _mm_load_ss(&p.z));
+    }
+    const __m128 xy01 = _mm_unpacklo_ps(r[0], r[1]), xy23 = _mm_unpacklo_ps(r[2], r[3]);
+    const __m128 z01 = _mm_unpackhi_ps(r[0], r[1]), z23 = _mm_unpackhi_ps(r[2], r[3]);
+    x = _mm_movelh_ps(xy01, xy23);
+    y = _mm_movehl_ps(xy23, xy01);
+    z = _mm_movelh_ps(z01, z23);
+}
+
+}  // namespace
+
+// The same operations in the same order as the scalar pass, lane by lane: the same bits. Only
+// the box is reduced in another order, which can change the sign of a zero bound but not a
+// comparison with it. At a million triangles: about a third of the scalar pass's instructions.
+std::size_t facts_by_four(const IndexedCorners& corners_of, const Vec3f& eye, std::size_t n,
+                          const TriangleFacts& out, BBox& box, double& volume) {
+    const __m128 zero = _mm_setzero_ps(), inf = _mm_set1_ps(std::numeric_limits<float>::infinity());
+    const __m128 ex = _mm_set1_ps(eye.x), ey = _mm_set1_ps(eye.y), ez = _mm_set1_ps(eye.z);
+    __m128 lo[3] = {_mm_set1_ps(box.lo.x), _mm_set1_ps(box.lo.y), _mm_set1_ps(box.lo.z)};
+    __m128 hi[3] = {_mm_set1_ps(box.hi.x), _mm_set1_ps(box.hi.y), _mm_set1_ps(box.hi.z)};
+    auto mul = [](__m128 a, __m128 b) { return _mm_mul_ps(a, b); };
+    auto sub = [](__m128 a, __m128 b) { return _mm_sub_ps(a, b); };
+    auto dot = [&](__m128 ax, __m128 ay, __m128 az, __m128 bx, __m128 by, __m128 bz) {
+        return _mm_add_ps(_mm_add_ps(mul(ax, bx), mul(ay, by)), mul(az, bz));
+    };
+    std::size_t t = 0;
+    for (; t + 4 <= n; t += 4) {
+        __m128 p[3][3];
+        for (int c = 0; c < 3; ++c) {
+            corner_by_four(corners_of, t, c, p[c][0], p[c][1], p[c][2]);
+            for (int a = 0; a < 3; ++a) {
+                // BBox::extend: std::min(lo, q) is q < lo ? q : lo, as minps(q, lo).
+                lo[a] = _mm_min_ps(p[c][a], lo[a]);
+                hi[a] = _mm_max_ps(p[c][a], hi[a]);
+            }
+        }
+        // unit_face_normal: cross(p1 - p0, p2 - p0) over its length, zero unless that
+        // is positive and finite.
+        const __m128 ax = sub(p[1][0], p[0][0]), ay = sub(p[1][1], p[0][1]),
+                     az = sub(p[1][2], p[0][2]);
+        const __m128 bx = sub(p[2][0], p[0][0]), by = sub(p[2][1], p[0][1]),
+                     bz = sub(p[2][2], p[0][2]);
+        const __m128 nx = sub(mul(ay, bz), mul(az, by)), ny = sub(mul(az, bx), mul(ax, bz)),
+                     nz = sub(mul(ax, by), mul(ay, bx));
+        const __m128 len = _mm_sqrt_ps(dot(nx, ny, nz, nx, ny, nz));
+        const __m128 ok = _mm_and_ps(_mm_cmpgt_ps(len, zero), _mm_cmplt_ps(len, inf));
+        const __m128 ux = _mm_and_ps(ok, _mm_div_ps(nx, len)),
+                     uy = _mm_and_ps(ok, _mm_div_ps(ny, len)),
+                     uz = _mm_and_ps(ok, _mm_div_ps(nz, len));
+        const __m128 facing = dot(ux, uy, uz, sub(ex, p[0][0]), sub(ey, p[0][1]), sub(ez, p[0][2]));
+        const int front = _mm_movemask_ps(_mm_cmpgt_ps(facing, zero));
+        const int behind = _mm_movemask_ps(_mm_cmplt_ps(facing, zero));
+        const int usable = _mm_movemask_ps(ok);
+        // dot(p0, cross(p1, p2)), each added to the sum in triangle order.
+        const __m128 cx = sub(mul(p[1][1], p[2][2]), mul(p[1][2], p[2][1])),
+                     cy = sub(mul(p[1][2], p[2][0]), mul(p[1][0], p[2][2])),
+                     cz = sub(mul(p[1][0], p[2][1]), mul(p[1][1], p[2][0]));
+        alignas(16) float u[3][4], v[4];
+        _mm_store_ps(u[0], ux);
+        _mm_store_ps(u[1], uy);
+        _mm_store_ps(u[2], uz);
+        _mm_store_ps(v, dot(p[0][0], p[0][1], p[0][2], cx, cy, cz));
+        alignas(16) std::int32_t r[3][4];
+        if (out.rounded) {
+            // round_normal: n + (n < 0 ? -0.5 : 0.5), truncated.
+            const __m128 half = _mm_set1_ps(0.5f), less_half = _mm_set1_ps(-0.5f);
+            const __m128 scale = _mm_set1_ps(127.0f);
+            const __m128 un[3] = {ux, uy, uz};
+            for (int a = 0; a < 3; ++a) {
+                const __m128 q = mul(un[a], scale);
+                const __m128 add = _mm_blendv_ps(half, less_half, _mm_cmplt_ps(q, zero));
+                _mm_store_si128(reinterpret_cast<__m128i*>(r[a]),
+                                _mm_cvttps_epi32(_mm_add_ps(q, add)));
+            }
+        }
+        for (std::size_t j = 0; j < 4; ++j) {
+            out.normal[t + j] = Vec3f(u[0][j], u[1][j], u[2][j]);
+            if (out.rounded)
+                out.rounded[t + j] = {static_cast<std::int8_t>(r[0][j]),
+                                      static_cast<std::int8_t>(r[1][j]),
+                                      static_cast<std::int8_t>(r[2][j])};
+            out.usable[t + j] = (usable >> j) & 1;
+            out.eye_side[t + j] = (front >> j) & 1    ? kEyeInFront
+                                  : (behind >> j) & 1 ? kEyeBehind
+                                                      : 0;
+            volume += static_cast<double>(v[j]);
+        }
+    }
+    alignas(16) float l[3][4], h[3][4];
+    for (int a = 0; a < 3; ++a) {
+        _mm_store_ps(l[a], lo[a]);
+        _mm_store_ps(h[a], hi[a]);
+    }
+    for (std::size_t j = 0; j < 4; ++j) {
+        box.lo = min(box.lo, Vec3f(l[0][j], l[1][j], l[2][j]));
+        box.hi = max(box.hi, Vec3f(h[0][j], h[1][j], h[2][j]));
+    }
+    return t;
+}
+
+namespace {
+
 // What band changes across mesh edges are found with.
 struct EdgeBands {
     const Scene& scene;
@@ -704,7 +814,6 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
     std::vector<Vec3f> normal(n);
     std::vector<std::uint8_t> corner_normals(n), usable_triangle(n), eye_side(n);
     std::vector<RoundedNormal> rounded(patches_searched ? n : 0);
-    constexpr std::uint8_t kEyeInFront = 1, kEyeBehind = 2;
     // (A scene without normals has no triangle with a normal at every corner.)
     const bool normals_given = !scene.tri_normals.empty() && !scene.normals.empty();
     auto triangle_pass = [&](auto one_object) {
@@ -716,7 +825,16 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
         // One object's box and volume are summed in locals, in the same order.
         BBox box;
         double sum = 0.0;
-        for (std::size_t t = 0; t < n; ++t) {
+        std::size_t t = 0;
+        if constexpr (decltype(one_object)::value) {
+            const TriangleFacts facts{normal_out, patches_searched ? rounded_out : nullptr,
+                                      usable_out, side_out};
+            t = facts_by_four(corners_of, eye, n, facts, box, sum);
+            if (normals_given)
+                for (std::size_t u = 0; u < t; ++u)
+                    corner_normals_out[u] = has_corner_normals(scene, u);
+        }
+        for (; t < n; ++t) {
             const auto p = corners_of(t);
             const Vec3f nt = unit_face_normal(p[0], p[1], p[2]);
             normal_out[t] = nt;
@@ -798,7 +916,7 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
     auto smooth_across = [&](std::uint32_t lo, const Side& s0, const Side& s1) {
         if (!corner_normals[s0.tri()] || !corner_normals[s1.tri()]) return false;
         return corner_normal(s0.tri(), lo) == corner_normal(s1.tri(), lo) &&
-               corner_normal(s0.tri(), s0.hi) == corner_normal(s1.tri(), s1.hi);
+               corner_normal(s0.tri(), s0.hi()) == corner_normal(s1.tri(), s1.hi());
     };
     const EdgeBands edge_bands{scene, mesh, settings, eye, corner_normals};
     // One segment per edge that is a line: each is classified first, and made only if drawn.
@@ -824,9 +942,12 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
     topology.for_each_edge([&](std::uint32_t i, std::uint32_t j,
                                std::uint32_t lo) __attribute__((always_inline)) {
         if (i + kAhead + 2 <= side_count) {
-            for (std::size_t k = i + kAhead; k < i + kAhead + 2; ++k) {
-                __builtin_prefetch(&normal_of[sides[k].tri()]);
-                if (materials) __builtin_prefetch(&material_of[sides[k].tri()]);
+            const std::uint32_t t0 = sides[i + kAhead].tri(), t1 = sides[i + kAhead + 1].tri();
+            __builtin_prefetch(&normal_of[t0]);
+            __builtin_prefetch(&normal_of[t1]);
+            if (materials) {
+                __builtin_prefetch(&material_of[t0]);
+                __builtin_prefetch(&material_of[t1]);
             }
         }
         // Copies: the links' stores below could otherwise change them.
@@ -855,7 +976,7 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
             else if (materials && material_of[s0.tri()] != material_of[s1.tri()])
                 type = EdgeType::Material;
             else if (settings.bands && !smooth_across(lo, s0, s1) &&
-                     bands_differ(edge_bands, lo, s0.hi, s0.tri(), s1.tri(), n0, n1))
+                     bands_differ(edge_bands, lo, s0.hi(), s0.tri(), s1.tri(), n0, n1))
                 type = EdgeType::Band;
             else return;
             const int out = outward[scene.tri_object[s0.tri()]];
@@ -865,9 +986,9 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
         }
         FeatureSegment& seg = segments.emplace_back();
         seg.p0 = p0;
-        seg.p1 = positions[position_of[s0.hi]];
+        seg.p1 = positions[position_of[s0.hi()]];
         seg.key0 = {lo, kNoIndex, kNoIndex};
-        seg.key1 = {s0.hi, kNoIndex, kNoIndex};
+        seg.key1 = {s0.hi(), kNoIndex, kNoIndex};
         seg.faces = {s0.tri(), j - i > 1 ? sides[i + 1].tri() : kNoIndex};
         seg.type = type;
         seg.certainly_hidden = certainly_hidden;

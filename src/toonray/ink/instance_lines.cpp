@@ -386,19 +386,19 @@ std::shared_ptr<const MeshLines> make_mesh_lines(std::shared_ptr<const TriangleM
     auto smooth_across = [&](std::uint32_t lo, const Side& s0, const Side& s1) {
         if (!ml.corner_normals[s0.tri()] || !ml.corner_normals[s1.tri()]) return false;
         return corner_normal(s0.tri(), lo) == corner_normal(s1.tri(), lo) &&
-               corner_normal(s0.tri(), s0.hi) == corner_normal(s1.tri(), s1.hi);
+               corner_normal(s0.tri(), s0.hi()) == corner_normal(s1.tri(), s1.hi());
     };
     std::vector<MeshLines::Edge> edges;
     topology.for_each_edge([&](std::uint32_t i, std::uint32_t j, std::uint32_t lo) {
         const Side& s0 = topology.sides[i];
         MeshLines::Edge edge{lo,
-                             s0.hi,
+                             s0.hi(),
                              s0.tri(),
                              j - i > 1 ? topology.sides[i + 1].tri() : kNoIndex,
                              mesh.positions[ml.welded.vertex_position[lo]],
                              Vec3f(0.0f),
                              Vec3f(0.0f),
-                             mesh.positions[ml.welded.vertex_position[s0.hi]],
+                             mesh.positions[ml.welded.vertex_position[s0.hi()]],
                              0,
                              static_cast<std::uint32_t>(edges.size())};
         if (j - i != 2) {

@@ -22,20 +22,25 @@ namespace toonray::ink {
 // A side of a usable triangle, from welded vertex lo to hi (lo < hi), kept in lo's range of
 // the sides (MeshTopology::vertex_sides): 8 bytes, as a million triangles have three million
 // sides. Whether it runs forward and which corner of the triangle starts it share a word with
-// the triangle.
+// the triangle; whether it starts an edge of exactly two sides shares a word with hi (welded
+// vertices number at most three per triangle, below 2^31).
 struct Side {
-    std::uint32_t hi;
+    // hi (the low 31 bits), and kPair when this side and the next are the edge's only two.
+    std::uint32_t hi_pair;
     // The triangle (the low kCornerShift bits), the corner k whose side (k -> k + 1 in the
     // triangle's winding) this is, and kForward when lo -> hi is its winding.
     std::uint32_t tri_corner_forward;
 
+    static constexpr std::uint32_t kPair = 0x80000000u;
     static constexpr std::uint32_t kForward = 0x80000000u;
     static constexpr int kCornerShift = 29;
     static constexpr std::uint32_t kTriangles = 1u << kCornerShift;  // triangle ids are below
     Side() = default;
     Side(std::uint32_t hi_, std::uint32_t tri_, std::uint32_t corner_, bool forward_)
-        : hi(hi_),
+        : hi_pair(hi_),
           tri_corner_forward(tri_ | (corner_ << kCornerShift) | (forward_ ? kForward : 0u)) {}
+    [[nodiscard]] std::uint32_t hi() const { return hi_pair & ~kPair; }
+    [[nodiscard]] bool starts_pair() const { return (hi_pair & kPair) != 0; }
     [[nodiscard]] std::uint32_t tri() const { return tri_corner_forward & (kTriangles - 1); }
     [[nodiscard]] std::uint32_t corner() const { return (tri_corner_forward >> kCornerShift) & 3; }
     [[nodiscard]] bool forward() const { return (tri_corner_forward & kForward) != 0; }
@@ -109,19 +114,22 @@ struct MeshTopology {
             Side* const last = sides.get() + offsets[v + 1];
             // By insertion, as a vertex has few sides (but not at the centre of a large fan).
             if (last - first > 32) {
-                std::stable_sort(first, last,
-                                 [](const Side& a, const Side& b) { return a.hi < b.hi; });
+                std::stable_sort(first, last, [](const Side& a, const Side& b) {
+                    return a.hi_pair < b.hi_pair;
+                });
             } else {
                 for (Side* i = first + 1; i < last; ++i) {
                     const Side side = *i;
                     Side* j = i;
-                    for (; j > first && (j - 1)->hi > side.hi; --j) *j = *(j - 1);
+                    for (; j > first && (j - 1)->hi_pair > side.hi_pair; --j) *j = *(j - 1);
                     *j = side;
                 }
             }
-            for (const Side* i = first; i < last;) {
-                const Side* j = i + 1;
-                while (j < last && j->hi == i->hi) ++j;
+            // The sides' kPair bits are still clear here: hi_pair is hi.
+            for (Side* i = first; i < last;) {
+                Side* j = i + 1;
+                while (j < last && j->hi_pair == i->hi_pair) ++j;
+                if (j - i == 2) i->hi_pair |= Side::kPair;
                 if (j - i != 2 || i[0].forward() == i[1].forward()) open[tri_object[i->tri()]] = 1;
                 i = j;
             }
@@ -140,9 +148,12 @@ struct MeshTopology {
         for (std::uint32_t lo = 0; lo < vertices; ++lo) {
             const std::uint32_t last = first[lo + 1];
             for (std::uint32_t i = first[lo]; i < last;) {
-                const std::uint32_t hi = s[i].hi;
-                std::uint32_t j = i + 1;
-                while (j < last && s[j].hi == hi) ++j;
+                // Most edges have two sides, marked as they were found.
+                std::uint32_t j = i + 2;
+                if (!s[i].starts_pair()) {
+                    const std::uint32_t hi = s[i].hi();
+                    for (j = i + 1; j < last && s[j].hi() == hi;) ++j;
+                }
                 f(i, j, lo);
                 i = j;
             }
@@ -155,19 +166,14 @@ struct MeshTopology {
     [[nodiscard]] std::vector<std::array<std::uint32_t, 3>> triangles_across(std::size_t n) const {
         std::vector<std::array<std::uint32_t, 3>> across(n, {kNoIndex, kNoIndex, kNoIndex});
         const Side* const s = sides.get();
-        for_each_edge([&](std::uint32_t i, std::uint32_t j, std::uint32_t) {
-            if (j - i == 2) link_across(s[i], s[i + 1], across);
-        });
+        // The edges of two sides are marked at their first: no vertex's range is needed.
+        const std::size_t count = side_count();
+        for (std::size_t i = 0; i < count; ++i) {
+            if (!s[i].starts_pair() || s[i].forward() == s[i + 1].forward()) continue;
+            across[s[i].tri()][s[i].corner()] = s[i + 1].tri();
+            across[s[i + 1].tri()][s[i + 1].corner()] = s[i].tri();
+        }
         return across;
-    }
-
-    /// triangles_across's entries for the two sides of one edge, in a pass over the edges that
-    /// already reads them.
-    static void link_across(const Side& s0, const Side& s1,
-                            std::vector<std::array<std::uint32_t, 3>>& across) {
-        if (s0.forward() == s1.forward()) return;
-        across[s0.tri()][s0.corner()] = s1.tri();
-        across[s1.tri()][s1.corner()] = s0.tri();
     }
 
     /// Whether the triangles' objects and usability are those it was made from (false when
@@ -212,6 +218,24 @@ using RoundedNormal = std::array<std::int8_t, 3>;
     }
     return r;
 }
+
+/// Which side of a triangle's plane the eye is on (0: in it, or the triangle is degenerate).
+inline constexpr std::uint8_t kEyeInFront = 1, kEyeBehind = 2;
+
+/// What find_feature_edges's per-triangle pass writes for each triangle.
+struct TriangleFacts {
+    Vec3f* normal;           ///< unit_face_normal of its corners
+    RoundedNormal* rounded;  ///< round_normal of that (null: not wanted)
+    std::uint8_t* usable;    ///< 1 where the normal is not zero
+    std::uint8_t* eye_side;  ///< kEyeInFront, kEyeBehind or 0, from dot(normal, eye - corner 0)
+};
+
+/// The per-triangle pass over triangles [0, 4 * (n / 4)) of one object, four at a time, with
+/// the scalar pass's bits: their facts, their corners added to `box` and each dot(p0, cross(p1,
+/// p2)) to `volume` in triangle order. Returns the number of triangles done (the rest are left
+/// to the scalar pass).
+std::size_t facts_by_four(const IndexedCorners& corners_of, const Vec3f& eye, std::size_t n,
+                          const TriangleFacts& out, BBox& box, double& volume);
 
 /// What lets the intersection search skip whole subtrees whose triangles cannot cross one
 /// another: per triangle, its unit normal (unit_face_normal) rounded, and the triangles across its
