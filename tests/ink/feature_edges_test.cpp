@@ -480,75 +480,169 @@ TEST(FindCrossings, SkippingPatchesThatCannotCrossThemselvesFindsTheSamePairs) {
     EXPECT_EQ(found(&patches), all);
 }
 
-// The four-at-a-time per-triangle pass gives the scalar pass's bits: normals, rounded normals,
-// usability, the eye's side, the volume summed in order and the box; on triangles of every
-// kind: ordinary, degenerate (a repeated corner, collinear corners), so large that the normal
-// overflows, so small that it underflows, and with the eye in a triangle's plane.
-TEST(FeatureEdges, TheTrianglePassByFourGivesTheScalarPassesBits) {
-    std::mt19937 rng(7);
-    std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
-    std::uniform_int_distribution<int> kind(0, 9);
-    const Vec3f eye(0.3f, 2.0f, 5.0f);
+// Triangles of every kind for the four-at-a-time pass: ordinary (of two sizes), degenerate (a repeated
+// corner, collinear corners), so small that the normal underflows, with the eye in their plane,
+// and (`overflowing`) so large that the normal overflows.
+struct RandomTriangles {
     std::vector<Vec3f> positions;
     std::vector<std::array<std::uint32_t, 3>> triangles;
+    RandomTriangles(std::size_t n, const Vec3f& eye, bool overflowing) {
+        std::mt19937 rng(7);
+        std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
+        std::uniform_int_distribution<int> kind(0, 9);
+        for (std::size_t t = 0; t < n; ++t) {
+            const auto first = static_cast<std::uint32_t>(positions.size());
+            const int k = kind(rng);
+            // Kind 4's volumes are 2^40 below the others': their sum rounds, by its order.
+            const float scale = k == 7 && overflowing ? 3e19f
+                                : k == 8              ? 1e-22f
+                                : k == 4              ? 1e-3f
+                                                      : 10.0f;
+            for (int c = 0; c < 3; ++c)
+                positions.push_back(Vec3f(unit(rng), unit(rng), unit(rng)) * scale);
+            if (k == 5) positions[first + 2] = positions[first + 1];  // repeated corner
+            if (k == 6)                                               // collinear
+                positions[first + 2] =
+                    positions[first] + (positions[first + 1] - positions[first]) * 2.0f;
+            if (k == 9)  // in the plane y = eye.y: the eye is in the triangle's plane
+                for (int c = 0; c < 3; ++c)
+                    positions[first + static_cast<std::uint32_t>(c)].y = eye.y;
+            triangles.push_back({first, first + 1, first + 2});
+        }
+    }
+};
+
+// The four-at-a-time per-triangle pass gives the scalar pass's bits: normals, rounded normals,
+// usability and the eye's side on triangles of every kind, and the volume summed in triangle
+// order and the box.
+TEST(FeatureEdges, TheTrianglePassByFourGivesTheScalarPassesBits) {
+    using Bits = std::array<std::uint32_t, 3>;
+    const Vec3f eye(0.3f, 2.0f, 5.0f);
     const std::size_t n = 4003;  // the last three are left to the scalar pass
-    for (std::size_t t = 0; t < n; ++t) {
-        const auto first = static_cast<std::uint32_t>(positions.size());
-        const int k = kind(rng);
-        const float scale = k == 7 ? 3e19f : k == 8 ? 1e-22f : 10.0f;
-        for (int c = 0; c < 3; ++c)
-            positions.push_back(Vec3f(unit(rng), unit(rng), unit(rng)) * scale);
-        if (k == 5) positions[first + 2] = positions[first + 1];  // repeated corner
-        if (k == 6)                                               // collinear
-            positions[first + 2] =
-                positions[first] + (positions[first + 1] - positions[first]) * 2.0f;
-        if (k == 9)  // in the plane y = eye.y: the eye is in the triangle's plane
-            for (int c = 0; c < 3; ++c) positions[first + static_cast<std::uint32_t>(c)].y = eye.y;
-        triangles.push_back({first, first + 1, first + 2});
-    }
-    const ink::IndexedCorners corners_of{positions, triangles};
-    std::vector<Vec3f> normal(n);
-    std::vector<ink::RoundedNormal> rounded(n);
-    std::vector<std::uint8_t> usable(n), side(n);
-    BBox box;
-    double volume = 0.0;
-    const std::size_t done = ink::facts_by_four(
-        corners_of, eye, n, {normal.data(), rounded.data(), usable.data(), side.data()}, box,
-        volume);
-    ASSERT_EQ(done, 4000u);
+    for (const bool overflowing : {true, false}) {
+        const RandomTriangles mesh(n, eye, overflowing);
+        const ink::IndexedCorners corners_of{mesh.positions, mesh.triangles};
+        std::vector<Vec3f> normal(n);
+        std::vector<ink::RoundedNormal> rounded(n);
+        std::vector<std::uint8_t> usable(n), side(n);
+        BBox box;
+        double volume = 0.0;
+        const std::size_t done = ink::facts_by_four(
+            corners_of, eye, n, {normal.data(), rounded.data(), usable.data(), side.data()}, box,
+            volume);
+        ASSERT_EQ(done, 4000u);
 
-    BBox expected_box;
-    double expected_volume = 0.0;
-    int zero = 0, in_plane = 0;
-    for (std::size_t t = 0; t < done; ++t) {
-        const auto p = corners_of(static_cast<std::uint32_t>(t));
-        const Vec3f nt = unit_face_normal(p[0], p[1], p[2]);
-        using Bits = std::array<std::uint32_t, 3>;
-        EXPECT_EQ(std::bit_cast<Bits>(normal[t]), std::bit_cast<Bits>(nt)) << t;
-        EXPECT_EQ(rounded[t], ink::round_normal(nt)) << t;
-        EXPECT_EQ(usable[t], nt != Vec3f(0.0f) ? 1 : 0) << t;
-        const float facing = dot(nt, eye - p[0]);
-        EXPECT_EQ(side[t], facing > 0 ? ink::kEyeInFront : facing < 0 ? ink::kEyeBehind : 0) << t;
-        zero += nt == Vec3f(0.0f);
-        in_plane += nt != Vec3f(0.0f) && facing == 0;
-        expected_volume += static_cast<double>(dot(p[0], cross(p[1], p[2])));
-        for (const Vec3f& q : p) expected_box.extend(q);
-    }
-    EXPECT_EQ(std::bit_cast<std::uint64_t>(volume), std::bit_cast<std::uint64_t>(expected_volume));
-    EXPECT_EQ(box.lo, expected_box.lo);
-    EXPECT_EQ(box.hi, expected_box.hi);
-    // Every kind occurs: degenerate and overflowing triangles have no normal.
-    EXPECT_GT(zero, 600);
-    EXPECT_GT(in_plane, 100);
+        BBox expected_box;
+        std::vector<double> volumes;
+        int zero = 0, in_plane = 0;
+        for (std::size_t t = 0; t < done; ++t) {
+            const auto p = corners_of(static_cast<std::uint32_t>(t));
+            const Vec3f nt = unit_face_normal(p[0], p[1], p[2]);
+            EXPECT_EQ(std::bit_cast<Bits>(normal[t]), std::bit_cast<Bits>(nt)) << t;
+            EXPECT_EQ(rounded[t], ink::round_normal(nt)) << t;
+            EXPECT_EQ(usable[t], nt != Vec3f(0.0f) ? 1 : 0) << t;
+            const float facing = dot(nt, eye - p[0]);
+            EXPECT_EQ(side[t], facing > 0   ? ink::kEyeInFront
+                               : facing < 0 ? ink::kEyeBehind
+                                            : 0)
+                << t;
+            zero += nt == Vec3f(0.0f);
+            in_plane += nt != Vec3f(0.0f) && facing == 0;
+            volumes.push_back(static_cast<double>(dot(p[0], cross(p[1], p[2]))));
+            for (const Vec3f& q : p) expected_box.extend(q);
+        }
+        // Every kind occurs: degenerate, underflowing and overflowing triangles have no normal.
+        EXPECT_GT(zero, overflowing ? 900 : 600);
+        EXPECT_GT(in_plane, 100);
+        EXPECT_EQ(box.lo, expected_box.lo);
+        EXPECT_EQ(box.hi, expected_box.hi);
+        if (!overflowing) {
+            // The volume, finite here, is summed in triangle order: summed backwards its bits
+            // differ.
+            double forwards = 0.0, backwards = 0.0;
+            for (const double v : volumes) forwards += v;
+            for (auto v = volumes.rbegin(); v != volumes.rend(); ++v) backwards += *v;
+            ASSERT_TRUE(std::isfinite(forwards));
+            ASSERT_NE(std::bit_cast<std::uint64_t>(forwards),
+                      std::bit_cast<std::uint64_t>(backwards));
+            EXPECT_EQ(std::bit_cast<std::uint64_t>(volume), std::bit_cast<std::uint64_t>(forwards));
+        }
 
-    // Without rounded normals (no intersection search), the rest is the same.
-    std::vector<Vec3f> normal2(n);
-    BBox box2;
-    double volume2 = 0.0;
-    ink::facts_by_four(corners_of, eye, n, {normal2.data(), nullptr, usable.data(), side.data()},
-                       box2, volume2);
-    EXPECT_EQ(std::bit_cast<std::uint64_t>(volume2), std::bit_cast<std::uint64_t>(volume));
-    EXPECT_TRUE(std::equal(normal.begin(), normal.begin() + 4000, normal2.begin()));
+        // Without rounded normals (no intersection search), the rest is the same.
+        std::vector<Vec3f> normal2(n);
+        std::vector<std::uint8_t> usable2(n), side2(n);
+        BBox box2;
+        double volume2 = 0.0;
+        ink::facts_by_four(corners_of, eye, n,
+                           {normal2.data(), nullptr, usable2.data(), side2.data()}, box2, volume2);
+        for (std::size_t t = 0; t < done; ++t)
+            EXPECT_EQ(std::bit_cast<Bits>(normal2[t]), std::bit_cast<Bits>(normal[t])) << t;
+        EXPECT_EQ(usable2, usable);
+        EXPECT_EQ(side2, side);
+        EXPECT_EQ(std::bit_cast<std::uint64_t>(volume2), std::bit_cast<std::uint64_t>(volume));
+    }
+}
+
+// The edges as for_each_edge gives them, and the triangles across each side, against a list
+// of every side sorted by its ends: on a mesh with borders, edges of three and four sides,
+// neighbours wound both ways, a degenerate triangle and a fan of 40 triangles (whose centre
+// has more than 32 sides to sort).
+TEST(MeshTopology, EdgesAndTheTrianglesAcrossThemMatchAListOfEverySide) {
+    std::mt19937 rng(3);
+    std::uniform_int_distribution<std::uint32_t> vertex(1, 30);
+    std::vector<std::array<std::uint32_t, 3>> tris;
+    for (int t = 0; t < 400; ++t) tris.push_back({vertex(rng), vertex(rng), vertex(rng)});
+    for (std::uint32_t k = 0; k < 40; ++k) tris.push_back({0, 31 + k, 31 + (k + 1) % 40});
+    ink::WeldedMesh mesh;
+    mesh.tri_vertices = tris;
+    mesh.vertex_position.resize(71);
+    for (std::uint32_t v = 0; v < 71; ++v) mesh.vertex_position[v] = v;
+    const std::size_t n = tris.size();
+    std::vector<std::uint8_t> usable(n, 1);
+    usable[7] = 0;
+    const std::vector<std::uint32_t> objects(n, 0);
+    const ink::MeshTopology topology(objects, mesh, usable, 1);
+
+    // Every side of a usable triangle: (lo, hi) -> (triangle, corner, forward), in triangle and
+    // corner order.
+    std::map<std::pair<std::uint32_t, std::uint32_t>, std::vector<std::array<std::uint32_t, 3>>>
+        expected;
+    for (std::uint32_t t = 0; t < n; ++t) {
+        if (!usable[t]) continue;
+        for (std::uint32_t k = 0; k < 3; ++k) {
+            const std::uint32_t u = tris[t][k], v = tris[t][(k + 1) % 3];
+            if (u != v) expected[{std::min(u, v), std::max(u, v)}].push_back({t, k, u < v});
+        }
+    }
+    std::map<std::pair<std::uint32_t, std::uint32_t>, std::vector<std::array<std::uint32_t, 3>>>
+        found;
+    int pairs = 0, larger = 0;
+    topology.for_each_edge([&](std::uint32_t i, std::uint32_t j, std::uint32_t lo) {
+        auto& sides = found[{lo, topology.sides[i].hi()}];
+        EXPECT_TRUE(sides.empty());  // each edge once
+        for (std::uint32_t s = i; s < j; ++s) {
+            const ink::Side& side = topology.sides[s];
+            EXPECT_EQ(side.hi(), topology.sides[i].hi());
+            sides.push_back({side.tri(), side.corner(), side.forward() ? 1u : 0u});
+        }
+        pairs += j - i == 2;
+        larger += j - i > 2;
+    });
+    EXPECT_EQ(found, expected);
+    EXPECT_GT(pairs, 100);
+    EXPECT_GT(larger, 10);
+
+    const auto across = topology.triangles_across(n);
+    std::vector<std::array<std::uint32_t, 3>> expected_across(n, {kNoIndex, kNoIndex, kNoIndex});
+    int linked = 0;
+    for (const auto& [edge, sides] : expected)
+        if (sides.size() == 2 && sides[0][2] != sides[1][2]) {
+            expected_across[sides[0][0]][sides[0][1]] = sides[1][0];
+            expected_across[sides[1][0]][sides[1][1]] = sides[0][0];
+            ++linked;
+        }
+    EXPECT_EQ(across, expected_across);
+    EXPECT_GT(linked, 40);
 }
 
 TEST(FeatureEdges, SameForAnyThreadCount) {

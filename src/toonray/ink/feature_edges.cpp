@@ -7,6 +7,7 @@
 #include <map>
 #include <memory>
 #include <cmath>
+#include <cstring>
 #include <numbers>
 #include <tuple>
 
@@ -603,7 +604,9 @@ void corner_by_four(const IndexedCorners& corners_of, std::size_t t, int c, __m1
     __m128 r[4];
     for (std::size_t j = 0; j < 4; ++j) {
         const Vec3f& p = corners_of.positions[corners_of.triangles[t + j][c]];
-        const __m128 xy = _mm_castsi128_ps(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(&p.x)));
+        std::int64_t x_and_y;  // copied: SIMDe's NEON load would read the floats as integers
+        std::memcpy(&x_and_y, &p.x, 8);
+        const __m128 xy = _mm_castsi128_ps(_mm_cvtsi64_si128(x_and_y));
         r[j] = _mm_movelh_ps(xy, _mm_load_ss(&p.z));
     }
     const __m128 xy01 = _mm_unpacklo_ps(r[0], r[1]), xy23 = _mm_unpacklo_ps(r[2], r[3]);
@@ -654,43 +657,58 @@ std::size_t facts_by_four(const IndexedCorners& corners_of, const Vec3f& eye, st
                      uy = _mm_and_ps(ok, _mm_div_ps(ny, len)),
                      uz = _mm_and_ps(ok, _mm_div_ps(nz, len));
         const __m128 facing = dot(ux, uy, uz, sub(ex, p[0][0]), sub(ey, p[0][1]), sub(ez, p[0][2]));
-        const int front = _mm_movemask_ps(_mm_cmpgt_ps(facing, zero));
-        const int behind = _mm_movemask_ps(_mm_cmplt_ps(facing, zero));
-        const int usable = _mm_movemask_ps(ok);
+        // Four Vec3f (x0 y0 z0 x1 | y1 z1 x2 y2 | z2 x3 y3 z3) from the lanes, in three stores.
+        static_assert(sizeof(Vec3f) == 12 && sizeof(RoundedNormal) == 3);
+        char* const normals = reinterpret_cast<char*>(out.normal + t);
+        _mm_storeu_ps(reinterpret_cast<float*>(normals),
+                      _mm_shuffle_ps(_mm_unpacklo_ps(ux, uy), _mm_unpacklo_ps(uz, ux),
+                                     _MM_SHUFFLE(3, 0, 1, 0)));
+        _mm_storeu_ps(reinterpret_cast<float*>(normals + 16),
+                      _mm_shuffle_ps(_mm_unpacklo_ps(uy, uz), _mm_unpackhi_ps(ux, uy),
+                                     _MM_SHUFFLE(1, 0, 3, 2)));
+        _mm_storeu_ps(reinterpret_cast<float*>(normals + 32),
+                      _mm_shuffle_ps(_mm_unpackhi_ps(uz, ux), _mm_unpackhi_ps(uy, uz),
+                                     _MM_SHUFFLE(3, 2, 3, 0)));
+        if (out.rounded) {
+            // round_normal: n + (n < 0 ? -0.5 : 0.5), truncated; the lanes' whole numbers (within
+            // 127) packed to bytes without saturating and put in corner order, 12 bytes.
+            const __m128 half = _mm_set1_ps(0.5f), less_half = _mm_set1_ps(-0.5f);
+            const __m128 scale = _mm_set1_ps(127.0f);
+            auto rounded = [&](__m128 n) {
+                const __m128 q = mul(n, scale);
+                return _mm_cvttps_epi32(
+                    _mm_add_ps(q, _mm_blendv_ps(half, less_half, _mm_cmplt_ps(q, zero))));
+            };
+            const __m128i bytes =
+                _mm_packs_epi16(_mm_packs_epi32(rounded(ux), rounded(uy)),
+                                _mm_packs_epi32(rounded(uz), _mm_setzero_si128()));
+            const __m128i by_triangle = _mm_shuffle_epi8(
+                bytes, _mm_setr_epi8(0, 4, 8, 1, 5, 9, 2, 6, 10, 3, 7, 11, -1, -1, -1, -1));
+            auto* const r = reinterpret_cast<char*>(out.rounded + t);
+            _mm_storel_epi64(reinterpret_cast<__m128i*>(r), by_triangle);
+            const std::int32_t last = _mm_extract_epi32(by_triangle, 2);
+            std::memcpy(r + 8, &last, 4);
+        }
+        // Usability (1 or 0) and the eye's side (kEyeInFront, kEyeBehind or 0: facing > 0 and
+        // facing < 0 exclude each other) as bytes, four of each.
+        const __m128i one = _mm_set1_epi32(1);
+        const __m128i side =
+            _mm_or_si128(_mm_and_si128(_mm_castps_si128(_mm_cmpgt_ps(facing, zero)),
+                                       _mm_set1_epi32(kEyeInFront)),
+                         _mm_and_si128(_mm_castps_si128(_mm_cmplt_ps(facing, zero)),
+                                       _mm_set1_epi32(kEyeBehind)));
+        const __m128i flags = _mm_packs_epi16(
+            _mm_packs_epi32(_mm_and_si128(_mm_castps_si128(ok), one), side), _mm_setzero_si128());
+        const std::int32_t usable4 = _mm_cvtsi128_si32(flags), side4 = _mm_extract_epi32(flags, 1);
+        std::memcpy(out.usable + t, &usable4, 4);
+        std::memcpy(out.eye_side + t, &side4, 4);
         // dot(p0, cross(p1, p2)), each added to the sum in triangle order.
         const __m128 cx = sub(mul(p[1][1], p[2][2]), mul(p[1][2], p[2][1])),
                      cy = sub(mul(p[1][2], p[2][0]), mul(p[1][0], p[2][2])),
                      cz = sub(mul(p[1][0], p[2][1]), mul(p[1][1], p[2][0]));
-        alignas(16) float u[3][4], v[4];
-        _mm_store_ps(u[0], ux);
-        _mm_store_ps(u[1], uy);
-        _mm_store_ps(u[2], uz);
+        alignas(16) float v[4];
         _mm_store_ps(v, dot(p[0][0], p[0][1], p[0][2], cx, cy, cz));
-        alignas(16) std::int32_t r[3][4];
-        if (out.rounded) {
-            // round_normal: n + (n < 0 ? -0.5 : 0.5), truncated.
-            const __m128 half = _mm_set1_ps(0.5f), less_half = _mm_set1_ps(-0.5f);
-            const __m128 scale = _mm_set1_ps(127.0f);
-            const __m128 un[3] = {ux, uy, uz};
-            for (int a = 0; a < 3; ++a) {
-                const __m128 q = mul(un[a], scale);
-                const __m128 add = _mm_blendv_ps(half, less_half, _mm_cmplt_ps(q, zero));
-                _mm_store_si128(reinterpret_cast<__m128i*>(r[a]),
-                                _mm_cvttps_epi32(_mm_add_ps(q, add)));
-            }
-        }
-        for (std::size_t j = 0; j < 4; ++j) {
-            out.normal[t + j] = Vec3f(u[0][j], u[1][j], u[2][j]);
-            if (out.rounded)
-                out.rounded[t + j] = {static_cast<std::int8_t>(r[0][j]),
-                                      static_cast<std::int8_t>(r[1][j]),
-                                      static_cast<std::int8_t>(r[2][j])};
-            out.usable[t + j] = (usable >> j) & 1;
-            out.eye_side[t + j] = (front >> j) & 1    ? kEyeInFront
-                                  : (behind >> j) & 1 ? kEyeBehind
-                                                      : 0;
-            volume += static_cast<double>(v[j]);
-        }
+        for (const float vj : v) volume += static_cast<double>(vj);
     }
     alignas(16) float l[3][4], h[3][4];
     for (int a = 0; a < 3; ++a) {
@@ -822,7 +840,7 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
         std::uint8_t* const usable_out = usable_triangle.data();
         std::uint8_t* const side_out = eye_side.data();
         std::uint8_t* const corner_normals_out = corner_normals.data();
-        // One object's box and volume are summed in locals, in the same order.
+        // One object's box and volume are summed in locals (the volume in triangle order).
         BBox box;
         double sum = 0.0;
         std::size_t t = 0;
@@ -897,19 +915,20 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
     std::vector<std::uint8_t>& turned_away = eye_side;  // in its place
     std::vector<std::uint8_t> live_triangle(intersections ? n : 0);
     if (objects == 1) {
-        // Bytes without branches, which the compiler does sixteen at a time.
+        // Bytes without branches, which the compiler does sixteen at a time (through locals: the
+        // stores could otherwise change n, which the lambdas above take by reference).
         const std::uint8_t closed_solid = outward[0] != 0;
         const std::uint8_t away_side = outward[0] > 0 ? kEyeBehind : kEyeInFront;
         const std::uint8_t keep_away = settings.certainly_hidden;
+        const std::size_t count = n;
         const std::uint8_t* const usable_of = usable_triangle.data();
         std::uint8_t* const side = eye_side.data();
-        for (std::size_t t = 0; t < n; ++t) {
-            const std::uint8_t away = closed_solid & usable_of[t] & (side[t] == away_side);
-            side[t] = away;
-        }
+        for (std::size_t t = 0; t < count; ++t)
+            side[t] = closed_solid & usable_of[t] & (side[t] == away_side);
+        std::uint8_t* const live = live_triangle.data();
         if (intersections)
-            for (std::size_t t = 0; t < n; ++t)
-                live_triangle[t] = usable_of[t] & (keep_away | (side[t] ^ 1));
+            for (std::size_t t = 0; t < count; ++t)
+                live[t] = usable_of[t] & (keep_away | (side[t] ^ 1));
     } else {
         for (std::size_t t = 0; t < n; ++t) {
             const int out = outward[scene.tri_object[t]];
@@ -945,7 +964,7 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
         settings.materials &&
         std::adjacent_find(scene.tri_material.begin(), scene.tri_material.begin() + n,
                            std::not_equal_to<>()) != scene.tri_material.begin() + n;
-    // Read through locals: the stores below (the sides' links, the segments) would otherwise
+    // Read through locals: the stores below (the segments) would otherwise
     // make the loop read the arrays' addresses and the settings again for every edge.
     const Vec3f* const normal_of = normal.data();
     const std::uint32_t* const material_of = scene.tri_material.data();
@@ -966,7 +985,7 @@ std::vector<FeatureSegment> find_feature_edges(const Scene& scene, const WeldedM
                 __builtin_prefetch(&material_of[t1]);
             }
         }
-        // Copies: the links' stores below could otherwise change them.
+        // Copies: the segments' stores below could otherwise change them.
         const Side s0 = sides[i];
         if (lo != at_vertex) {
             at_vertex = lo;

@@ -55,7 +55,8 @@ struct MeshTopology {
     std::size_t objects = 0;
     /// Every side of a usable triangle, in order of (lo, hi, triangle, corner): the sides from
     /// welded vertex lo are [vertex_sides[lo], vertex_sides[lo + 1]), and an edge is a run of
-    /// them with the same hi (found as they are read, rather than listed: 4 bytes an edge).
+    /// them with the same hi (found as they are read, rather than listed: 4 bytes an edge; the
+    /// first of an edge's two sides is marked, Side::kPair).
     std::unique_ptr<Side[]> sides;  // every one written: not cleared first
     std::vector<std::uint32_t> vertex_sides;
     /// Per object: not closed, for an edge without exactly two sides in opposite directions,
@@ -230,10 +231,11 @@ struct TriangleFacts {
     std::uint8_t* eye_side;  ///< kEyeInFront, kEyeBehind or 0, from dot(normal, eye - corner 0)
 };
 
-/// The per-triangle pass over triangles [0, 4 * (n / 4)) of one object, four at a time, with
-/// the scalar pass's bits: their facts, their corners added to `box` and each dot(p0, cross(p1,
-/// p2)) to `volume` in triangle order. Returns the number of triangles done (the rest are left
-/// to the scalar pass).
+/// The per-triangle pass over triangles [0, 4 * (n / 4)) of one object, four at a time: their
+/// facts with the scalar pass's bits, their corners added to `box` and each dot(p0, cross(p1,
+/// p2)) to `volume` in triangle order. The box can differ from the scalar pass's in the sign of
+/// a zero bound, and a NaN volume in its payload, which no comparison sees. Returns the number
+/// of triangles done (the rest are left to the scalar pass).
 std::size_t facts_by_four(const IndexedCorners& corners_of, const Vec3f& eye, std::size_t n,
                           const TriangleFacts& out, BBox& box, double& volume);
 
