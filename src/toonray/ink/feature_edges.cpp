@@ -619,8 +619,9 @@ void corner_by_four(const IndexedCorners& corners_of, std::size_t t, int c, __m1
 }  // namespace
 
 // The same operations in the same order as the scalar pass, lane by lane: the same bits. Only
-// the box is reduced in another order, which can change the sign of a zero bound but not a
-// comparison with it. At a million triangles: about a third of the scalar pass's instructions.
+// the box is reduced in another order (the sign of a zero bound can differ) and a NaN volume's
+// payload can differ, neither of which a comparison sees. At a million triangles: about a third
+// of the scalar pass's instructions.
 std::size_t facts_by_four(const IndexedCorners& corners_of, const Vec3f& eye, std::size_t n,
                           const TriangleFacts& out, BBox& box, double& volume) {
     const __m128 zero = _mm_setzero_ps(), inf = _mm_set1_ps(std::numeric_limits<float>::infinity());
